@@ -1,0 +1,1 @@
+"""The DLPC410 side: datasheet facts, DMD geometries, the data-beat map and the sequencer."""

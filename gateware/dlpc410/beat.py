@@ -1,0 +1,46 @@
+"""Where each column of a row travels on the DLPC410 data buses: the one map.
+
+One *beat* is what the core hands the DDR output registers in one ``dmd`` cycle: for a two-bus
+DMD (DLP7000, DLP650LNIR) 64 bits, DIN_A(15:0) and DIN_B(15:0) on the rising and on the falling
+DCLK edge. A bit-plane *word* is 64 bits that hold 64 adjacent columns of one row of one plane;
+word bit ``i`` is column ``64 * w + i`` (bit 0 = leftmost column, west when NS_FLIP is low).
+
+This table maps word bits to (bus, edge, pin). The bit-plane serialiser packs columns into words
+by the first rule above; the DLPC410 model decodes pins back into columns through this table;
+nothing else knows the order.
+
+Assumption (to confirm against the DLPC410 datasheet's data-bus figure on hardware): within a
+beat, rising edge before falling edge, bus A before bus B, pin 0 first; that is::
+
+    word bits  0..15 -> DIN_A(15:0), rising edge
+    word bits 16..31 -> DIN_B(15:0), rising edge
+    word bits 32..47 -> DIN_A(15:0), falling edge
+    word bits 48..63 -> DIN_B(15:0), falling edge
+
+A four-bus DMD (DLP9500) takes two words per beat: the first on A/B as above, the second on C/D.
+"""
+
+__all__ = ["LANES", "word_to_lanes", "lanes_to_word", "PINS_PER_BUS"]
+
+PINS_PER_BUS = 16
+
+#: (bus, edge, first word bit) for each 16-bit lane of a 64-bit word, in word-bit order.
+LANES = (
+    ("A", "rise", 0),
+    ("B", "rise", 16),
+    ("A", "fall", 32),
+    ("B", "fall", 48),
+)
+
+
+def word_to_lanes(word):
+    """Split a 64-bit word (int) into ``{(bus, edge): 16-bit value}``."""
+    return {(bus, edge): (word >> lsb) & 0xffff for bus, edge, lsb in LANES}
+
+
+def lanes_to_word(lanes):
+    """Inverse of :func:`word_to_lanes`."""
+    word = 0
+    for bus, edge, lsb in LANES:
+        word |= (lanes[(bus, edge)] & 0xffff) << lsb
+    return word

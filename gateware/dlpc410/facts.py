@@ -1,0 +1,120 @@
+"""Facts about the TI DLPC410 controller and its DMDs, in one table each, with their sources.
+
+Every number the gateware or a model takes from a TI document lives here, as a parameter with
+its source named; nothing else in the tree writes such a number down. Where a value is uncertain
+the entry says so and callers take it as a run-time or build-time parameter.
+
+Sources
+-------
+DLPC410     DLPC410 datasheet (DLPS024), row addressing and command tables
+DLPU045A    DLPC410 programming note: DCLK, even idle cycles
+DLPA008B    DLPC410 application note: reset, settle, clears, phased operation
+DLPU040C    DLPC410 user guide, table 1-1 (binary pattern rates)
+DLP7000     DLP7000 datasheet (timing 7.12, initialisation 8.3)
+DLPC910     sister part's datasheet (same interface family)
+refHDL      TI's applications-FPGA reference HDL as quoted in public repositories
+forum       TI E2E forum answer quoting the datasheet; Mathews et al., IEEE QCE 2022 (measured)
+"""
+
+from dataclasses import dataclass
+
+from amaranth.lib import enum
+
+
+__all__ = ["Fact", "TIMING", "DmdType", "DMDS", "RowMode", "BlockMode", "TEST_DMD"]
+
+
+@dataclass(frozen=True)
+class Fact:
+    value: float
+    unit: str
+    source: str
+    confidence: str = "high"
+    note: str = ""
+
+
+#: Timing rules. Durations in seconds; the gateware takes them as cycle counts at run time.
+TIMING = {
+    "t_rst_active": Fact(4.54e-6, "s", "forum (measured 908 cycles at 200 MHz)", "medium",
+                         "RST_ACTIVE high after a mirror clocking pulse; no new pulse before it falls"),
+    "t_settle": Fact(8e-6, "s", "forum; DLPA008B 4.1", "medium",
+                     "after RST_ACTIVE falls, a pulsed block's memory must not change for this long"),
+    "t_crossover": Fact(4e-6, "s", "DLP7000 7.12", "high", "mirror crossover time"),
+    "t_switch": Fact(12.5e-6, "s", "DLP7000 7.12", "high", "typical mirror switching time"),
+    "t_init": Fact(220e-3, "s", "DLP7000 8.3", "medium", "INIT_ACTIVE high after ARSTZ"),
+    "init_to_dvalid_clocks": Fact(64, "DCLK", "DLPC910", "medium",
+                                  "first DVALID at least this many clocks after INIT_ACTIVE falls"),
+    "global_overhead": Fact(13.5e-6, "s", "DLPU040C table 1-1, derived", "medium",
+                            "per-frame overhead of global-reset binary patterns"),
+    "t_pwr_float": Fact(300e-6, "s", "DLPC410", "medium", "mirror parking after PWR_FLOAT"),
+    "t_watchdog": Fact(10.0, "s", "DLPC410", "medium", "WDT_ENBLZ low: forced reset if none issued"),
+    "dclk_min": Fact(200e6, "Hz", "DLP7000 table 8-2", "high"),
+    "dclk_max": Fact(400e6, "Hz", "DLP7000 table 8-2; DLPU045A (new PROM: 400 MHz only)", "high"),
+}
+
+
+@dataclass(frozen=True)
+class DmdType:
+    """A DMD as the DLPC410 addresses it.
+
+    ``columns`` is the width sent on the bus (the DLP9500's 1920 columns are sent as 2048).
+    """
+    name: str
+    columns: int
+    rows: int
+    visible_columns: int
+    blocks: int
+    rows_per_block: int
+    buses: int
+    bits_per_dclk: int
+    dclk_per_row: int
+    dmd_type_code: int | None
+    clear_row_cycles: int
+    source: str
+
+    @property
+    def words_per_row(self):
+        """64-bit words in one row of one bit-plane."""
+        return self.columns // 64
+
+    @property
+    def words_per_plane(self):
+        return self.words_per_row * self.rows
+
+    def block_of_row(self, row):
+        return row // self.rows_per_block
+
+    def __post_init__(self):
+        assert self.columns % 64 == 0
+        assert self.blocks * self.rows_per_block == self.rows
+
+
+#: DMDs (DLPC410 datasheet row addressing; DMD_TYPE codes from refHDL; clear cost DLPA008B 4.2).
+DMDS = {
+    "dlp7000": DmdType("DLP7000 0.7in XGA", 1024, 768, 1024, 16, 48, 2, 64, 16, 0b0001, 1,
+                       "DLPC410 row addressing; refHDL DMD_TYPE"),
+    "dlp9500": DmdType("DLP9500 0.95in 1080p", 2048, 1080, 1920, 15, 72, 4, 128, 16, 0b0000, 3,
+                       "DLPC410 row addressing; refHDL DMD_TYPE; 1080p clear = 1 + 2 no-op rows"),
+    "dlp650lnir": DmdType("DLP650LNIR 0.65in WXGA", 1280, 800, 1280, 16, 50, 2, 32, 40, 0b0111, 1,
+                          "DLPC410 row addressing; refHDL DMD_TYPE"),
+}
+
+#: A small DMD for fast tests: same rules, 128x96 in 4 blocks of 24 rows, XGA-style bus.
+TEST_DMD = DmdType("test 128x96", 128, 96, 128, 4, 24, 2, 64, 2, None, 1, "test geometry")
+DMDS["test"] = TEST_DMD
+
+
+class RowMode(enum.Enum, shape=2):
+    """ROWMD(1:0) (DLPC410 for 00 and 10; DLPC910 and refHDL for 01 and 11)."""
+    NOOP = 0b00
+    NEXT = 0b01       # advance the row pointer and write (decrement with NS_FLIP)
+    ADDRESSED = 0b10  # write at ROWAD
+    FIRST = 0b11      # pointer to row 0 and write there
+
+
+class BlockMode(enum.Enum, shape=2):
+    """BLKMD(1:0) (refHDL; confidence medium). See :mod:`gateware.dlpc410.facts` table above."""
+    NOOP = 0b00
+    CLEAR = 0b01      # clear block BLKAD
+    RESET = 0b10      # mirror clocking pulse of block BLKAD
+    MULTI = 0b11      # dual (RST2BLKZ=0), quad (RST2BLKZ=1, BLKAD=0qq0) or global (BLKAD=10xx)

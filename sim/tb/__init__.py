@@ -1,0 +1,1 @@
+"""cocotb testbenches; each module drives one generated Verilog top."""

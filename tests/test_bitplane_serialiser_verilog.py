@@ -1,0 +1,16 @@
+"""The bit-plane serialiser's generated Verilog under cocotb and Verilator."""
+
+import pytest
+
+from gateware.bitplane import Serialiser
+from gateware.dlpc410.facts import DMDS
+from sim.harness import cocotb_run
+
+
+@pytest.mark.verilog
+@pytest.mark.parametrize("lanes", [1, 8])
+def test_serialiser_verilog(lanes):
+    dmd = "test"
+    cocotb_run.run(Serialiser(DMDS[dmd], lanes=lanes), toplevel="bitplane_serialiser",
+                   module="sim.tb.serialiser", key=f"{dmd}-{lanes}",
+                   params={"dmd": dmd, "lanes": lanes})
