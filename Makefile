@@ -1,0 +1,47 @@
+# The projector's build and test entry points. Every target creates the virtual environment
+# (.venv, with an editable install of this project) if it is missing.
+
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+JOBS   ?= 2
+
+.PHONY: setup test sim verilog resources bench waves lint clean
+
+$(STAMP): pyproject.toml
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[dev]'
+	touch $(STAMP)
+
+setup: $(STAMP)
+
+# The whole suite: Amaranth-simulator unit tests and cocotb tests on the generated Verilog.
+test: $(STAMP)
+	$(PY) -m pytest -n $(JOBS) -q
+
+# The main job: the system simulation on the default scene.
+sim: $(STAMP)
+	$(PY) -m gateware sim
+
+# The Spartan-6 ISE tree (Verilog, UCF, ISE scripts) and each block's Verilog, in build/spartan6.
+verilog: $(STAMP)
+	$(PY) -m gateware verilog
+
+# LUT/FF/BRAM/DSP per block and in total on XC6SLX45 (Yosys synth_xilinx -family xc6s).
+resources: $(STAMP)
+	$(PY) -m gateware resources
+
+# Every benchmark; writes build/bench.json and prints the figures.
+bench: $(STAMP)
+	$(PY) -m gateware bench
+
+waves: $(STAMP)
+	$(PY) -m gateware waves
+
+lint: $(STAMP)
+	$(PY) -m ruff check gateware sim tests constraints $(wildcard host)
+
+clean:
+	rm -rf build results.xml .pytest_cache

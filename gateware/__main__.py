@@ -1,0 +1,5 @@
+import sys
+
+from gateware.cli import main
+
+sys.exit(main())

@@ -1,0 +1,41 @@
+"""Command line: ``python -m gateware <verilog|resources|bench|sim|waves>``."""
+
+import argparse
+import sys
+
+__all__ = ["main"]
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m gateware", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+    sub.add_parser("verilog", help="write the Spartan-6 ISE tree and every block's Verilog to build/spartan6")
+    sub.add_parser("resources", help="Yosys synth_xilinx -family xc6s: LUT/FF/BRAM/DSP per block and in total")
+    bench = sub.add_parser("bench", help="run the benchmarks and write build/bench.json")
+    bench.add_argument("--only", action="append", help="run only this benchmark module (repeatable)")
+    bench.add_argument("--no-resources", action="store_true", help="skip the synthesis figures")
+    sim = sub.add_parser("sim", help="the system simulation on the default scene")
+    sim.add_argument("--frames", type=int, default=None, help="number of frames to stream")
+    sub.add_parser("waves", help="say where the latest VCD and its GTKWave save file are")
+    args = parser.parse_args(argv)
+
+    if args.command == "verilog":
+        from gateware.flow.verilog import main as run
+        return run()
+    if args.command == "resources":
+        from gateware.flow.resources import main as run
+        return run()
+    if args.command == "bench":
+        from gateware.flow.bench import main as run
+        return run(args.only, resources=not args.no_resources)
+    if args.command == "sim":
+        from sim.system import main as run
+        return run(frames=args.frames)
+    if args.command == "waves":
+        from sim.harness.waves import main as run
+        return run()
+    return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

