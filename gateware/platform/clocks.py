@@ -10,6 +10,7 @@ gmii_tx    125 MHz     MAC transmit (forwarded to GTX_CLK)
 
 ``gmii_rx`` comes from the PHY's RX_CLK and is made by the platform top. Each domain's reset is
 held until the PLL locks and released synchronously (:class:`amaranth.lib.cdc.ResetSynchronizer`).
+The domains belong to the top (``m.domains += Spartan6Clocks.domains()``); this block drives them.
 """
 
 from amaranth import ClockDomain, ClockSignal, Elaboratable, Instance, Module, Signal
@@ -41,6 +42,11 @@ class Spartan6Clocks(Elaboratable):
         self.rst_in = rst_in
         self.locked = Signal()
 
+    @staticmethod
+    def domains():
+        """The clock domains this block drives; the top that owns them adds them."""
+        return [ClockDomain(name) for name in PLL_PLAN["outputs"]]
+
     def frequencies(self):
         vco = PLL_PLAN["input_mhz"] * PLL_PLAN["mult"]
         return {name: vco / div * 1e6 for name, div in PLL_PLAN["outputs"].items()}
@@ -65,8 +71,6 @@ class Spartan6Clocks(Elaboratable):
         m.submodules.pll = Instance("PLL_BASE", **params)
 
         for name in names:
-            domain = ClockDomain(name)
-            m.domains += domain
             m.submodules[f"bufg_{name}"] = Instance("BUFG", i_I=raw[name], o_O=ClockSignal(name))
             m.submodules[f"rst_{name}"] = ResetSynchronizer(~self.locked, domain=name)
         return m

@@ -27,6 +27,7 @@ class BringupTop(Elaboratable):
         rst = platform.request("rst", dir="-")
         m.submodules.clk_buf = clk_buf = io.Buffer("i", clk100)
         m.submodules.rst_buf = rst_buf = io.Buffer("i", rst)
+        m.domains += Spartan6Clocks.domains()
         m.submodules.clocks = Spartan6Clocks(clk_buf.i, rst_buf.i)
 
         dmd = DMDS["dlp7000"]

@@ -90,17 +90,24 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
     }
     if timeout_s is not None:
         env["DUT_TIMEOUT_S"] = str(timeout_s)
-    results = runner.test(
-        test_module=module,
-        hdl_toplevel=toplevel,
-        build_dir=build,
-        test_dir=build,
-        testcase=testcase,
-        extra_env=env,
-        waves=waves,
-        results_xml=str(build / "results.xml"),
-    )
-    tests, failed = get_results(Path(results))
+    results = build / "results.xml"
+    results.unlink(missing_ok=True)
+    try:
+        runner.test(
+            test_module=module,
+            hdl_toplevel=toplevel,
+            build_dir=build,
+            test_dir=build,
+            testcase=testcase,
+            extra_env=env,
+            waves=waves,
+            results_xml=str(results),
+        )
+    except SystemExit as exc:
+        # under pytest the runner exits on failure; report it as the test's failure, with counts
+        if not results.exists():
+            raise AssertionError(f"simulation of {module} ended abnormally (exit {exc.code}), see {build}")
+    tests, failed = get_results(results)
     assert tests > 0, f"cocotb ran no test from {module}"
     assert failed == 0, f"{failed} of {tests} cocotb tests failed in {module} (see {build})"
     return build
