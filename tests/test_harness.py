@@ -1,7 +1,7 @@
 """The harnesses themselves: layouts round-trip, and a failing cocotb test fails pytest."""
 
 import pytest
-from amaranth import Module, Signal
+from amaranth import Module
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import Out
 

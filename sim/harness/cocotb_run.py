@@ -106,7 +106,7 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
     except SystemExit as exc:
         # under pytest the runner exits on failure; report it as the test's failure, with counts
         if not results.exists():
-            raise AssertionError(f"simulation of {module} ended abnormally (exit {exc.code}), see {build}")
+            raise AssertionError(f"simulation of {module} ended abnormally (exit {exc.code}), see {build}") from None
     tests, failed = get_results(results)
     assert tests > 0, f"cocotb ran no test from {module}"
     assert failed == 0, f"{failed} of {tests} cocotb tests failed in {module} (see {build})"
