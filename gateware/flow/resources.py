@@ -70,7 +70,7 @@ def report(outdir="build/spartan6"):
 
 def figures(results):
     out = {}
-    units = {"lut": "LUT6", "ff": "FF", "bram18": "RAMB16", "dsp": "DSP48A1"}
+    units = {"lut": "LUT6", "ff": "FF", "bram18": "18Kb BRAM", "dsp": "DSP48A1"}
     for name, counts in results.items():
         for key, unit in units.items():
             out[f"res.{name}.{key}"] = (counts[key], unit)
