@@ -49,12 +49,13 @@ def emit_verilog(component, name, path=None):
 
 
 def run(component, *, toplevel, module, key, params=None, testcase=None, waves=None,
-        extra_sources=(), timeout_s=None):
+        extra_sources=(), plusargs=(), timeout_s=None):
     """Build ``component`` and run the cocotb tests in ``module`` against it.
 
     Parameters
     ----------
-    component : wiring.Component or Elaboratable
+    component : wiring.Component or Elaboratable or None
+        None when the top is plain Verilog from ``extra_sources``.
     toplevel : str
         Verilog module name.
     module : str
@@ -71,12 +72,15 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
     if waves is None:
         waves = os.environ.get("WAVES", "0") == "1"
     build = build_dir("cocotb", f"{toplevel}-{key}")
-    source = build / f"{toplevel}.v"
-    emit_verilog(component, toplevel, source)
+    sources = [Path(p) for p in extra_sources]
+    if component is not None:
+        source = build / f"{toplevel}.v"
+        emit_verilog(component, toplevel, source)
+        sources.insert(0, source)
 
     runner = get_runner("verilator")
     runner.build(
-        sources=[source, *extra_sources],
+        sources=sources,
         hdl_toplevel=toplevel,
         build_dir=build,
         build_args=VERILATOR_ARGS,
@@ -102,6 +106,7 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
             extra_env=env,
             waves=waves,
             results_xml=str(results),
+            plusargs=list(plusargs),
         )
     except SystemExit as exc:
         # under pytest the runner exits on failure; report it as the test's failure, with counts
