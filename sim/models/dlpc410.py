@@ -546,6 +546,9 @@ class CocotbAdapter:
     their reset values, outputs are not driven).
 
     ``await adapter.run()`` runs until the test ends and raises :class:`RuleBreak` on a break.
+    Each cycle it samples the pins mid-cycle (falling edge of ``clock``, where registered
+    outputs are stable) and drives the controller's outputs after the next rising edge, as
+    :func:`amaranth_process` does.
     """
 
     def __init__(self, model, dut, clock, *, prefix="dlpc__", names=None):
@@ -563,11 +566,11 @@ class CocotbAdapter:
             h.value = levels[n]
 
     async def run(self):
-        from cocotb.triggers import RisingEdge
+        from cocotb.triggers import FallingEdge, RisingEdge
 
         self._drive(self.model.outputs())
         while True:
+            await FallingEdge(self.clock)
+            sampled = {n: int(h.value) for n, h in self.inputs}
             await RisingEdge(self.clock)
-            # read just after the edge: the values the edge sampled
-            sampled = {n: h.value.to_unsigned() for n, h in self.inputs}
             self._drive(self.model.step(sampled))
