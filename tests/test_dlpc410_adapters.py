@@ -88,3 +88,17 @@ def test_amaranth_adapter_drives_outputs(test_name):
 def test_cocotb_adapter():
     cocotb_run.run(replay(), toplevel="dlpc410_replay", module="sim.tb.dlpc410_replay", key="test",
                    params={"dmd": "test"})
+
+
+def test_cocotb_adapter_names():
+    """The prefix and the name map pick the DUT's signals; absent members are left out."""
+    from types import SimpleNamespace
+
+    from sim.models.dlpc410 import CocotbAdapter
+
+    dut = SimpleNamespace(**{name: object() for name in
+                             ["top_din_a", "top_din_b", "top_dvalid", "dmd_arstz", "top_rst_active"]})
+    adapter = CocotbAdapter(Dlpc410(TEST_DMD), dut, clock=None, prefix="top_", names={"arstz": "dmd_arstz"})
+    assert [n for n, _ in adapter.inputs] == ["din_a", "din_b", "dvalid", "arstz"]
+    assert adapter.inputs[-1][1] is dut.dmd_arstz
+    assert [n for n, _ in adapter.outputs] == ["rst_active"]

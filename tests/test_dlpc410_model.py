@@ -379,3 +379,24 @@ def test_rule_init_dvalid():
 def test_dlp650lnir_is_not_modelled():
     with pytest.raises(NotImplementedError):
         Dlpc410(DMDS["dlp650lnir"])
+
+
+def test_mirrors_settle_after_the_switching_time():
+    model, d = started()
+    a, b = planes(TEST_DMD, 9, 2)
+    d.load(a)
+    p = d.pulse("global")
+    after_settle(d, p)
+    d.load(b, rows=range(24, 48))
+    q = d.pulse("single", 1)
+    d.idle(2)
+    model.run(d.items)
+    switch = model.timing["switch_cycles"]
+    assert switch == 2500
+    assert not model.mirrors_at(p + switch - 1).any()
+    assert np.array_equal(model.mirrors_at(p + switch), a)
+    mixed = a.copy()
+    mixed[24:48] = b[24:48]
+    assert np.array_equal(model.mirrors_at(q + switch - 1), a)
+    assert np.array_equal(model.mirrors_at(q + 10, motion_cycles=10), mixed)
+    assert np.array_equal(model.mirrors, mixed)

@@ -45,17 +45,18 @@ class Camera:
     Parameters
     ----------
     model : Dlpc410
-    ramp_cycles : int
-        Length of the linear transition; default the crossover time at the model's timing.
+    ramp_cycles : int, optional
+        Length of the linear transition; default the crossover time (DLP7000 7.12) at the
+        model's DCLK.
     delay_cycles : int
         Pulse command to the start of the mirrors' motion.
     visible : bool
         Return only the visible columns (the DLP9500's 1920 of 2048).
     """
 
-    def __init__(self, model, *, ramp_cycles=0, delay_cycles=0, visible=True):
+    def __init__(self, model, *, ramp_cycles=None, delay_cycles=0, visible=True):
         self.model = model
-        self.ramp = ramp_cycles
+        self.ramp = model.timing["crossover_cycles"] if ramp_cycles is None else ramp_cycles
         self.delay = delay_cycles
         self.visible = visible
         self._cache = {}

@@ -194,6 +194,9 @@ class Dlpc410:
             raise NotImplementedError(f"{dmd.name}: {dmd.bits_per_dclk} bits per DCLK is not modelled")
         facts = timing_cycles(dclk)
         self.dmd = dmd
+        self.dclk = dclk
+        #: the facts at ``dclk`` in cycles (crossover and switching times for the camera)
+        self.timing = facts
         given = {"rst_active_cycles": rst_active_cycles, "settle_cycles": settle_cycles,
                  "init_cycles": init_cycles, "init_to_dvalid_clocks": init_to_dvalid_clocks}
         for key, value in given.items():
@@ -501,6 +504,21 @@ class Dlpc410:
                     else f"{c - p} cycles after its pulse, while RST_ACTIVE is high")
             raise RuleBreak(RULES["settle"], c,
                             f"{what} of block {block} {verb} {when}, needs {self.settle_cycles}")
+
+    # --- mirror state over time ----------------------------------------------------------------
+
+    def mirrors_at(self, cycle, motion_cycles=None):
+        """The state the mirrors have *settled* in at ``cycle``: per block, the state latched by
+        its last pulse at least ``motion_cycles`` (default the switching time) before; mirrors
+        still moving show the state they leave. Needs ``keep_history``."""
+        motion = self.timing["switch_cycles"] if motion_cycles is None else motion_cycles
+        rpb = self.dmd.rows_per_block
+        out = np.zeros_like(self.mirrors)
+        for b, hist in enumerate(self.history):
+            done = [state for c, state in hist if c + motion <= cycle]
+            if done:
+                out[b * rpb:(b + 1) * rpb] = done[-1]
+        return out
 
     # --- helpers -------------------------------------------------------------------------------
 
