@@ -301,6 +301,13 @@ def test_rule_row_cycle_cut_short():
     assert e.cycle == start + 9
 
 
+def test_rule_row_hold():
+    model, d = started()
+    d.row(RowMode.ADDRESSED, rowad=7)
+    d.items[-1] = {**d.items[-1], "rowad": 8, "blkmd": 1}
+    breaks("row_hold", model, d.items, "ROWAD, BLKMD changed in cycle 2 of the row cycle")
+
+
 def test_rule_row_address():
     model, d = started()
     d.row(RowMode.ADDRESSED, rowad=TEST_DMD.rows)

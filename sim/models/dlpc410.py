@@ -97,6 +97,7 @@ _RULES = [
     Rule("clear_overlap", "DLPA008B 4.2", "clear overlapping a row load"),
     Rule("dvalid_gap", "DLPU045A", "odd DVALID idle gap"),
     Rule("row_cycle", "DLPC410 row addressing", "row cycle cut short"),
+    Rule("row_hold", "DLPC410 row addressing", "row command not held"),
     Rule("row_address", "DLPC410 row addressing", "row address beyond the array"),
     Rule("row_pointer", "DLPA008B", "row pointer"),
     Rule("block_address", "refHDL block commands", "block address"),
@@ -114,6 +115,12 @@ INPUTS = ("din_a", "din_b", "din_c", "din_d", "dvalid", "rowmd", "rowad", "blkmd
 OUTPUTS = ("init_active", "rst_active", "ecp2_finished", "dmd_type", "ddc_version")
 
 _DEFAULTS = {"rst2blkz": 1, "wdt_enblz": 1}
+#: Sampled on a row cycle's first cycle and held for its length (interface contract).
+_HELD = ("rowmd", "rowad", "blkmd", "blkad", "rst2blkz", "comp_data", "ns_flip")
+
+
+def _held(signals):
+    return tuple(signals.get(name, _DEFAULTS.get(name, 0)) for name in _HELD)
 
 
 def timing_cycles(dclk):
@@ -148,6 +155,7 @@ class _RowCycle:
     rowmd: RowMode
     row: int | None
     comp: int
+    held: tuple
     beats: list
 
 
@@ -340,6 +348,11 @@ class Dlpc410:
             return
         if self._row is None:
             self._start_row(c, s)
+        elif _held(s) != self._row.held:
+            changed = [n for n, a, b in zip(_HELD, _held(s), self._row.held, strict=True) if a != b]
+            raise RuleBreak(RULES["row_hold"], c,
+                            f"{', '.join(changed).upper()} changed in cycle {len(self._row.beats) + 1} "
+                            f"of the row cycle from cycle {self._row.start}")
         self._row.beats.append([s.get(f"din_{b}", 0) for b in self.buses])
         if len(self._row.beats) == self.dmd.dclk_per_row:
             self._end_row(self._row)
@@ -367,7 +380,7 @@ class Dlpc410:
             self._pulse(c, blkmd, blkad, rst2blkz)
         if row is not None:
             self._check_settle(c, self.dmd.block_of_row(row), f"row {row}", "written")
-        self._row = _RowCycle(c, rowmd, row, s.get("comp_data", 0), [])
+        self._row = _RowCycle(c, rowmd, row, s.get("comp_data", 0), _held(s), [])
 
     def _end_row(self, rc):
         if rc.row is None:
