@@ -204,6 +204,17 @@ def test_back_to_back_rows_and_even_gaps():
     assert np.array_equal(model.memory[3:7], a[3:7])
 
 
+def test_quiet_only_between_row_cycles():
+    model, d = started()
+    assert model.quiet()
+    d.row(RowMode.ADDRESSED, rowad=1)
+    model.step(d.items[0])
+    assert not model.quiet()
+    model.step(d.items[1])
+    assert model.quiet()
+    assert not Dlpc410(TEST_DMD).quiet()
+
+
 def test_arstz_again_resets_memory_and_mirrors():
     model, d = started()
     a, = planes(TEST_DMD, 8)
