@@ -108,23 +108,41 @@ def test_every_grey_level_exact(mode, order):
     assert set(np.round(got).astype(int).ravel()) == set(range(256))
 
 
+@pytest.mark.parametrize("order", ["msb", "lsb"])
 @pytest.mark.parametrize("ramp", [0, RAMP])
-def test_misaligned_window_error(ramp):
+def test_misaligned_window_error(ramp, order):
     """A window that starts late and ends early: the camera's error in LSB equals the
     independent integral's."""
     image = grey_image()
-    order = ORDERS["msb"]
-    model, pulses = play(image, order, "global")
+    model, pulses = play(image, ORDERS[order], "global")
     camera = Camera(model, ramp_cycles=ramp, delay_cycles=DELAY)
     lsb = LSB["global"]
     t0, t1 = pulses[0][0] + 1234, pulses[0][-1] - 567
     got = to_lsb(camera.image(t0, t1), lsb)
-    want = to_lsb(expected_light(image, order, pulses, t0, t1, ramp, DELAY), lsb)
+    want = to_lsb(expected_light(image, ORDERS[order], pulses, t0, t1, ramp, DELAY), lsb)
     assert np.abs(got - want).max() < 1e-6
     err = got - image
     assert err.min() < -0.4, "the misaligned window must lose light"
     # the largest loss is the white pixel's: the cut-off ends of the frame
     assert err[image == 255].min() == pytest.approx((1234 + 567) / -lsb, abs=1e-9)
+
+
+@pytest.mark.parametrize("phase", [0, 1, 2, 3])
+def test_window_through_ramps(phase):
+    """Window edges inside mirror transitions (the ramp's partial integral), with phased pulses:
+    each block's ramps fall elsewhere in the window."""
+    image = grey_image()
+    order = ORDERS["msb"]
+    model, pulses = play(image, order, "phased")
+    camera = Camera(model, ramp_cycles=RAMP, delay_cycles=DELAY)
+    t0 = pulses[phase][0] + DELAY + 300
+    t1 = pulses[phase][3] + DELAY + 170                # inside the ramp of plane 4 in block `phase`
+    got = camera.image(t0, t1)
+    want = expected_light(image, order, pulses, t0, t1, RAMP, DELAY)
+    assert np.abs(got - want).max() < 1e-6
+    # the window's end cuts the ramp of plane 4 (bit 4 off -> on or on -> off) in block `phase`
+    rows = slice(phase * 24, (phase + 1) * 24)
+    assert not np.allclose(got[rows] % 1, 0)
 
 
 def test_window_inside_a_plane_and_before_any_pulse():
