@@ -394,6 +394,24 @@ def test_rule_init_dvalid():
     breaks("init_dvalid", model, d.items, "DVALID high 62 clocks after INIT_ACTIVE fell, needs 64")
 
 
+@pytest.mark.parametrize("grace", [0, 3])
+def test_training_running_on_after_init(grace):
+    """Training (DVALID toggling) that runs on for 3 cycles after INIT_ACTIVE fell is a break
+    unless ``init_grace_cycles`` covers the FPGA's synchroniser latency."""
+    model = Dlpc410(TEST_DMD, init_cycles=INIT, init_grace_cycles=grace)
+    d = Driver(TEST_DMD)
+    d.hold_reset(4)
+    d.training(INIT + 3)
+    d.items[-3:] = [{**item, "dvalid": i % 2} for i, item in enumerate(d.items[-3:], start=1)]
+    d.idle(64)
+    d.row()
+    if grace:
+        model.run(d.items)
+        assert model.log == []
+    else:
+        breaks("init_dvalid", model, d.items, "DVALID high 0 clocks after INIT_ACTIVE fell")
+
+
 def test_dlp650lnir_is_not_modelled():
     with pytest.raises(NotImplementedError):
         Dlpc410(DMDS["dlp650lnir"])

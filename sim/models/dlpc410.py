@@ -57,7 +57,9 @@ Assumptions where the TI documents are uncertain (see also ``docs/dlpc410_model.
   every data pin from the cycle ARSTZ rises until INIT_ACTIVE falls; DVALID's share of the
   pattern is the platform layer's (the core has one DVALID bit per cycle) and is not checked.
   ROWMD and BLKMD must stay 00 meanwhile. DVALID must stay low for ``init_to_dvalid_clocks``
-  after INIT_ACTIVE falls. ARSTZ falling again resets memory, mirrors and pointer to zero.
+  after INIT_ACTIVE falls, except that ``init_grace_cycles`` (default 0) lets the training
+  pattern, DVALID included, run on for the FPGA's synchroniser latency. ARSTZ falling again
+  resets memory, mirrors and pointer to zero.
 * Mirrors start at 0 (off). WDT_ENBLZ and PWR_FLOAT are not modelled.
 * DLP650LNIR (32 bits per DCLK, odd pins of A and B) is not modelled: the bit map for it is not
   in :mod:`gateware.dlpc410.beat`.
@@ -169,6 +171,10 @@ class Dlpc410:
         DCLK in Hz; the timing defaults are the facts at this rate (:func:`timing_cycles`).
     rst_active_cycles, settle_cycles, init_cycles, init_to_dvalid_clocks : int, optional
         Override the facts (tests use short ones).
+    init_grace_cycles : int
+        Cycles after INIT_ACTIVE falls in which the training pattern (DVALID included) may go on
+        as during initialisation; commands are still forbidden. Default 0: DVALID high in the
+        ``init_to_dvalid_clocks`` after the fall is a break from the first cycle.
     ecp2_cycles : int
         ECP2_FINISHED rises on this cycle.
     strict_rst_active : bool
@@ -196,7 +202,7 @@ class Dlpc410:
     """
 
     def __init__(self, dmd, *, dclk=200e6, rst_active_cycles=None, settle_cycles=None,
-                 init_cycles=None, init_to_dvalid_clocks=None, ecp2_cycles=4,
+                 init_cycles=None, init_to_dvalid_clocks=None, init_grace_cycles=0, ecp2_cycles=4,
                  strict_rst_active=True, check_training=True, keep_history=True, ddc_version=0):
         if dmd.bits_per_dclk % 64:
             raise NotImplementedError(f"{dmd.name}: {dmd.bits_per_dclk} bits per DCLK is not modelled")
@@ -209,6 +215,7 @@ class Dlpc410:
                  "init_cycles": init_cycles, "init_to_dvalid_clocks": init_to_dvalid_clocks}
         for key, value in given.items():
             setattr(self, key, facts[key] if value is None else value)
+        self.init_grace_cycles = init_grace_cycles
         self.ecp2_cycles = ecp2_cycles
         self.strict_rst_active = strict_rst_active
         self.check_training = check_training
@@ -237,6 +244,11 @@ class Dlpc410:
         cycle = self.cycle if cycle is None else cycle
         return self.init_end is None or cycle < self.init_end
 
+    def _initialising(self, cycle):
+        """INIT_ACTIVE high, or within ``init_grace_cycles`` after it fell (the training
+        pattern may still be on the pins while the FPGA's synchroniser catches up)."""
+        return self.init_end is None or cycle < self.init_end + self.init_grace_cycles
+
     def outputs(self):
         """The controller's outputs on the current cycle."""
         return {
@@ -254,7 +266,7 @@ class Dlpc410:
         c = self.cycle
         s = signals
         self._track_arstz(c, s.get("arstz", 0))
-        if self.init_active(c):
+        if self._initialising(c):
             self._init_cycle(c, s)
         else:
             self._framing(c, s)
@@ -266,7 +278,7 @@ class Dlpc410:
         :meth:`step` each time, faster once nothing but the idle gap can change."""
         s = {"arstz": 1} if signals is None else signals
         assert not s.get("dvalid", 0), "idle() is for DVALID low"
-        while count and (self._arstz != s.get("arstz", 0) or self.init_active() or self._row):
+        while count and (self._arstz != s.get("arstz", 0) or self._initialising(self.cycle) or self._row):
             self.step(s)
             count -= 1
         if count:
@@ -278,7 +290,7 @@ class Dlpc410:
     def quiet(self):
         """True when a DVALID-low cycle with ARSTZ high can only lengthen the idle gap (past
         initialisation, no row cycle open): adapters then need read nothing else."""
-        return bool(self._arstz) and not self.init_active() and self._row is None
+        return bool(self._arstz) and not self._initialising(self.cycle) and self._row is None
 
     def run(self, items):
         """Feed a sequence of per-cycle dicts and :class:`Idle` items (see the driver)."""
@@ -318,7 +330,7 @@ class Dlpc410:
             raise RuleBreak(RULES["init_command"], c,
                             f"ROWMD={rowmd:02b} BLKMD={blkmd:02b} while INIT_ACTIVE is high")
         pins = tuple(s.get(f"din_{b}", 0) for b in self.buses)
-        if self.check_training and self._arstz and self._prev2_pins is not None:
+        if self.check_training and self._arstz and self._prev2_pins is not None and self.init_active(c):
             self._check_training(c, pins)
         self._prev2_pins, self._prev_pins = self._prev_pins, pins
 
