@@ -40,12 +40,13 @@ Assumptions where the TI documents are uncertain (see also ``docs/dlpc410_model.
   decrements. ROWMD 10 writes at ROWAD and also moves the pointer there. The pointer is unset
   after initialisation; 01 with no pointer, or stepping past either end, breaks the row rule
   (DLPA008B: the pointer does not wrap).
-* NS_FLIP and COMP_DATA are sampled with the row cycle; COMP_DATA stores the complement.
+* NS_FLIP and COMP_DATA are sampled with the row cycle; COMP_DATA stores the complement. Like
+  ROWMD, ROWAD, BLKMD, BLKAD and RST2BLKZ they must be held through the row cycle.
 * Block commands (refHDL, confidence medium): dual and quad groups that reach past the last block
   (DLP9500 has 15) pulse the blocks that exist; a group with none is a block-address break.
 * A clear occupies ``clear_row_cycles`` row cycles (:mod:`~gateware.dlpc410.facts`): its own,
   whose ROWMD must be 00, then no-op rows (ROWMD 00, no second clear, no pulse of the block
-  being cleared). Idle gaps do not count towards them.
+  being cleared; a pulse of other blocks may ride on them). Idle gaps do not count.
 * Open question of DLPC410.md: with ``strict_rst_active`` (default) no pulse may start while
   RST_ACTIVE is high; with it off, a pulse may start while RST_ACTIVE is high from a pulse of
   other blocks, never of its own blocks.
@@ -54,7 +55,7 @@ Assumptions where the TI documents are uncertain (see also ``docs/dlpc410_model.
 * Initialisation: INIT_ACTIVE is high while ARSTZ is low and for ``init_cycles`` after ARSTZ
   rises (counting from ECP2_FINISHED if that comes later). The training pattern (DLPC410
   datasheet: a repeating ``0100`` on every data pin, any phase; four edges = two cycles) must be on
-  every data pin from the cycle ARSTZ rises until INIT_ACTIVE falls; DVALID's share of the
+  every data pin from two cycles before ARSTZ rises until INIT_ACTIVE falls; DVALID's share of the
   pattern is the platform layer's (the core has one DVALID bit per cycle) and is not checked.
   ROWMD and BLKMD must stay 00 meanwhile. DVALID must stay low for ``init_to_dvalid_clocks``
   after INIT_ACTIVE falls, except that ``init_grace_cycles`` (default 0) lets the training
@@ -70,7 +71,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gateware.dlpc410.beat import LANES, PINS_PER_BUS
+from gateware.dlpc410.beat import PINS_PER_BUS, lanes_to_word
 from gateware.dlpc410.facts import TIMING, BlockMode, RowMode
 
 __all__ = ["Rule", "RULES", "RuleBreak", "Command", "Dlpc410", "timing_cycles",
@@ -410,14 +411,12 @@ class Dlpc410:
     def _beat_words(self, pins):
         """One beat's pins (packed DinPairs, bus order) -> its words; the second word of a
         four-bus DMD travels on C/D as the first does on A/B (:mod:`gateware.dlpc410.beat`)."""
+        mask = (1 << PINS_PER_BUS) - 1
         words = []
         for i in range(self.words_per_beat):
-            pair = {"A": pins[2 * i], "B": pins[2 * i + 1]}
-            word = 0
-            for bus, edge, lsb in LANES:
-                half = pair[bus] if edge == "rise" else pair[bus] >> PINS_PER_BUS
-                word |= (half & 0xffff) << lsb
-            words.append(word)
+            a, b = pins[2 * i], pins[2 * i + 1]
+            words.append(lanes_to_word({("A", "rise"): a & mask, ("A", "fall"): a >> PINS_PER_BUS,
+                                        ("B", "rise"): b & mask, ("B", "fall"): b >> PINS_PER_BUS}))
         return words
 
     # --- row addressing ------------------------------------------------------------------------
