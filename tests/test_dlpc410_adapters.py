@@ -8,14 +8,9 @@ from gateware.dlpc410.facts import TEST_DMD
 from sim.harness import cocotb_run
 from sim.harness.amaranth_sim import simulate
 from sim.models.dlpc410 import RULES, Dlpc410, RuleBreak, amaranth_process
-from sim.models.dlpc410_replay import MODEL_PARAMS, Replay, sequences
+from sim.models.dlpc410_replay import MODEL_PARAMS, NAMES, replay, sequences
 
 SEQUENCES = sequences(TEST_DMD)
-NAMES = ["legal", "illegal"]
-
-
-def replay():
-    return Replay(TEST_DMD, [SEQUENCES[n] for n in NAMES])
 
 
 def reference(name):

@@ -18,10 +18,13 @@ from gateware.dlpc410.facts import TEST_DMD
 
 from .dlpc410_driver import Driver, expand
 
-__all__ = ["Replay", "MODEL_PARAMS", "sequences", "entry_layout"]
+__all__ = ["Replay", "MODEL_PARAMS", "NAMES", "sequences", "replay", "entry_layout"]
 
 #: Short timing for the replayed sequences (the ROM holds every cycle).
 MODEL_PARAMS = {"rst_active_cycles": 12, "settle_cycles": 20, "init_cycles": 16}
+
+#: The sequences :func:`replay` holds, in ``select`` order.
+NAMES = ("legal", "illegal")
 
 _CONTROLS = {"dvalid": 1, "rowmd": 2, "rowad": 11, "blkmd": 2, "blkad": 4, "rst2blkz": 1,
              "comp_data": 1, "ns_flip": 1, "arstz": 1}
@@ -43,7 +46,7 @@ def sequences(dmd=TEST_DMD):
     b = [[(row + col) % 3 == 0 for col in range(dmd.columns)] for row in range(dmd.rows)]
     rpb = dmd.rows_per_block
     out = {}
-    for name in ("legal", "illegal"):
+    for name in NAMES:
         d = Driver(dmd)
         d.start(MODEL_PARAMS["init_cycles"])
         d.load(a)
@@ -60,6 +63,12 @@ def sequences(dmd=TEST_DMD):
         d.idle(4)
         out[name] = list(expand(d.items))
     return out
+
+
+def replay(dmd=TEST_DMD):
+    """A :class:`Replay` of every sequence of :func:`sequences`, ``select`` = index in NAMES."""
+    seqs = sequences(dmd)
+    return Replay(dmd, [seqs[name] for name in NAMES])
 
 
 class Replay(wiring.Component):

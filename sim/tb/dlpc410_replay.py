@@ -12,9 +12,7 @@ from cocotb.triggers import ClockCycles, RisingEdge, with_timeout
 from gateware.dlpc410.facts import DMDS
 from sim.harness.cocotb_run import params
 from sim.models.dlpc410 import RULES, CocotbAdapter, Dlpc410, RuleBreak
-from sim.models.dlpc410_replay import MODEL_PARAMS, sequences
-
-NAMES = ["legal", "illegal"]   # the order the replay's ROM holds them
+from sim.models.dlpc410_replay import MODEL_PARAMS, NAMES, sequences
 
 
 def relative(log, origin):
