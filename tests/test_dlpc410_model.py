@@ -413,7 +413,7 @@ def test_training_running_on_after_init(grace):
 
 
 def test_dlp650lnir_is_not_modelled():
-    with pytest.raises(NotImplementedError):
+    with pytest.raises(ValueError, match="not modelled"):
         Dlpc410(DMDS["dlp650lnir"])
 
 

@@ -206,7 +206,7 @@ class Dlpc410:
                  init_cycles=None, init_to_dvalid_clocks=None, init_grace_cycles=0, ecp2_cycles=4,
                  strict_rst_active=True, check_training=True, keep_history=True, ddc_version=0):
         if dmd.bits_per_dclk % 64:
-            raise NotImplementedError(f"{dmd.name}: {dmd.bits_per_dclk} bits per DCLK is not modelled")
+            raise ValueError(f"{dmd.name}: {dmd.bits_per_dclk} bits per DCLK is not modelled")
         facts = timing_cycles(dclk)
         self.dmd = dmd
         self.dclk = dclk
