@@ -127,3 +127,10 @@ def test_tiny_bursts_leave_nothing(test_name):
         symbols += mac.wire(bytes(range(n))) + mac.idle(3)
     expected, frames = check(symbols, test_name)
     assert frames == [] and mac.counts(expected)["runt"] == 5
+
+
+def test_latency_figure():
+    """``eth.mac_rx_latency_cycles`` as the benchmark measures it: the pin register, the FCS
+    register, and the output register after ``rx_dv`` falls."""
+    from sim.bench.mac import rx_latency
+    assert rx_latency() == 3

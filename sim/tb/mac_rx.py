@@ -27,9 +27,9 @@ class Bench:
         self.sink = AxiStreamSink(AxiStreamBus.from_prefix(dut, "m_axis"), dut.clk, dut.rst)
 
     @classmethod
-    async def start(cls, dut, *, sync_ns=CLOCK_NS):
+    async def start(cls, dut, *, sync_ps=CLOCK_NS * 1000):
         cocotb.start_soon(Clock(dut.gmii_rx_clk, CLOCK_NS, unit="ns").start())
-        cocotb.start_soon(Clock(dut.clk, sync_ns, unit="ns").start())
+        cocotb.start_soon(Clock(dut.clk, sync_ps, unit="ps").start())
         dut.rst.value = 1
         dut.gmii_rx_rst.value = 1
         await ClockCycles(dut.clk, 4)

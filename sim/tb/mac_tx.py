@@ -48,7 +48,8 @@ async def send_and_check(dut, frames, *, sync_ns, aborts=()):
         assert bytes(got.get_payload()) == padded(frame), f"frame {i}: payload differs"
         assert got.check_fcs() == (i not in aborts), f"frame {i}: FCS"
     # Frames queued behind each other leave at the minimum gap, never closer.
-    gaps = [(b.sim_time_start - a.sim_time_end) // (CLOCK_NS * 1000) for a, b in zip(received, received[1:])]
+    gaps = [(b.sim_time_start - a.sim_time_end) // (CLOCK_NS * 1000)
+            for a, b in zip(received, received[1:], strict=False)]
     assert min(gaps) >= 12, gaps
     assert int(dut.underruns.value) == 0
     return gaps
