@@ -22,7 +22,7 @@ def run_receiver(symbols, name, *, max_frame=9018):
                 out["beats"].append((int(beat.data), int(beat.last), int(beat.user)))
         out["counters"] = {v: ctx.get(dut.counters[v]) for v in mac.VERDICTS}
 
-    simulate(dut, [bench], name=name, clocks=CLOCKS, deadline=1e-2)
+    simulate(dut, [bench], name=f"mac_{name}", clocks=CLOCKS, deadline=1e-2)
     return mac.split_frames(out["beats"]), out["counters"]
 
 

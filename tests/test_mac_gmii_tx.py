@@ -47,7 +47,7 @@ def run_transmitter(frames, name, *, pause_in=None, idle=0.0):
         out["symbols"] = await record(ctx, dut.gmii, total)
         out["underruns"] = ctx.get(dut.underruns)
 
-    simulate(dut, [feed, watch], name=name, deadline=1e-2)
+    simulate(dut, [feed, watch], name=f"mac_{name}", deadline=1e-2)
     return out["symbols"], out["underruns"]
 
 
@@ -109,7 +109,7 @@ def test_transmit_path_never_underruns(test_name):
         await ctx.tick().repeat(total)
         out["underruns"] = ctx.get(dut.underruns)
 
-    simulate(dut, [feed, watch, counters], name=test_name, clocks={"sync": 100e6, "gmii_tx": 125e6},
+    simulate(dut, [feed, watch, counters], name=f"mac_{test_name}", clocks={"sync": 100e6, "gmii_tx": 125e6},
              deadline=1e-2)
     sent = mac.wire_frames(out["symbols"])
     assert [s[0] for s in sent] == [on_wire(f) for f in frames]

@@ -8,7 +8,7 @@ from sim.harness.amaranth_sim import simulate
 from sim.models import mac
 
 
-def run_path(symbols, name, *, stall=0.0, depth=16384, max_frame=9018, sync_hz=125e6, frames_hint=None):
+def run_path(symbols, name, *, stall=0.0, depth=16384, max_frame=9018, sync_hz=125e6):
     """Drive ``symbols`` on the pins while a ``sync`` consumer takes the frames, holding ready low
     with probability ``stall``. Returns the frames received (bytes, bad), the verdict counters and
     the drop count, both read in ``sync``."""
@@ -37,7 +37,8 @@ def run_path(symbols, name, *, stall=0.0, depth=16384, max_frame=9018, sync_hz=1
         out["counters"] = {v: ctx.get(dut.counters[v]) for v in mac.VERDICTS}
         out["dropped"] = ctx.get(dut.dropped)
 
-    simulate(dut, [drive, consume], name=name, clocks={"gmii_rx": 125e6, "sync": sync_hz}, deadline=5e-2)
+    simulate(dut, [drive, consume], name=f"mac_{name}", clocks={"gmii_rx": 125e6, "sync": sync_hz},
+             deadline=5e-2)
     return mac.split_frames(out["beats"]), out["counters"], out["dropped"]
 
 

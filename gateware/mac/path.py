@@ -60,8 +60,8 @@ class ReceivePath(wiring.Component):
         m.submodules.crossing = crossing = RxCrossing(depth=self._depth, max_frame=self._max_frame,
                                                       counter_width=width)
         m.d.comb += mac.gmii.eq(self.gmii)
-        # The crossing takes every transfer (GMII has no backpressure), so no ready is needed.
-        m.d.comb += [crossing.i.valid.eq(mac.frames.valid), crossing.i.payload.eq(mac.frames.payload)]
+        # Both ends are always ready: the crossing takes every byte (GMII has no backpressure).
+        wiring.connect(m, mac.frames, crossing.i)
         wiring.connect(m, crossing.o, wiring.flipped(self.frames))
 
         pairs = [(mac.counters[name], self.counters[name]) for name, _ in counters_layout(width)]

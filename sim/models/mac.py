@@ -11,8 +11,8 @@ import struct
 import zlib
 
 __all__ = [
-    "with_fcs", "udp_frame", "frame_of_length", "wire", "idle", "receive", "RxResult",
-    "wire_frames", "VERDICTS",
+    "with_fcs", "udp_frame", "frame_of_length", "wire", "idle", "receive", "RxResult", "counts",
+    "split_frames", "wire_frames", "random_sizes", "seeded", "VERDICTS",
 ]
 
 PREAMBLE, SFD = 0x55, 0xD5
