@@ -13,8 +13,13 @@ the crossing latency). When it does not keep up, frames are dropped whole and co
   rest of the frame is discarded, so the consumer sees a short frame flagged bad.
 
 Either way ``dropped`` counts the frame, and no frame leaves with ``user`` = 0 unless every byte
-of it went through. The free space is computed from the FIFO's write-side level, which lags by
-one write and sees reads late, so it never overstates the room.
+of it went through. Why no write is ever refused: the free space is computed from the FIFO's
+write-side level, which sees reads late (so never overstates the room) and misses only the write
+of the previous cycle (so the true fill is at most one above it). A byte is written normally only
+when that free space exceeds 2, leaving at least one truly free slot after it; the next write,
+normal or the cut marker, therefore always fits, and after a marker nothing is written until a
+frame start finds more than ``room`` free. (:mod:`tests.test_mac_cdc` checks that a margin of 1
+loses bytes.)
 
 Transmit (:class:`TxCrossing`, ``sync`` -> ``gmii_tx``)
 -------------------------------------------------------
