@@ -116,6 +116,15 @@ class Receiver(wiring.Component):
         def reject(why):
             m.d.comb += [counted.eq(1), verdict.eq(why)]
 
+        def emit(last, user):
+            # The held byte leaves; the output is a register, valid for this one cycle.
+            m.d[rx] += [
+                self.frames.valid.eq(1),
+                self.frames.payload.data.eq(held),
+                self.frames.payload.last.eq(last),
+                self.frames.payload.user.eq(user),
+            ]
+
         with m.FSM(domain=self._domain):
             with m.State("IDLE"):
                 with m.If(pins.dv):
@@ -155,12 +164,7 @@ class Receiver(wiring.Component):
                         with m.If(length >= _HOLD - 1):
                             m.d[rx] += held.eq(window[-8:])
                         with m.If(length >= _HOLD):
-                            m.d[rx] += [
-                                self.frames.valid.eq(1),
-                                self.frames.payload.data.eq(held),
-                                self.frames.payload.last.eq(0),
-                                self.frames.payload.user.eq(0),
-                            ]
+                            emit(last=0, user=0)
                 with m.Else():
                     with m.If(errored):
                         m.d.comb += verdict.eq(Verdict.RX_ER)
@@ -174,12 +178,7 @@ class Receiver(wiring.Component):
                         m.d.comb += verdict.eq(Verdict.GOOD)
                     m.d.comb += counted.eq(1)
                     with m.If(length >= _HOLD):
-                        m.d[rx] += [
-                            self.frames.valid.eq(1),
-                            self.frames.payload.data.eq(held),
-                            self.frames.payload.last.eq(1),
-                            self.frames.payload.user.eq(verdict != Verdict.GOOD),
-                        ]
+                        emit(last=1, user=verdict != Verdict.GOOD)
                     m.next = "IDLE"
 
             with m.State("DISCARD"):
