@@ -5,6 +5,8 @@ GmiiSink does not keep the first byte of a burst (the first preamble byte), so f
 compared by their payload after the SFD, never by raw offsets.
 """
 
+import itertools
+
 import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, with_timeout
@@ -73,3 +75,22 @@ async def abort_and_slow_producer(dut):
     rng = mac.seeded(61)
     frames = [mac.frame_of_length(n, rng)[:-4] for n in (200, 64, 1500, 80)]
     await send_and_check(dut, frames, sync_ns=10, aborts={1})
+
+
+@cocotb.test()
+async def underrun_of_a_frame_longer_than_the_fifo(dut):
+    """A 6,000-byte frame (longer than the 2,048-byte FIFO) from a producer at half the line rate
+    runs dry mid-frame: tx_er goes out, the underrun is counted, and the next frame is intact."""
+    source, sink = await start(dut, 8)
+    source.set_pause_generator(itertools.cycle([0, 1]))
+    rng = mac.seeded(62)
+    long_frame, after = mac.frame_of_length(6004, rng)[:-4], mac.frame_of_length(100, rng)[:-4]
+    await source.send(AxiStreamFrame(long_frame))
+    await source.send(AxiStreamFrame(after))
+    cut = await with_timeout(sink.recv(), 2, "ms")
+    good = await with_timeout(sink.recv(), 2, "ms")
+    assert cut.error is not None and any(cut.error), "no tx_er on the cut frame"
+    assert len(cut.get_payload(strip_fcs=False)) < len(long_frame)
+    assert bytes(good.get_payload()) == after and good.check_fcs() and good.error is None
+    await ClockCycles(dut.clk, 10)
+    assert int(dut.underruns.value) == 1
