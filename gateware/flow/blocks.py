@@ -13,6 +13,18 @@ def _serialiser():
     return Serialiser(DMDS["dlp7000"], lanes=8)
 
 
+def _eth_rx():
+    from gateware.mac.path import ReceivePath
+    return ReceivePath()
+
+
+def _eth_tx():
+    from gateware.mac.path import TransmitPath
+    return TransmitPath()
+
+
 BLOCKS = {
     "serialiser": _serialiser,
+    "eth_rx": _eth_rx,
+    "eth_tx": _eth_tx,
 }

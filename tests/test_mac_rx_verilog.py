@@ -1,0 +1,12 @@
+"""The receive MAC's generated Verilog (AXI-Stream wrapper) under cocotb and Verilator."""
+
+import pytest
+
+from gateware.mac.axis import AxisReceiver
+from sim.harness import cocotb_run
+
+
+@pytest.mark.verilog
+def test_mac_rx_verilog():
+    cocotb_run.run(AxisReceiver(), toplevel="mac_axis_rx", module="sim.tb.mac_rx", key="default",
+                   params={"max_frame": 9018})
