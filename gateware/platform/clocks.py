@@ -4,7 +4,9 @@
 domain     frequency   use
 =========  ==========  ===========================================
 sync       125 MHz     protocol, serialiser, DDR2 writer, status
-dmd        200 MHz     plane reader, sequencer, DCLK
+dmd        200 MHz     plane reader, sequencer, DIN/DVALID output registers
+dclk       200 MHz     DCLK forwarding only: 90 degrees after ``dmd``, so that each
+                       DCLK edge falls in the middle of a DIN bit
 gmii_tx    125 MHz     MAC transmit (forwarded to GTX_CLK)
 =========  ==========  ===========================================
 
@@ -22,7 +24,8 @@ __all__ = ["Spartan6Clocks", "PLL_PLAN"]
 PLL_PLAN = {
     "input_mhz": 100.0,
     "mult": 10,
-    "outputs": {"sync": 8, "dmd": 5, "gmii_tx": 8},
+    "outputs": {"sync": 8, "dmd": 5, "dclk": 5, "gmii_tx": 8},
+    "phases": {"dclk": 90.0},
 }
 
 
@@ -65,7 +68,7 @@ class Spartan6Clocks(Elaboratable):
         )
         for i, name in enumerate(names):
             params[f"p_CLKOUT{i}_DIVIDE"] = PLL_PLAN["outputs"][name]
-            params[f"p_CLKOUT{i}_PHASE"] = 0.0
+            params[f"p_CLKOUT{i}_PHASE"] = PLL_PLAN["phases"].get(name, 0.0)
             params[f"p_CLKOUT{i}_DUTY_CYCLE"] = 0.5
             params[f"o_CLKOUT{i}"] = raw[name]
         m.submodules.pll = Instance("PLL_BASE", **params)

@@ -16,6 +16,7 @@ from gateware.bitplane import Serialiser
 from gateware.dlpc410 import beat
 from gateware.dlpc410.facts import DMDS
 from gateware.platform.clocks import Spartan6Clocks
+from gateware.platform.pins import Dlpc410Pins, TriggerPins
 
 __all__ = ["BringupTop"]
 
@@ -62,24 +63,17 @@ class BringupTop(Elaboratable):
         with m.If(fifo.r_rdy):
             m.d.dmd += word_dmd.eq(fifo.r_data)
 
-        pins = platform.request("dlpc410", 0, dir={
-            "din_a": "-", "dclk_a": "-", "dvalid_a": "-", "dclk_b": "-", "dvalid_b": "-"})
+        m.submodules.dlpc410 = dlpc = Dlpc410Pins()
         lanes = beat.word_to_lanes(word_dmd)
-        m.submodules.din_a = din_a = io.DDRBuffer("o", pins.din_a, o_domain="dmd")
-        m.d.comb += [din_a.o[0].eq(lanes[("A", "rise")]), din_a.o[1].eq(lanes[("A", "fall")])]
-        for name in ("dclk_a", "dclk_b"):
-            m.submodules[name] = buf = io.DDRBuffer("o", getattr(pins, name), o_domain="dmd")
-            m.d.comb += [buf.o[0].eq(1), buf.o[1].eq(0)]
-        for name in ("dvalid_a", "dvalid_b"):
-            m.submodules[name] = buf = io.DDRBuffer("o", getattr(pins, name), o_domain="dmd")
-            m.d.comb += [buf.o[0].eq(1), buf.o[1].eq(1)]
+        m.d.comb += [
+            dlpc.bus.din_a.rise.eq(lanes[("A", "rise")]),
+            dlpc.bus.din_a.fall.eq(lanes[("A", "fall")]),
+            dlpc.bus.dvalid.eq(1),
+        ]
 
-        trigger = platform.request("trigger_in", 0, dir="-")
-        sync_out = platform.request("sync_out", 0, dir="-")
-        m.submodules.trigger_buf = trigger_buf = io.FFBuffer("i", trigger, i_domain="dmd")
-        m.submodules.sync_buf = sync_buf = io.FFBuffer("o", sync_out, o_domain="dmd")
+        m.submodules.trigger = trigger = TriggerPins()
         trigger_dmd = Signal()
-        m.submodules.trigger_sync = FFSynchronizer(trigger_buf.i, trigger_dmd, o_domain="dmd")
-        m.d.comb += sync_buf.o.eq(trigger_dmd)
+        m.submodules.trigger_sync = FFSynchronizer(trigger.trigger, trigger_dmd, o_domain="dmd")
+        m.d.comb += trigger.sync.eq(trigger_dmd)
         return m
 

@@ -1,0 +1,147 @@
+"""Pin adapters: the core's ports to the board's pins, with the Spartan-6 I/O primitives.
+
+The core gives plain signals per clock cycle; here they become IOB registers, DDR outputs
+(ODDR2) and LVDS buffers. Nothing here is simulated with the core: the core simulates without
+vendor primitives, and these adapters are checked by building the Spartan-6 tree.
+"""
+
+from amaranth import ClockSignal, Elaboratable, Instance, Module, Signal
+from amaranth.lib import io
+from amaranth.lib.cdc import FFSynchronizer
+
+from gateware.dlpc410.interface import Signature as Dlpc410Signature
+from gateware.mac.gmii import RxPins, TxPins
+
+__all__ = ["GmiiPins", "Dlpc410Pins", "TriggerPins"]
+
+
+class GmiiPins(Elaboratable):
+    """The 88E1111's GMII and management pins.
+
+    Drives ``ClockSignal("gmii_rx")`` from RX_CLK (the top owns the ``gmii_rx`` domain),
+    registers the receive pins in the IOBs on RX_CLK and the transmit pins on ``gmii_tx``, and
+    forwards ``gmii_tx``'s clock to GTX_CLK through an ODDR2 so that it leaves the FPGA with the
+    same delay as the data.
+
+    Attributes
+    ----------
+    rx : Signal(RxPins), in ``gmii_rx``
+    tx : Signal(TxPins), in ``gmii_tx``
+    phy_reset_n, mdc, mdio_o, mdio_oe : Signal, driven by the core
+    mdio_i : Signal, to the core
+    """
+
+    def __init__(self):
+        self.rx = Signal(RxPins)
+        self.tx = Signal(TxPins)
+        self.phy_reset_n = Signal()
+        self.mdc = Signal()
+        self.mdio_o = Signal()
+        self.mdio_oe = Signal()
+        self.mdio_i = Signal()
+
+    def elaborate(self, platform):
+        m = Module()
+        pins = platform.request("eth_gmii", 0, dir="-")
+
+        m.submodules.rx_clk = rx_clk = io.Buffer("i", pins.rx_clk)
+        m.submodules.rx_bufg = Instance("BUFG", i_I=rx_clk.i, o_O=ClockSignal("gmii_rx"))
+        for name, port, target in (("rx_data", pins.rx_data, self.rx.d), ("rx_dv", pins.rx_dv, self.rx.dv),
+                                   ("rx_er", pins.rx_er, self.rx.er)):
+            m.submodules[name] = buf = io.FFBuffer("i", port, i_domain="gmii_rx")
+            m.d.comb += target.eq(buf.i)
+
+        for name, port, value in (("tx_data", pins.tx_data, self.tx.d), ("tx_en", pins.tx_en, self.tx.en),
+                                  ("tx_er", pins.tx_er, self.tx.er)):
+            m.submodules[name] = buf = io.FFBuffer("o", port, o_domain="gmii_tx")
+            m.d.comb += buf.o.eq(value)
+        m.submodules.gtx_clk = gtx = io.DDRBuffer("o", pins.gtx_clk, o_domain="gmii_tx")
+        m.d.comb += [gtx.o[0].eq(1), gtx.o[1].eq(0)]
+
+        m.submodules.phy_rst = rst = io.Buffer("o", pins.rst)
+        m.submodules.mdc = mdc = io.Buffer("o", pins.mdc)
+        m.submodules.mdio = mdio = io.Buffer("io", pins.mdio)
+        m.d.comb += [
+            rst.o.eq(~self.phy_reset_n),     # the resource's pin is active low already
+            mdc.o.eq(self.mdc),
+            mdio.o.eq(self.mdio_o),
+            mdio.oe.eq(self.mdio_oe),
+        ]
+        m.submodules.mdio_sync = FFSynchronizer(mdio.i, self.mdio_i)
+        return m
+
+
+class Dlpc410Pins(Elaboratable):
+    """The DLPC410 interface on the adapter board's pins.
+
+    Data and DVALID leave through ODDR2s clocked by ``dmd`` (rising-edge bit first); DCLK is
+    forwarded from ``dclk``, 90 degrees later, so its edges sit in the middle of each bit.
+    Inputs are registered in the IOBs and synchronised into ``dmd``.
+
+    On a board without the adapter's second port (``platform.dlpc410_complete`` false) only
+    bus A, DCLK and DVALID exist: the core's other outputs go nowhere and ECP2_FINISHED reads
+    low, so the sequencer never leaves its initialisation wait.
+
+    Attributes
+    ----------
+    bus : interface of :class:`gateware.dlpc410.interface.Signature`, flipped: the core drives it
+    """
+
+    def __init__(self, buses=2):
+        self.bus = Dlpc410Signature(buses).flip().create()
+
+    def _ddr(self, m, name, port, rise, fall, domain="dmd"):
+        m.submodules[name] = buf = io.DDRBuffer("o", port, o_domain=domain)
+        m.d.comb += [buf.o[0].eq(rise), buf.o[1].eq(fall)]
+
+    def elaborate(self, platform):
+        m = Module()
+        bus = self.bus
+        fast = platform.request("dlpc410", 0, dir="-")
+        self._ddr(m, "din_a", fast.din_a, bus.din_a.rise, bus.din_a.fall)
+        for clk in ("dclk_a", "dclk_b"):
+            self._ddr(m, clk, getattr(fast, clk), 1, 0, domain="dclk")
+        for valid in ("dvalid_a", "dvalid_b"):
+            self._ddr(m, valid, getattr(fast, valid), bus.dvalid, bus.dvalid)
+
+        if not getattr(platform, "dlpc410_complete", False):
+            return m
+
+        ext = platform.request("dlpc410_ext", 0, dir="-")
+        self._ddr(m, "din_b", ext.din_b, bus.din_b.rise, bus.din_b.fall)
+        for name in ("rowmd", "rowad", "blkmd", "blkad", "rst2blkz", "comp_data", "ns_flip",
+                     "wdt_enblz", "pwr_float", "arstz"):
+            m.submodules[name] = buf = io.FFBuffer("o", getattr(ext, name), o_domain="dmd")
+            m.d.comb += buf.o.eq(getattr(bus, name))
+        for name in ("init_active", "rst_active", "ecp2_finished", "dmd_type", "ddc_version"):
+            m.submodules[name] = buf = io.FFBuffer("i", getattr(ext, name), i_domain="dmd")
+            m.submodules[f"{name}_sync"] = FFSynchronizer(buf.i, getattr(bus, name), o_domain="dmd")
+        return m
+
+
+class TriggerPins(Elaboratable):
+    """Trigger in (IOB register on ``dmd``), sync out and camera-trigger out (IOB registers).
+
+    The input's IOB register is the first synchronising stage; the core adds the rest.
+
+    Attributes
+    ----------
+    trigger : Signal, to the core (``dmd``, one IOB stage, not yet synchronised)
+    sync, camera : Signal, from the core
+    """
+
+    def __init__(self):
+        self.trigger = Signal()
+        self.sync = Signal()
+        self.camera = Signal()
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.trigger = trig = io.FFBuffer("i", platform.request("trigger_in", 0, dir="-"), i_domain="dmd")
+        m.submodules.sync = sync = io.FFBuffer("o", platform.request("sync_out", 0, dir="-"), o_domain="dmd")
+        m.submodules.camera = cam = io.FFBuffer(
+            "o", platform.request("camera_trigger_out", 0, dir="-"), o_domain="dmd")
+        m.d.comb += [self.trigger.eq(trig.i), sync.o.eq(self.sync), cam.o.eq(self.camera)]
+        return m
+
+
