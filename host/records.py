@@ -6,7 +6,7 @@ from gateware.protocol import fields
 from gateware.protocol.fields import Action, RecordType
 
 __all__ = ["ProtocolError", "header", "image_records", "sequence_records", "rows_per_record",
-           "control_record", "status_query", "decode"]
+           "control_record", "status_query", "status_reply", "decode"]
 
 
 class ProtocolError(ValueError):
@@ -72,6 +72,12 @@ def control_record(sequence=0, *, software_trigger=False, **config):
 
 def status_query(sequence=0):
     return header(RecordType.STATUS_QUERY, fields.size(fields.HEADER), sequence)
+
+
+def status_reply(sequence, values):
+    """A status reply record (what the gateware sends; used by test servers)."""
+    body = fields.pack(fields.STATUS_REPLY, values)
+    return header(RecordType.STATUS_REPLY, fields.size(fields.HEADER) + len(body), sequence) + body
 
 
 _BODIES = {

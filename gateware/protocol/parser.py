@@ -141,9 +141,13 @@ class Parser(wiring.Component):
         with m.Elif((header.type != RecordType.IMAGE) & (header.type != RecordType.CONTROL)
                     & (header.type != RecordType.STATUS_QUERY)):
             m.d.comb += cause.eq(1 + causes.index("type"))
-        with m.Elif((header.length == 0) | ((header.type == RecordType.IMAGE) & (image.row_count == 0))):
+        with m.Elif(header.length == 0):
             m.d.comb += cause.eq(1 + causes.index("empty"))
-        with m.Elif((header.length != length) | (length < needed) | (header.length != expected)):
+        with m.Elif((header.length != length) | (length < needed)):
+            m.d.comb += cause.eq(1 + causes.index("length"))
+        with m.Elif((header.type == RecordType.IMAGE) & (image.row_count == 0)):
+            m.d.comb += cause.eq(1 + causes.index("empty"))
+        with m.Elif(header.length != expected):
             m.d.comb += cause.eq(1 + causes.index("length"))
         with m.Elif((header.type == RecordType.IMAGE)
                     & ((image.first_row + image.row_count > dmd.rows) | (image.row_bytes != dmd.columns))):

@@ -39,14 +39,18 @@ def assemble_rows(pixels, columns):
 
 
 def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pixel_stall=0.0,
-        tx_stall=0.0, status=None, buffer_depth=16384, waves=None, settle=400, on_cycle=None):
+        tx_stall=0.0, status=None, buffer_depth=16384, waves=None, settle=400, settle_each=None):
     """Feed ``frames`` (a list of ``(bytes, bad)``) with ``gap`` idle cycles (uniform in the
-    range) between frames. Returns a dict of what came out."""
+    range) between frames. Returns a dict of what came out.
+
+    With ``settle_each``, wait after each frame until nothing has come out for that many cycles
+    and record a snapshot (counters, pixels and frames sent so far) in ``snapshots``: the
+    effects of each frame, one by one."""
     a = addresses or Addresses()
     dut = Ingest(dmd, mac=a.mac, ip=a.ip, port=a.port, buffer_depth=buffer_depth)
     rng = random.Random(seed)
     out = {"pixels": [], "tx": [], "triggers": 0, "cycle": 0, "activity": 0, "last_in": [],
-           "first_pixel": []}
+           "first_pixel": [], "snapshots": []}
 
     async def clock(ctx):
         async for _ in ctx.tick():
@@ -64,11 +68,22 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
                 await ctx.tick().until(dut.rx.ready)
             out["last_in"].append(out["cycle"])
             ctx.set(dut.rx.valid, 0)
-        while out["cycle"] - max(out["activity"], out["last_in"][-1] if out["last_in"] else 0) < settle:
+            if settle_each:
+                await quiet(ctx, settle_each)
+                out["snapshots"].append(snapshot(ctx))
+        await quiet(ctx, settle)
+        out.update(snapshot(ctx))
+
+    async def quiet(ctx, cycles):
+        while out["cycle"] - max(out["activity"], out["last_in"][-1] if out["last_in"] else 0) < cycles:
             await ctx.tick()
-        out["net"] = plain(ctx.get(dut.net_counters), fields.NET_COUNTERS)
-        out["app"] = plain(ctx.get(dut.app_counters), fields.APP_COUNTERS)
-        out["config"] = plain(ctx.get(dut.config), fields.CONFIG)
+
+    def snapshot(ctx):
+        return {"net": plain(ctx.get(dut.net_counters), fields.NET_COUNTERS),
+                "app": plain(ctx.get(dut.app_counters), fields.APP_COUNTERS),
+                "config": plain(ctx.get(dut.config), fields.CONFIG),
+                "pixel_count": len(out["pixels"]), "tx_count": len(out["tx"]),
+                "triggers": out["triggers"]}
 
     async def pixels(ctx):
         prng = random.Random(seed + 1)

@@ -149,9 +149,13 @@ class Model:
             return "drop_app_version"
         if kind not in (RecordType.IMAGE, RecordType.CONTROL, RecordType.STATUS_QUERY):
             return "drop_app_type"
-        if head["length"] == 0 or (kind == RecordType.IMAGE and image["row_count"] == 0):
+        if head["length"] == 0:
             return "drop_app_empty"
-        if head["length"] != len(data) or len(data) < needed or head["length"] != expected:
+        if head["length"] != len(data) or len(data) < needed:
+            return "drop_app_length"
+        if kind == RecordType.IMAGE and image["row_count"] == 0:
+            return "drop_app_empty"
+        if head["length"] != expected:
             return "drop_app_length"
         if kind == RecordType.IMAGE and (image["first_row"] + image["row_count"] > self.dmd.rows
                                          or image["row_bytes"] != self.dmd.columns):
