@@ -12,11 +12,14 @@ __all__ = ["main"]
 
 def _load(path):
     """An 8-bit grey image from ``.npy`` or any format Pillow reads."""
-    if path.endswith(".npy"):
-        image = np.load(path)
-    else:
-        from PIL import Image
-        image = np.asarray(Image.open(path).convert("L"))
+    try:
+        if path.endswith(".npy"):
+            image = np.load(path)
+        else:
+            from PIL import Image
+            image = np.asarray(Image.open(path).convert("L"))
+    except (OSError, ValueError) as error:
+        raise ClientError(f"cannot read {path}: {error}") from error
     if image.dtype != np.uint8 or image.ndim != 2:
         raise ClientError(f"{path}: need a 2-D 8-bit image, got {image.dtype} {image.shape}")
     return image

@@ -74,8 +74,7 @@ BAD_CASES.update({name: (app_frame(record), False, counter)
 def one_by_one():
     """Every bad frame, each between good image records, with a snapshot after every frame."""
     sequence = [(image_frame(0), False)]
-    for name, (raw, bad, _counter) in BAD_CASES.items():
-        sequence.append((raw, bad))
+    sequence += [(raw, bad) for raw, bad, _counter in BAD_CASES.values()]
     sequence.append((image_frame(1, frame=1), False))
     out = ingest_sim.run(sequence, name="ingest_bad_one_by_one", settle_each=200, gap=(0, 20))
     return sequence, out
@@ -112,7 +111,8 @@ def test_bad_frame_dropped_and_counted(case, one_by_one):
     raw, bad, _ = BAD_CASES[case]
     outcome = model.frame(raw, bad)
     if outcome == "udp":
-        outcome = next(name for name, value in model.counters.items() if name.startswith("drop_app") and value)
+        outcome = next(name for name, value in model.counters.items()
+                       if name.startswith("drop_app") and value)
     assert outcome == counter
 
 
