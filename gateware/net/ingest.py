@@ -39,7 +39,7 @@ class Ingest(wiring.Component):
         Frames to the MAC transmit side.
     pixels : Out(stream.Signature(pixel_layout(dmd, 1, frame_bits)))
         Image rows for :class:`gateware.bitplane.Serialiser` (``lanes=1``).
-    config : Out(fields.layout(fields.CONFIG))
+    settings : Out(fields.layout(fields.CONFIG))
         Run-time configuration for the sequencer and store.
     trigger : Out(1)
         Software trigger pulse.
@@ -58,7 +58,7 @@ class Ingest(wiring.Component):
             "rx": In(stream.Signature(ByteBeat)),
             "tx": Out(stream.Signature(ByteBeat)),
             "pixels": Out(stream.Signature(pixel_layout(dmd, 1, frame_bits))),
-            "config": Out(CONFIG_LAYOUT, init=self._config),
+            "settings": Out(CONFIG_LAYOUT, init=self._config),
             "trigger": Out(1),
             "status": In(fields.layout(fields.SYSTEM_STATUS)),
             "net_counters": Out(fields.layout(fields.NET_COUNTERS)),
@@ -79,10 +79,10 @@ class Ingest(wiring.Component):
         connect(m, reply.request, stack.reply_request)
         connect(m, reply.body, stack.reply_body)
         m.d.comb += [
-            stack.mac.eq(parser.config.mac),
-            stack.ip.eq(parser.config.ip),
-            stack.port.eq(parser.config.port),
-            self.config.eq(parser.config),
+            stack.mac.eq(parser.settings.mac),
+            stack.ip.eq(parser.settings.ip),
+            stack.port.eq(parser.settings.port),
+            self.settings.eq(parser.settings),
             self.trigger.eq(parser.trigger),
             reply.net.eq(stack.counters),
             reply.app.eq(parser.counters),

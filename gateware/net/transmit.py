@@ -30,7 +30,8 @@ class Transmitter(wiring.Component):
         Exactly ``length`` bytes per ICMP or UDP request, ``last`` on the final one (ICMP: the
         whole message, header included; UDP: the payload). None for ARP.
     tx : Out(stream.Signature(ByteBeat))
-        Frames from the destination MAC on; the MAC pads them and adds the FCS.
+        Frames from the destination MAC on; the MAC pads them and adds the FCS. ``user`` with
+        ``last`` asks the MAC to abort a frame whose body did not match its length.
     """
 
     def __init__(self, sources=2):
@@ -52,6 +53,7 @@ class Transmitter(wiring.Component):
         turn = Signal(range(n))
         ident = Signal(16)
         index = Signal(range(64))
+        sent = Signal.like(request.length)
 
         is_arp = request.kind == ReplyKind.ARP
         is_udp = request.kind == ReplyKind.UDP
@@ -88,6 +90,7 @@ class Transmitter(wiring.Component):
                         m.d.sync += request.eq(source.payload)
                 m.d.sync += [
                     index.eq(0),
+                    sent.eq(0),
                     turn.eq(Mux(selected == n - 1, 0, selected + 1)),
                 ]
                 m.next = "HEADER"
@@ -113,8 +116,13 @@ class Transmitter(wiring.Component):
                             self.tx.valid.eq(body.valid),
                             self.tx.payload.data.eq(body.payload.data),
                             self.tx.payload.last.eq(body.payload.last),
+                            # a body that ends off its announced length would make a wrong
+                            # frame: ask the MAC to abort it
+                            self.tx.payload.user.eq(body.payload.last & (sent != request.length - 1)),
                             body.ready.eq(self.tx.ready),
                         ]
-                        with m.If(body.valid & self.tx.ready & body.payload.last):
-                            m.next = "IDLE"
+                        with m.If(body.valid & self.tx.ready):
+                            m.d.sync += sent.eq(sent + 1)
+                            with m.If(body.payload.last):
+                                m.next = "IDLE"
         return m

@@ -3,7 +3,7 @@
 One UDP datagram carries one record (see ``docs/protocol.md``). The parser collects the common
 header and the type's own header, checks them all against each other, against the datagram's
 length and against the DMD geometry, and only then acts: an image record's rows go to the
-bit-plane serialiser, a control record updates :attr:`Parser.config`, a status query asks
+bit-plane serialiser, a control record updates :attr:`Parser.settings`, a status query asks
 :class:`~gateware.protocol.status.StatusReply` for an answer. A record that fails a check is
 consumed and counted under its cause and has no other effect.
 """
@@ -58,7 +58,7 @@ class Parser(wiring.Component):
         Committed UDP payloads from :class:`gateware.net.stack.Stack`.
     pixels : Out(stream.Signature(pixel_layout(dmd, 1, frame_bits)))
         The rows of valid image records, one 8-bit pixel per transfer, left to right.
-    config : Out(fields.layout(fields.CONFIG))
+    settings : Out(fields.layout(fields.CONFIG))
         The configuration registers; control records update the fields they select.
     trigger : Out(1)
         One-cycle pulse for a control record with the software-trigger action.
@@ -74,7 +74,7 @@ class Parser(wiring.Component):
         super().__init__({
             "datagrams": In(stream.Signature(Datagram)),
             "pixels": Out(stream.Signature(pixel_layout(dmd, 1, frame_bits))),
-            "config": Out(CONFIG_LAYOUT, init=config),
+            "settings": Out(CONFIG_LAYOUT, init=config),
             "trigger": Out(1),
             "queries": Out(stream.Signature(Query)),
             "counters": Out(fields.layout(fields.APP_COUNTERS)),
@@ -187,7 +187,7 @@ class Parser(wiring.Component):
                             bump("records_control")
                             for i, (name, _) in enumerate(fields.CONFIG):
                                 with m.If(control.apply[i]):
-                                    m.d.sync += self.config[name].eq(control[name])
+                                    m.d.sync += self.settings[name].eq(control[name])
                             m.d.sync += self.trigger.eq(
                                 (control.action & fields.Action.SOFTWARE_TRIGGER) != 0)
                             m.next = "DISCARD"

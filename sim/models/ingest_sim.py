@@ -81,7 +81,7 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
     def snapshot(ctx):
         return {"net": plain(ctx.get(dut.net_counters), fields.NET_COUNTERS),
                 "app": plain(ctx.get(dut.app_counters), fields.APP_COUNTERS),
-                "config": plain(ctx.get(dut.config), fields.CONFIG),
+                "config": plain(ctx.get(dut.settings), fields.CONFIG),
                 "pixel_count": len(out["pixels"]), "tx_count": len(out["tx"]),
                 "triggers": out["triggers"]}
 
