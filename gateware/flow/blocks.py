@@ -13,6 +13,13 @@ def _serialiser():
     return Serialiser(DMDS["dlp7000"], lanes=8)
 
 
+def _eth_stack():
+    from gateware.net.ingest import Ingest
+    # Build-time addresses; a control record may change them at run time.
+    return Ingest(DMDS["dlp7000"], mac=0x02_00_00_00_00_01, ip=0xC0_A8_01_0A, port=5000)
+
+
 BLOCKS = {
     "serialiser": _serialiser,
+    "eth_stack": _eth_stack,
 }

@@ -46,6 +46,7 @@ class FrameBuffer(wiring.Component):
         The bytes read, ``last`` on the final one.
     release : In(1)
         Free everything up to ``release_to`` (frames are freed in the order they were kept).
+        Bytes are also freed as they are read.
     release_to : In(pointer)
     """
 
@@ -92,8 +93,6 @@ class FrameBuffer(wiring.Component):
             with m.Else():
                 m.d.comb += wr_port.en.eq(1)
                 m.d.sync += self.write_pointer.eq(self.write_pointer + 1)
-        with m.If(self.release):
-            m.d.sync += released.eq(self.release_to)
 
         # Read side: the port's output register is the stream's payload, so it advances only
         # when the consumer takes a byte (or none is held).
@@ -113,6 +112,12 @@ class FrameBuffer(wiring.Component):
                 remaining.eq(self.read.payload.length),
                 busy.eq(1),
             ]
+        # Bytes are freed as they are read, so that a frame being read and the next one being
+        # written fit together; ``release`` then frees the rest of the frame (its padding).
+        with m.If(self.release):
+            m.d.sync += released.eq(self.release_to)
+        with m.Elif(rd_port.en):
+            m.d.sync += released.eq(addr + 1)
         with m.If(advance):
             m.d.sync += self.data.valid.eq(busy)
             with m.If(busy):
