@@ -137,9 +137,6 @@ class Stack(wiring.Component):
         with m.If(taken):
             m.d.sync += offset.eq(Mux(offset.all(), offset, offset + 1))
 
-        def drop(name):
-            m.d.sync += [accept.eq(0), cause.eq(DROP_CAUSES.index(name))]
-
         start = buffer.frame_start
         with m.FSM():
             with m.State("RECEIVE"):
@@ -153,67 +150,58 @@ class Stack(wiring.Component):
                     m.next = "DECIDE"
             with m.State("DECIDE"):
                 # The first failing check names the cause.
+                is_ip = eth.is_ipv4
+                is_icmp = ip.protocol == ipv4.PROTOCOL_ICMP
+                is_udp = ip.protocol == ipv4.PROTOCOL_UDP
+                checks = [
+                    (mac_bad, "mac"),
+                    (buffer.overflow, "overflow"),
+                    (eth.short, "ethertype"),
+                    (~eth.dst_ok, "dst_mac"),
+                    (eth.vlan, "vlan"),
+                    (eth.is_arp & ~arp_check.request_for_us, "arp"),
+                    (~eth.is_arp & ~is_ip, "ethertype"),
+                    (is_ip & ~ip.length_ok, "ip_length"),
+                    (is_ip & ~ip.version_ok, "ip_version"),
+                    (is_ip & ip.options, "ip_options"),
+                    (is_ip & ~ip.checksum_ok, "ip_checksum"),
+                    (is_ip & ip.fragment, "ip_fragment"),
+                    (is_ip & ~ip.dst_ok, "ip_dst"),
+                    (is_ip & is_icmp & ~(icmp_check.echo_request & icmp_check.checksum_ok), "icmp"),
+                    (is_ip & is_udp & ~udp_check.length_ok, "udp_length"),
+                    (is_ip & is_udp & ~udp_check.port_ok, "udp_port"),
+                    (is_ip & is_udp & ~udp_check.checksum_ok, "udp_checksum"),
+                    (is_ip & ~is_icmp & ~is_udp, "ip_protocol"),
+                ]
                 m.d.sync += [accept.eq(1), descriptor.end.eq(buffer.write_pointer)]
-                with m.If(mac_bad):
-                    drop("mac")
-                with m.Elif(buffer.overflow):
-                    drop("overflow")
-                with m.Elif(eth.short):
-                    drop("ethertype")
-                with m.Elif(~eth.dst_ok):
-                    drop("dst_mac")
-                with m.Elif(eth.vlan):
-                    drop("vlan")
-                with m.Elif(eth.is_arp):
-                    with m.If(~arp_check.request_for_us):
-                        drop("arp")
+                for i, (failed, name) in enumerate(checks):
+                    with (m.If if i == 0 else m.Elif)(failed):
+                        m.d.sync += [accept.eq(0), cause.eq(DROP_CAUSES.index(name))]
+                # What to do with the frame if it is kept, and where an answer goes.
+                m.d.sync += [
+                    descriptor.peer.mac.eq(eth.src),
+                    descriptor.peer.ip.eq(ip.src),
+                    descriptor.peer.port.eq(udp_check.src_port),
+                    descriptor.checksum.eq(icmp_check.checksum),
+                ]
+                with m.If(eth.is_arp):
                     m.d.sync += [
                         descriptor.kind.eq(ReplyKind.ARP),
                         descriptor.peer.mac.eq(arp_check.sha),
                         descriptor.peer.ip.eq(arp_check.spa),
                     ]
-                with m.Elif(~eth.is_ipv4):
-                    drop("ethertype")
-                with m.Elif(~ip.length_ok):
-                    drop("ip_length")
-                with m.Elif(~ip.version_ok):
-                    drop("ip_version")
-                with m.Elif(ip.options):
-                    drop("ip_options")
-                with m.Elif(~ip.checksum_ok):
-                    drop("ip_checksum")
-                with m.Elif(ip.fragment):
-                    drop("ip_fragment")
-                with m.Elif(~ip.dst_ok):
-                    drop("ip_dst")
-                with m.Elif(ip.protocol == ipv4.PROTOCOL_ICMP):
-                    with m.If(~icmp_check.echo_request | ~icmp_check.checksum_ok):
-                        drop("icmp")
+                with m.Elif(is_icmp):
                     m.d.sync += [
                         descriptor.kind.eq(ReplyKind.ICMP),
                         descriptor.addr.eq(start + ipv4.PAYLOAD_AT),
                         descriptor.length.eq(ip.payload_length),
-                        descriptor.peer.mac.eq(eth.src),
-                        descriptor.peer.ip.eq(ip.src),
-                        descriptor.checksum.eq(icmp_check.checksum),
                     ]
-                with m.Elif(ip.protocol == ipv4.PROTOCOL_UDP):
-                    with m.If(~udp_check.length_ok):
-                        drop("udp_length")
-                    with m.Elif(~udp_check.port_ok):
-                        drop("udp_port")
-                    with m.Elif(~udp_check.checksum_ok):
-                        drop("udp_checksum")
+                with m.Else():
                     m.d.sync += [
                         descriptor.kind.eq(ReplyKind.UDP),
                         descriptor.addr.eq(start + udp.PAYLOAD_AT),
                         descriptor.length.eq(udp_check.data_length),
-                        descriptor.peer.mac.eq(eth.src),
-                        descriptor.peer.ip.eq(ip.src),
-                        descriptor.peer.port.eq(udp_check.src_port),
                     ]
-                with m.Else():
-                    drop("ip_protocol")
                 m.next = "COMMIT"
             with m.State("COMMIT"):
                 keep = accept & fifo.w_rdy

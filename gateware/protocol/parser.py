@@ -111,26 +111,17 @@ class Parser(wiring.Component):
             with m.If(index == 0):
                 m.d.sync += [peer.eq(beat.peer), length.eq(beat.length)]
 
-        # The header length each record type needs before it can be checked.
+        # The header each record type needs before it can be checked, and its whole length.
         needed = Signal(range(_CAPTURED + 1))
-        with m.Switch(header.type):
-            with m.Case(RecordType.IMAGE):
-                m.d.comb += needed.eq(_IMAGE_END)
-            with m.Case(RecordType.CONTROL):
-                m.d.comb += needed.eq(_CONTROL_END)
-            with m.Default():
-                m.d.comb += needed.eq(_HEADER)
-
-        row_bits = exact_log2(dmd.columns)
-        image_length = _IMAGE_END + (image.row_count << row_bits)
         expected = Signal(OFFSET_BITS + 17)
         with m.Switch(header.type):
             with m.Case(RecordType.IMAGE):
-                m.d.comb += expected.eq(image_length)
+                m.d.comb += [needed.eq(_IMAGE_END),
+                             expected.eq(_IMAGE_END + (image.row_count << exact_log2(dmd.columns)))]
             with m.Case(RecordType.CONTROL):
-                m.d.comb += expected.eq(_CONTROL_END)
+                m.d.comb += [needed.eq(_CONTROL_END), expected.eq(_CONTROL_END)]
             with m.Default():
-                m.d.comb += expected.eq(_HEADER)
+                m.d.comb += [needed.eq(_HEADER), expected.eq(_HEADER)]
 
         cause = Signal(range(8))
         causes = ["magic", "version", "type", "empty", "length", "rows"]
