@@ -60,6 +60,7 @@ BAD_RECORDS = {
     "rows_beyond_frame": (_record(body=_image_body(first_row=TEST_DMD.rows - 1, row_count=2)),
                           "drop_app_rows"),
     "row_bytes_not_dmd": (_record(body=_image_body(row_bytes=COLUMNS * 2)), "drop_app_rows"),
+    "bit_depth_out_of_range": (records.control_record(bit_depth=9, armed=1), "drop_app_value"),
 }
 
 PAYLOAD = records.image_records(IMAGE[:1], 1)[0]
@@ -229,6 +230,12 @@ def test_randomized_mix_ledger(test_name):
         elif roll < 0.65:
             raw, bad = frames.udp(A, records.status_query(seq)), False
             seq += 1
+        elif roll < 0.69:
+            control = records.control_record(seq, bit_depth=rng.randrange(0, 10),
+                                             exposure_us=rng.randrange(1 << 20),
+                                             software_trigger=rng.random() < 0.5)
+            raw, bad = frames.udp(A, control), False
+            seq += 1
         else:
             raw, bad, _ = rng.choice(bad_cases)
         sequence.append((raw, bad))
@@ -238,8 +245,14 @@ def test_randomized_mix_ledger(test_name):
     assert out["net"] == {name: model.counters[name] for name, _ in fields.NET_COUNTERS}
     assert out["app"] == {name: model.counters[name] for name, _ in fields.APP_COUNTERS}
     assert out["rows"] == model.rows
-    assert [Ether(raw).type for raw in out["tx"]] == \
-        [0x0806 if kind == "arp" else 0x0800 for kind, _ in model.replies]
+    assert out["triggers"] == model.triggers > 0
+    assert {k: out["config"][k] for k in ("bit_depth", "exposure_us")} == \
+        {k: model.config[k] for k in ("bit_depth", "exposure_us")}
+    # Status replies and ARP/ICMP replies come from two sources that take turns: the kinds
+    # match one for one, the order between the two sources may differ.
+    sent = sorted("arp" if ARP in Ether(raw) else "icmp" if ICMP in Ether(raw) else "status"
+                  for raw in out["tx"])
+    assert sent == sorted(kind for kind, _ in model.replies)
     assert sum(1 for k, _ in model.replies if k == "status") >= 5
 
 

@@ -118,6 +118,7 @@ APP_COUNTERS = [
     ("drop_app_empty", 32),    # zero length or zero rows
     ("drop_app_length", 32),   # length field against datagram, or against the rows it carries
     ("drop_app_rows", 32),     # rows beyond the frame geometry, or row_bytes not the DMD's
+    ("drop_app_value", 32),    # a control record setting a value out of range
     ("sequence_gaps", 32),     # records whose sequence number was not the previous + 1
     ("rows", 32),              # image rows handed to the serialiser
     ("payload_bytes", 48),     # image bytes handed on

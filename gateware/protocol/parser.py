@@ -124,7 +124,11 @@ class Parser(wiring.Component):
                 m.d.comb += [needed.eq(_HEADER), expected.eq(_HEADER)]
 
         cause = Signal(range(8))
-        causes = ["magic", "version", "type", "empty", "length", "rows"]
+        causes = ["magic", "version", "type", "empty", "length", "rows", "value"]
+        names = [name for name, _ in fields.CONFIG]
+
+        def applies(name):
+            return control.apply[names.index(name)]
         with m.If(header.magic != fields.MAGIC):
             m.d.comb += cause.eq(1 + causes.index("magic"))
         with m.Elif(header.version != fields.VERSION):
@@ -143,6 +147,12 @@ class Parser(wiring.Component):
         with m.Elif((header.type == RecordType.IMAGE)
                     & ((image.first_row + image.row_count > dmd.rows) | (image.row_bytes != dmd.columns))):
             m.d.comb += cause.eq(1 + causes.index("rows"))
+        with m.Elif((header.type == RecordType.CONTROL)
+                    & ((applies("bit_depth") & ((control.bit_depth == 0) | (control.bit_depth > 8)))
+                       | (applies("trigger_mode") & (control.trigger_mode > max(fields.TriggerMode)))
+                       | (applies("armed") & (control.armed > 1))
+                       | (applies("sequence_length") & (control.sequence_length == 0)))):
+            m.d.comb += cause.eq(1 + causes.index("value"))
 
         sequence_seen = Signal()
         sequence_last = Signal(32)

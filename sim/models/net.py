@@ -160,6 +160,17 @@ class Model:
         if kind == RecordType.IMAGE and (image["first_row"] + image["row_count"] > self.dmd.rows
                                          or image["row_bytes"] != self.dmd.columns):
             return "drop_app_rows"
+        if kind == RecordType.CONTROL:
+            control = fields.unpack(fields.CONTROL, data[header_size:])
+            names = [name for name, _ in fields.CONFIG]
+
+            def applies(name):
+                return control["apply"] >> names.index(name) & 1
+            if ((applies("bit_depth") and not 1 <= control["bit_depth"] <= 8)
+                    or (applies("trigger_mode") and control["trigger_mode"] > max(fields.TriggerMode))
+                    or (applies("armed") and control["armed"] > 1)
+                    or (applies("sequence_length") and control["sequence_length"] == 0)):
+                return "drop_app_value"
         if self._sequence is not None and head["sequence"] != (self._sequence + 1) & 0xFFFFFFFF:
             self.count("sequence_gaps")
         self._sequence = head["sequence"]
@@ -176,7 +187,6 @@ class Model:
             self.counters["last_frame"] = image["frame"]
             return "image"
         if kind == RecordType.CONTROL:
-            control = fields.unpack(fields.CONTROL, data[header_size:])
             for i, (name, _) in enumerate(fields.CONFIG):
                 if control["apply"] >> i & 1:
                     self.config[name] = control[name]

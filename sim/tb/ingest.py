@@ -71,9 +71,15 @@ async def feed(source, dut, traffic, rng, gap):
 
 
 def check_replies(tx, model):
+    """Each reply as the model expects; ARP/ICMP replies (from the stack) and status replies
+    (from the protocol) each in order, the two sources interleaved in any order."""
     assert len(tx) == len(model.replies), (len(tx), [k for k, _ in model.replies])
-    for raw, (kind, expect) in zip(tx, model.replies, strict=True):
-        reply = Ether(raw)
+    stack = [(Ether(raw), None) for raw in tx if ARP in Ether(raw) or ICMP in Ether(raw)]
+    status = [(Ether(raw), None) for raw in tx if UDP in Ether(raw)]
+    expected_stack = [r for r in model.replies if r[0] != "status"]
+    expected_status = [r for r in model.replies if r[0] == "status"]
+    assert len(stack) == len(expected_stack) and len(status) == len(expected_status)
+    for (reply, _), (kind, expect) in zip(stack + status, expected_stack + expected_status, strict=True):
         assert reply.src == A.mac_str and reply.dst == A.host_mac
         if kind == "arp":
             assert reply[ARP].op == 2 and reply[ARP].psrc == A.ip_str and reply[ARP].pdst == A.host_ip
