@@ -15,7 +15,12 @@ from ..protocol.parser import CONFIG_LAYOUT, Parser, config_init
 from ..protocol.status import StatusReply
 from .stack import Stack
 
-__all__ = ["Ingest"]
+__all__ = ["Ingest", "Config", "Status"]
+
+#: The run-time configuration the ingest block drives (fields: :data:`fields.CONFIG`).
+Config = CONFIG_LAYOUT
+#: The figures the rest of the system reports through status replies (:data:`fields.SYSTEM_STATUS`).
+Status = fields.layout(fields.SYSTEM_STATUS)
 
 
 class Ingest(wiring.Component):
@@ -39,11 +44,11 @@ class Ingest(wiring.Component):
         Frames to the MAC transmit side.
     pixels : Out(stream.Signature(pixel_layout(dmd, 1, frame_bits)))
         Image rows for :class:`gateware.bitplane.Serialiser` (``lanes=1``).
-    settings : Out(fields.layout(fields.CONFIG))
-        Run-time configuration for the sequencer and store.
+    settings : Out(Config)
+        Run-time configuration for the sequencer and store (reset value: the build parameters).
     trigger : Out(1)
         Software trigger pulse.
-    status : In(fields.layout(fields.SYSTEM_STATUS))
+    status : In(Status)
         Figures from the rest of the system, reported in status replies.
     net_counters : Out(fields.layout(fields.NET_COUNTERS))
     app_counters : Out(fields.layout(fields.APP_COUNTERS))
@@ -58,9 +63,9 @@ class Ingest(wiring.Component):
             "rx": In(stream.Signature(ByteBeat)),
             "tx": Out(stream.Signature(ByteBeat)),
             "pixels": Out(stream.Signature(pixel_layout(dmd, 1, frame_bits))),
-            "settings": Out(CONFIG_LAYOUT, init=self._config),
+            "settings": Out(Config, init=self._config),
             "trigger": Out(1),
-            "status": In(fields.layout(fields.SYSTEM_STATUS)),
+            "status": In(Status),
             "net_counters": Out(fields.layout(fields.NET_COUNTERS)),
             "app_counters": Out(fields.layout(fields.APP_COUNTERS)),
         })

@@ -89,6 +89,9 @@ def check_replies(tx, model):
         assert Ether(bytes(reply))[IP].chksum == ip_sum, "IPv4 header checksum"
         if kind == "icmp":
             assert reply[ICMP].type == 0 and bytes(reply[ICMP])[4:] == expect["message"][4:]
+            icmp_sum = reply[ICMP].chksum
+            del reply[ICMP].chksum
+            assert Ether(bytes(reply))[ICMP].chksum == icmp_sum, "ICMP checksum"
         else:
             head, body, _ = records.decode(bytes(reply[UDP].payload))
             assert head["sequence"] == expect["sequence"] and body["clock_hz"] == 125_000_000
