@@ -6,7 +6,7 @@ from amaranth.lib.wiring import In, Out
 
 from ..protocol import fields
 from . import ethernet
-from .checksum import fold, ones_sum, word_add
+from .checksum import fold, word_add
 from .layouts import OFFSET_BITS
 from .tap import Tap, capture
 
@@ -70,14 +70,17 @@ class Checker(wiring.Component):
         m = Module()
         tap = self.tap
         header = capture(m, tap, _AT, HEADER, "ip")
-        n = fields.size(HEADER)
-        raw = [fields.byte_slice(header.as_value(), n, i, 1) for i in range(n)]
         end = Signal(OFFSET_BITS + 1)
         m.d.comb += end.eq(_AT + header.total_length)
 
+        # Both sums accumulate as the bytes pass, so that the decision after the last byte
+        # needs only a fold and a compare.
+        header_sum = Signal(20)
         with m.If(tap.valid):
             with m.If(tap.offset == 0):
-                m.d.sync += self.payload_sum.eq(0)
+                m.d.sync += [header_sum.eq(0), self.payload_sum.eq(0)]
+            with m.Elif((tap.offset >= _AT) & (tap.offset < PAYLOAD_AT)):
+                m.d.sync += header_sum.eq(word_add(header_sum, tap.data, ~tap.offset[0]))
             with m.Elif((tap.offset >= PAYLOAD_AT) & (tap.offset < end)):
                 m.d.sync += self.payload_sum.eq(word_add(self.payload_sum, tap.data, ~tap.offset[0]))
 
@@ -86,7 +89,7 @@ class Checker(wiring.Component):
                               & ((tap.length == end) | ((end < MIN_FRAME) & (tap.length == MIN_FRAME)))),
             self.version_ok.eq(header.version == 4),
             self.options.eq(header.ihl != 5),
-            self.checksum_ok.eq(ones_sum(_words(raw)) == 0xFFFF),
+            self.checksum_ok.eq(fold(header_sum) == 0xFFFF),
             self.fragment.eq(((header.flags & FLAG_MF) != 0) | (header.fragment_offset != 0)),
             self.dst_ok.eq(header.dst == self.ip),
             self.protocol.eq(header.protocol),

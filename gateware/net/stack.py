@@ -2,7 +2,7 @@
 
 Receive is store-and-forward through :class:`~gateware.net.buffer.FrameBuffer`: every byte is
 written as it arrives while the per-protocol checkers (:mod:`.ethernet`, :mod:`.arp`,
-:mod:`.ipv4`, :mod:`.icmp`, :mod:`.udp`) watch it pass; two cycles after the last byte (whose
+:mod:`.ipv4`, :mod:`.icmp`, :mod:`.udp`) watch it pass; three cycles after the last byte (whose
 ``user`` bit carries the MAC's verdict) the frame is either committed, with a descriptor of
 what to do with it, or rewound and counted under the first check it failed. A dispatcher then
 reads committed frames back in order: UDP payloads leave on ``datagrams``, ICMP echo requests and
@@ -10,7 +10,7 @@ ARP requests become replies through :class:`~gateware.net.transmit.Transmitter`,
 the application's replies.
 """
 
-from amaranth import Module, Mux, Signal
+from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.lib.wiring import In, Out, connect
@@ -56,7 +56,8 @@ class Stack(wiring.Component):
     -------
     rx : In(stream.Signature(ByteBeat))
         Frames from the MAC (``user`` with ``last``: the MAC's verdict is bad). Ready drops for
-        two cycles after each frame while the stack decides.
+        three cycles after each frame while the stack decides (the MAC's inter-frame gap is
+        at least 20 byte times).
     tx : Out(stream.Signature(ByteBeat))
         ARP replies, ICMP echo replies and the application's replies, towards the MAC.
     mac, ip, port : In(48), In(32), In(16)
@@ -106,7 +107,6 @@ class Stack(wiring.Component):
             eth.mac.eq(self.mac), arp_check.ip.eq(self.ip), ip.ip.eq(self.ip), udp_check.port.eq(self.port),
             icmp_check.payload_length.eq(ip.payload_length), icmp_check.payload_sum.eq(ip.payload_sum),
             udp_check.payload_length.eq(ip.payload_length), udp_check.payload_sum.eq(ip.payload_sum),
-            udp_check.src.eq(ip.src), udp_check.dst.eq(ip.dst),
         ]
         for name in ("mac", "ip", "port"):
             m.d.comb += getattr(transmitter, name).eq(getattr(self, name))
@@ -138,6 +138,31 @@ class Stack(wiring.Component):
             m.d.sync += offset.eq(Mux(offset.all(), offset, offset + 1))
 
         start = buffer.frame_start
+        # The first failing check names the cause.
+        is_ip = eth.is_ipv4
+        is_icmp = ip.protocol == ipv4.PROTOCOL_ICMP
+        is_udp = ip.protocol == ipv4.PROTOCOL_UDP
+        checks = [
+            (mac_bad, "mac"),
+            (buffer.overflow, "overflow"),
+            (eth.short, "ethertype"),
+            (~eth.dst_ok, "dst_mac"),
+            (eth.vlan, "vlan"),
+            (eth.is_arp & ~arp_check.request_for_us, "arp"),
+            (~eth.is_arp & ~is_ip, "ethertype"),
+            (is_ip & ~ip.length_ok, "ip_length"),
+            (is_ip & ~ip.version_ok, "ip_version"),
+            (is_ip & ip.options, "ip_options"),
+            (is_ip & ~ip.checksum_ok, "ip_checksum"),
+            (is_ip & ip.fragment, "ip_fragment"),
+            (is_ip & ~ip.dst_ok, "ip_dst"),
+            (is_ip & is_icmp & ~(icmp_check.echo_request & icmp_check.checksum_ok), "icmp"),
+            (is_ip & is_udp & ~udp_check.length_ok, "udp_length"),
+            (is_ip & is_udp & ~udp_check.port_ok, "udp_port"),
+            (is_ip & is_udp & ~udp_check.checksum_ok, "udp_checksum"),
+            (is_ip & ~is_icmp & ~is_udp, "ip_protocol"),
+        ]
+        failed = Signal(len(checks))
         with m.FSM():
             with m.State("RECEIVE"):
                 m.d.comb += self.rx.ready.eq(1)
@@ -147,35 +172,14 @@ class Stack(wiring.Component):
                         mac_bad.eq(self.rx.payload.user),
                         offset.eq(0),
                     ]
-                    m.next = "DECIDE"
+                    m.next = "EVALUATE"
+            with m.State("EVALUATE"):
+                m.d.sync += failed.eq(Cat(condition for condition, _ in checks))
+                m.next = "DECIDE"
             with m.State("DECIDE"):
-                # The first failing check names the cause.
-                is_ip = eth.is_ipv4
-                is_icmp = ip.protocol == ipv4.PROTOCOL_ICMP
-                is_udp = ip.protocol == ipv4.PROTOCOL_UDP
-                checks = [
-                    (mac_bad, "mac"),
-                    (buffer.overflow, "overflow"),
-                    (eth.short, "ethertype"),
-                    (~eth.dst_ok, "dst_mac"),
-                    (eth.vlan, "vlan"),
-                    (eth.is_arp & ~arp_check.request_for_us, "arp"),
-                    (~eth.is_arp & ~is_ip, "ethertype"),
-                    (is_ip & ~ip.length_ok, "ip_length"),
-                    (is_ip & ~ip.version_ok, "ip_version"),
-                    (is_ip & ip.options, "ip_options"),
-                    (is_ip & ~ip.checksum_ok, "ip_checksum"),
-                    (is_ip & ip.fragment, "ip_fragment"),
-                    (is_ip & ~ip.dst_ok, "ip_dst"),
-                    (is_ip & is_icmp & ~(icmp_check.echo_request & icmp_check.checksum_ok), "icmp"),
-                    (is_ip & is_udp & ~udp_check.length_ok, "udp_length"),
-                    (is_ip & is_udp & ~udp_check.port_ok, "udp_port"),
-                    (is_ip & is_udp & ~udp_check.checksum_ok, "udp_checksum"),
-                    (is_ip & ~is_icmp & ~is_udp, "ip_protocol"),
-                ]
                 m.d.sync += [accept.eq(1), descriptor.end.eq(buffer.write_pointer)]
-                for i, (failed, name) in enumerate(checks):
-                    with (m.If if i == 0 else m.Elif)(failed):
+                for i, (_, name) in enumerate(checks):
+                    with (m.If if i == 0 else m.Elif)(failed[i]):
                         m.d.sync += [accept.eq(0), cause.eq(DROP_CAUSES.index(name))]
                 # What to do with the frame if it is kept, and where an answer goes.
                 m.d.sync += [

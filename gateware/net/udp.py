@@ -1,12 +1,12 @@
 """UDP (RFC 768) on receive: port, length and checksum with the IPv4 pseudo-header."""
 
-from amaranth import Module
+from amaranth import Module, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from ..protocol import fields
-from . import ipv4
-from .checksum import fold
+from . import ethernet, ipv4
+from .checksum import fold, word_add
 from .layouts import OFFSET_BITS
 from .tap import Tap, capture
 
@@ -24,7 +24,7 @@ class Checker(wiring.Component):
     tap : In(Tap)
     port : In(16)
         Our port.
-    payload_length, payload_sum, src, dst : In
+    payload_length, payload_sum : In
         From :class:`gateware.net.ipv4.Checker`.
     length_ok : Out(1)
         The UDP length equals the IPv4 payload and leaves at least one byte of data
@@ -41,8 +41,6 @@ class Checker(wiring.Component):
     port: In(16)
     payload_length: In(OFFSET_BITS)
     payload_sum: In(32)
-    src: In(32)
-    dst: In(32)
     length_ok: Out(1)
     port_ok: Out(1)
     checksum_ok: Out(1)
@@ -52,8 +50,18 @@ class Checker(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         header = capture(m, self.tap, ipv4.PAYLOAD_AT, HEADER, "udp")
-        pseudo = (self.src[16:] + self.src[:16] + self.dst[16:] + self.dst[:16]
-                  + ipv4.PROTOCOL_UDP + header.length)
+        # The pseudo-header's addresses and UDP length, summed as their bytes pass (the
+        # protocol number is a constant).
+        pseudo = Signal(20)
+        tap = self.tap
+        addresses = fields.offsets(ipv4.HEADER)["src"] + fields.size(ethernet.HEADER)
+        length_at = ipv4.PAYLOAD_AT + fields.offsets(HEADER)["length"]
+        with m.If(tap.valid):
+            with m.If(tap.offset == 0):
+                m.d.sync += pseudo.eq(ipv4.PROTOCOL_UDP)
+            with m.Elif(((tap.offset >= addresses) & (tap.offset < addresses + 8))
+                        | (tap.offset == length_at) | (tap.offset == length_at + 1)):
+                m.d.sync += pseudo.eq(word_add(pseudo, tap.data, ~tap.offset[0]))
         m.d.comb += [
             self.length_ok.eq((header.length > fields.size(HEADER))
                               & (header.length == self.payload_length)),

@@ -41,6 +41,7 @@ def ingest_at_line_rate(records_count=6, dmd="dlp7000"):
         "payload_fraction": payload / cycles,
         "drops": drops,
         "commit_latency": out["first_pixel"][0] - out["last_in"][0],
+        "rx_stalls": out["rx_stalls"],
         "frame_bytes": len(sequence[0][0]),
     }
 
@@ -54,6 +55,7 @@ def run():
         "eth.xga_frames_per_s": (fraction * LINE_RATE / (xga.columns * xga.rows), "frame/s"),
         "eth.drops_at_line_rate": (t["drops"], "records"),
         "eth.stack_commit_latency_cycles": (t["commit_latency"], "cycles"),
+        "eth.rx_stall_cycles_at_line_rate": (t["rx_stalls"], "cycles"),
         "eth.jumbo_frame_bytes": (t["frame_bytes"], "bytes"),
     }
 

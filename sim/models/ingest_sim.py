@@ -50,7 +50,7 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
     dut = Ingest(dmd, mac=a.mac, ip=a.ip, port=a.port, buffer_depth=buffer_depth)
     rng = random.Random(seed)
     out = {"pixels": [], "tx": [], "triggers": 0, "cycle": 0, "activity": 0, "last_in": [],
-           "first_pixel": [], "snapshots": []}
+           "first_pixel": [], "snapshots": [], "rx_stalls": 0}
 
     async def clock(ctx):
         async for _ in ctx.tick():
@@ -65,7 +65,8 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
             for beat in byte_beats(raw, bad):
                 ctx.set(dut.rx.payload, beat)
                 ctx.set(dut.rx.valid, 1)
-                await ctx.tick().until(dut.rx.ready)
+                while not (await ctx.tick().sample(dut.rx.ready))[2]:
+                    out["rx_stalls"] += 1
             out["last_in"].append(out["cycle"])
             ctx.set(dut.rx.valid, 0)
             if settle_each:
