@@ -119,3 +119,18 @@ def test_cli_reports_unreachable(capsys):
     finally:
         sock.close()
     assert "error: no status reply" in capsys.readouterr().err
+
+
+def test_python_m_host_status(projector):
+    """The command line as users run it, in a separate process."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    done = subprocess.run([sys.executable, "-m", "host", "--address", "127.0.0.1", "--port",
+                           str(projector.port), "status"], capture_output=True, text=True, env=env,
+                          cwd=root, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert "records_status" in done.stdout

@@ -6,7 +6,7 @@ from amaranth.lib.wiring import In, Out
 
 from ..protocol import fields
 from . import ethernet
-from .checksum import fold, word_add
+from .checksum import fold, ones_sum, word_add
 from .layouts import OFFSET_BITS
 from .tap import Tap, capture
 
@@ -106,5 +106,5 @@ def header_fields(protocol, payload_length, ident, src, dst):
     values = {"version": 4, "ihl": 5, "total_length": total, "ident": ident, "flags": FLAG_DF,
               "ttl": TTL, "protocol": protocol, "src": src, "dst": dst}
     raw = fields.to_bytes(HEADER, values)
-    values["checksum"] = ~fold(sum(_words(raw)))
+    values["checksum"] = ~ones_sum(_words(raw))
     return values
