@@ -76,12 +76,14 @@ class Transmitter(wiring.Component):
 
         with m.FSM():
             with m.State("IDLE"):
-                # Round robin: the source after the last one served goes first.
-                for k in reversed(range(n)):
-                    source = (turn + k)[:len(turn) + 1] % n if n > 1 else 0
-                    with m.If(Array(r.valid for r in self.requests)[source]):
-                        m.d.sync += selected.eq(source)
-                with m.If(Cat(r.valid for r in self.requests).any()):
+                # Round robin: source ``turn`` first, then the ones after it (later
+                # assignments win, so the nearest to ``turn`` is assigned last).
+                valid = Cat(r.valid for r in self.requests)
+                for distance in reversed(range(n)):
+                    for i in range(n):
+                        with m.If((turn == (i - distance) % n) & valid[i]):
+                            m.d.sync += selected.eq(i)
+                with m.If(valid.any()):
                     m.next = "TAKE"
             with m.State("TAKE"):
                 for i, source in enumerate(self.requests):
