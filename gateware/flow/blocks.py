@@ -23,8 +23,15 @@ def _eth_tx():
     return TransmitPath()
 
 
+def _eth_stack():
+    from gateware.net.ingest import Ingest
+    # Build-time addresses; a control record may change them at run time.
+    return Ingest(DMDS["dlp7000"], mac=0x02_00_00_00_00_01, ip=0xC0_A8_01_0A, port=5000)
+
+
 BLOCKS = {
     "serialiser": _serialiser,
     "eth_rx": _eth_rx,
     "eth_tx": _eth_tx,
+    "eth_stack": _eth_stack,
 }

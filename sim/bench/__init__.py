@@ -9,4 +9,5 @@ MODULES = [
     "sim.bench.bitplane",
     "sim.bench.dlpc410_model",
     "sim.bench.mac",
+    "sim.bench.net",
 ]

@@ -1,0 +1,98 @@
+"""The ingest block: the network stack with the application protocol behind it.
+
+This is what sits between the MAC (a :class:`~gateware.mac.layouts.ByteBeat` stream each way)
+and the bit-plane serialiser, the sequencer and the status sources. All in ``sync``.
+"""
+
+from amaranth import Module
+from amaranth.lib import stream, wiring
+from amaranth.lib.wiring import In, Out, connect
+
+from ..bitplane import pixel_layout
+from ..mac.layouts import ByteBeat
+from ..protocol import fields
+from ..protocol.parser import CONFIG_LAYOUT, Parser, config_init
+from ..protocol.status import StatusReply
+from .stack import Stack
+
+__all__ = ["Ingest", "Config", "Status"]
+
+#: The run-time configuration the ingest block drives (fields: :data:`fields.CONFIG`).
+Config = CONFIG_LAYOUT
+#: The figures the rest of the system reports through status replies (:data:`fields.SYSTEM_STATUS`).
+Status = fields.layout(fields.SYSTEM_STATUS)
+
+
+class Ingest(wiring.Component):
+    """Stack + protocol parser + status reply.
+
+    Parameters
+    ----------
+    dmd : :class:`gateware.dlpc410.facts.DmdType`
+    mac, ip, port : int
+        Addresses at reset (build parameters); a control record may change them.
+    frame_bits : int
+        Width of the frame tag on ``pixels``.
+    buffer_depth : int
+        Bytes of the receive ring.
+
+    Members
+    -------
+    rx : In(stream.Signature(ByteBeat))
+        Frames from the MAC receive side (crossed into ``sync``).
+    tx : Out(stream.Signature(ByteBeat))
+        Frames to the MAC transmit side.
+    pixels : Out(stream.Signature(pixel_layout(dmd, 1, frame_bits)))
+        Image rows for :class:`gateware.bitplane.Serialiser` (``lanes=1``).
+    settings : Out(Config)
+        Run-time configuration for the sequencer and store (reset value: the build parameters).
+    trigger : Out(1)
+        Software trigger pulse.
+    status : In(Status)
+        Figures from the rest of the system, reported in status replies.
+    net_counters : Out(fields.layout(fields.NET_COUNTERS))
+    app_counters : Out(fields.layout(fields.APP_COUNTERS))
+    """
+
+    def __init__(self, dmd, *, mac, ip, port, frame_bits=4, buffer_depth=16384):
+        self._dmd = dmd
+        self._config = config_init(mac=mac, ip=ip, port=port)
+        self._frame_bits = frame_bits
+        self._depth = buffer_depth
+        super().__init__({
+            "rx": In(stream.Signature(ByteBeat)),
+            "tx": Out(stream.Signature(ByteBeat)),
+            "pixels": Out(stream.Signature(pixel_layout(dmd, 1, frame_bits))),
+            "settings": Out(Config, init=self._config),
+            "trigger": Out(1),
+            "status": In(Status),
+            "net_counters": Out(fields.layout(fields.NET_COUNTERS)),
+            "app_counters": Out(fields.layout(fields.APP_COUNTERS)),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.stack = stack = Stack(buffer_depth=self._depth)
+        m.submodules.parser = parser = Parser(self._dmd, self._config, frame_bits=self._frame_bits)
+        m.submodules.status_reply = reply = StatusReply()
+
+        connect(m, wiring.flipped(self.rx), stack.rx)
+        connect(m, stack.tx, wiring.flipped(self.tx))
+        connect(m, stack.datagrams, parser.datagrams)
+        connect(m, parser.pixels, wiring.flipped(self.pixels))
+        connect(m, parser.queries, reply.queries)
+        connect(m, reply.request, stack.reply_request)
+        connect(m, reply.body, stack.reply_body)
+        m.d.comb += [
+            stack.mac.eq(parser.settings.mac),
+            stack.ip.eq(parser.settings.ip),
+            stack.port.eq(parser.settings.port),
+            self.settings.eq(parser.settings),
+            self.trigger.eq(parser.trigger),
+            reply.net.eq(stack.counters),
+            reply.app.eq(parser.counters),
+            reply.system.eq(self.status),
+            self.net_counters.eq(stack.counters),
+            self.app_counters.eq(parser.counters),
+        ]
+        return m

@@ -1,0 +1,110 @@
+"""IPv4 (RFC 791) on receive: the header checks, and the sum of the payload for the layer above."""
+
+from amaranth import Module, Signal
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+from ..protocol import fields
+from . import ethernet
+from .checksum import fold, ones_sum, word_add
+from .layouts import OFFSET_BITS
+from .tap import Tap, capture
+
+__all__ = ["HEADER", "PROTOCOL_ICMP", "PROTOCOL_UDP", "MIN_FRAME", "Checker", "header_fields"]
+
+HEADER = [("version", 4), ("ihl", 4), ("tos", 8), ("total_length", 16), ("ident", 16),
+          ("flags", 3), ("fragment_offset", 13), ("ttl", 8), ("protocol", 8), ("checksum", 16),
+          ("src", 32), ("dst", 32)]
+PROTOCOL_ICMP = 1
+PROTOCOL_UDP = 17
+FLAG_MF = 0b001
+FLAG_DF = 0b010
+#: Shortest Ethernet frame without FCS; shorter packets arrive padded to it.
+MIN_FRAME = 60
+TTL = 64
+_AT = fields.size(ethernet.HEADER)
+PAYLOAD_AT = _AT + fields.size(HEADER)
+
+
+def _words(raw_bytes):
+    return [raw_bytes[i] << 8 | raw_bytes[i + 1] for i in range(0, len(raw_bytes), 2)]
+
+
+class Checker(wiring.Component):
+    """Looks at the IPv4 header after the Ethernet header, and sums its payload.
+
+    Members
+    -------
+    tap : In(Tap)
+    ip : In(32)
+        Our address.
+    length_ok : Out(1)
+        Total length at least a header and the frame exactly that long (or padded to 60 bytes).
+    version_ok, options, checksum_ok, fragment, dst_ok : Out(1)
+        Version 4; a header longer than 20 bytes; the header checksum holds; MF set or a
+        non-zero fragment offset; addressed to ``ip``.
+    protocol : Out(8)
+    src, dst : Out(32)
+    payload_length : Out(OFFSET_BITS)
+        Bytes after the header, by the total length (padding excluded).
+    payload_sum : Out(32)
+        Two's complement sum of the payload as big-endian 16-bit words (an odd last byte
+        padded with zero), for the ICMP and UDP checksums.
+    """
+
+    tap: In(Tap())
+    ip: In(32)
+    length_ok: Out(1)
+    version_ok: Out(1)
+    options: Out(1)
+    checksum_ok: Out(1)
+    fragment: Out(1)
+    dst_ok: Out(1)
+    protocol: Out(8)
+    src: Out(32)
+    dst: Out(32)
+    payload_length: Out(OFFSET_BITS)
+    payload_sum: Out(32)
+
+    def elaborate(self, platform):
+        m = Module()
+        tap = self.tap
+        header = capture(m, tap, _AT, HEADER, "ip")
+        end = Signal(OFFSET_BITS + 1)
+        m.d.comb += end.eq(_AT + header.total_length)
+
+        # Both sums accumulate as the bytes pass, so that the decision after the last byte
+        # needs only a fold and a compare.
+        header_sum = Signal(20)
+        with m.If(tap.valid):
+            with m.If(tap.offset == 0):
+                m.d.sync += [header_sum.eq(0), self.payload_sum.eq(0)]
+            with m.Elif((tap.offset >= _AT) & (tap.offset < PAYLOAD_AT)):
+                m.d.sync += header_sum.eq(word_add(header_sum, tap.data, ~tap.offset[0]))
+            with m.Elif((tap.offset >= PAYLOAD_AT) & (tap.offset < end)):
+                m.d.sync += self.payload_sum.eq(word_add(self.payload_sum, tap.data, ~tap.offset[0]))
+
+        m.d.comb += [
+            self.length_ok.eq((header.total_length >= fields.size(HEADER))
+                              & ((tap.length == end) | ((end < MIN_FRAME) & (tap.length == MIN_FRAME)))),
+            self.version_ok.eq(header.version == 4),
+            self.options.eq(header.ihl != 5),
+            self.checksum_ok.eq(fold(header_sum) == 0xFFFF),
+            self.fragment.eq(((header.flags & FLAG_MF) != 0) | (header.fragment_offset != 0)),
+            self.dst_ok.eq(header.dst == self.ip),
+            self.protocol.eq(header.protocol),
+            self.src.eq(header.src),
+            self.dst.eq(header.dst),
+            self.payload_length.eq(header.total_length - fields.size(HEADER)),
+        ]
+        return m
+
+
+def header_fields(protocol, payload_length, ident, src, dst):
+    """Fields of a header we send (checksum included): no options, don't fragment."""
+    total = payload_length + fields.size(HEADER)
+    values = {"version": 4, "ihl": 5, "total_length": total, "ident": ident, "flags": FLAG_DF,
+              "ttl": TTL, "protocol": protocol, "src": src, "dst": dst}
+    raw = fields.to_bytes(HEADER, values)
+    values["checksum"] = ~ones_sum(_words(raw))
+    return values

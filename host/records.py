@@ -1,0 +1,112 @@
+"""Encoding and decoding of the application records (``docs/protocol.md``)."""
+
+import numpy as np
+
+from gateware.protocol import fields
+from gateware.protocol.fields import Action, RecordType
+
+__all__ = ["ProtocolError", "header", "image_records", "sequence_records", "rows_per_record",
+           "control_record", "status_query", "status_reply", "decode"]
+
+
+class ProtocolError(ValueError):
+    """Bytes that are not a well-formed record of this protocol version."""
+
+
+def header(record_type, length, sequence):
+    return fields.pack(fields.HEADER, {"magic": fields.MAGIC, "version": fields.VERSION,
+                                       "type": record_type, "length": length,
+                                       "sequence": sequence & 0xFFFFFFFF})
+
+
+def rows_per_record(row_bytes, limit=fields.MAX_RECORD):
+    """Whole rows that fit one record: 8 rows of 1,024 bytes or 4 of 2,048 in a 9,000-byte MTU."""
+    rows = (limit - fields.image_record_length(0, row_bytes)) // row_bytes
+    if rows < 1:
+        raise ValueError(f"a {row_bytes}-byte row does not fit a {limit}-byte record")
+    # Keep to a power of two so that records of a frame are all the same size.
+    return 1 << (rows.bit_length() - 1)
+
+
+def image_records(image, frame, *, sequence=0, rows=None):
+    """An 8-bit image (``uint8`` array, rows x columns) -> its image records, top to bottom.
+
+    ``rows`` is the rows per record (default :func:`rows_per_record`). Sequence numbers count
+    up from ``sequence``.
+    """
+    image = np.asarray(image)
+    if image.dtype != np.uint8 or image.ndim != 2:
+        raise ValueError(f"need a 2-D uint8 image, got {image.dtype} with shape {image.shape}")
+    height, width = image.shape
+    rows = rows or rows_per_record(width)
+    out = []
+    for first in range(0, height, rows):
+        block = image[first:first + rows]
+        body = fields.pack(fields.IMAGE, {"frame": frame & 0xFFFF, "first_row": first,
+                                          "row_count": len(block), "row_bytes": width})
+        length = fields.image_record_length(len(block), width)
+        out.append(header(RecordType.IMAGE, length, sequence + len(out)) + body + block.tobytes())
+    return out
+
+
+def sequence_records(images, first_frame=0, *, sequence=0, rows=None):
+    """Several images, frame ids counting up from ``first_frame``."""
+    out = []
+    for i, image in enumerate(images):
+        out += image_records(image, first_frame + i, sequence=sequence + len(out), rows=rows)
+    return out
+
+
+def control_record(sequence=0, *, software_trigger=False, **config):
+    """A control record setting the given :data:`~gateware.protocol.fields.CONFIG` fields
+    (others unchanged) and optionally firing a software trigger."""
+    names = [name for name, _ in fields.CONFIG]
+    unknown = set(config) - set(names)
+    if unknown:
+        raise KeyError(f"not a configuration field: {sorted(unknown)}")
+    apply = sum(1 << names.index(name) for name in config)
+    action = Action.SOFTWARE_TRIGGER if software_trigger else 0
+    body = fields.pack(fields.CONTROL, {"apply": apply, "action": int(action), **config})
+    return header(RecordType.CONTROL, fields.size(fields.HEADER) + len(body), sequence) + body
+
+
+def status_query(sequence=0):
+    return header(RecordType.STATUS_QUERY, fields.size(fields.HEADER), sequence)
+
+
+def status_reply(sequence, values):
+    """A status reply record (what the gateware sends; used by test servers)."""
+    body = fields.pack(fields.STATUS_REPLY, values)
+    return header(RecordType.STATUS_REPLY, fields.size(fields.HEADER) + len(body), sequence) + body
+
+
+_BODIES = {
+    RecordType.IMAGE: fields.IMAGE,
+    RecordType.CONTROL: fields.CONTROL,
+    RecordType.STATUS_QUERY: [],
+    RecordType.STATUS_REPLY: fields.STATUS_REPLY,
+}
+
+
+def decode(raw):
+    """A record's bytes -> ``(header, body, rest)``: two dicts and the bytes after the body
+    (an image record's pixels). Raises :class:`ProtocolError` on anything malformed."""
+    raw = bytes(raw)
+    n = fields.size(fields.HEADER)
+    if len(raw) < n:
+        raise ProtocolError(f"{len(raw)} bytes is shorter than a record header ({n})")
+    head = fields.unpack(fields.HEADER, raw)
+    if head["magic"] != fields.MAGIC:
+        raise ProtocolError(f"magic 0x{head['magic']:04x} is not 0x{fields.MAGIC:04x}")
+    if head["version"] != fields.VERSION:
+        raise ProtocolError(f"protocol version {head['version']}, this client speaks {fields.VERSION}")
+    if head["length"] != len(raw):
+        raise ProtocolError(f"record says {head['length']} bytes, datagram has {len(raw)}")
+    try:
+        table = _BODIES[RecordType(head["type"])]
+    except ValueError:
+        raise ProtocolError(f"unknown record type {head['type']}") from None
+    if len(raw) < n + fields.size(table):
+        raise ProtocolError(f"record type {head['type']} needs {n + fields.size(table)} bytes")
+    body = fields.unpack(table, raw[n:]) if table else {}
+    return head, body, raw[n + fields.size(table):]

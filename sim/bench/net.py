@@ -1,0 +1,65 @@
+"""Ethernet ingest figures, measured in the Amaranth simulator on the ingest block (stack +
+protocol) with XGA image records in jumbo frames.
+
+The MAC is assumed to present each frame's bytes at GMII timing: one byte per cycle, and between
+frames the 8 preamble/SFD, 4 FCS and 12 inter-frame gap cycles the line spends on them (24 idle
+cycles). The consumer of the pixels never stalls.
+"""
+
+import numpy as np
+
+from gateware.dlpc410.facts import DMDS
+from host import records
+from sim.models import frames, ingest_sim
+
+#: Line cycles per frame that carry no frame byte: preamble + SFD, FCS, inter-frame gap.
+GMII_OVERHEAD = 8 + 4 + 12
+LINE_RATE = 125e6  # bytes per second on gigabit GMII
+
+
+def ingest_at_line_rate(records_count=6, dmd="dlp7000"):
+    geometry = DMDS[dmd]
+    rows = records.rows_per_record(geometry.columns)
+    image = np.random.default_rng(0).integers(0, 256, (rows * records_count, geometry.columns),
+                                              dtype=np.uint8)
+    encoded = records.image_records(image, 1)
+    a = frames.Addresses()
+    sequence = [(frames.udp(a, record), False) for record in encoded]
+    out = ingest_sim.run(sequence, name="bench_net_line_rate", dmd=geometry, gap=(GMII_OVERHEAD,) * 2,
+                         waves=False, settle=50)
+    assert out["app"]["payload_bytes"] == len(out["pixels"]) == image.size
+    # Steady state: the records leave one after another, so the payload rate is the payload of
+    # all records but the first over the cycles from the first record's first pixel to the last
+    # record's; at line rate that is the line time of those frames, bytes plus GMII overhead.
+    starts = out["first_pixel"][::rows]
+    cycles = starts[-1] - starts[0]
+    payload = (len(encoded) - 1) * rows * geometry.columns
+    drops = sum(v for k, v in out["net"].items() if k.startswith("drop_")) \
+        + sum(v for k, v in out["app"].items() if k.startswith("drop_app"))
+    drops += len(encoded) - out["app"]["records_image"]
+    return {
+        "payload_fraction": payload / cycles,
+        "drops": drops,
+        "commit_latency": out["first_pixel"][0] - out["last_in"][0],
+        "rx_stalls": out["rx_stalls"],
+        "frame_bytes": len(sequence[0][0]),
+    }
+
+
+def run():
+    t = ingest_at_line_rate()
+    fraction = t["payload_fraction"]
+    xga = DMDS["dlp7000"]
+    return {
+        "eth.payload_fraction_of_line_rate": (fraction, "fraction"),
+        "eth.xga_frames_per_s": (fraction * LINE_RATE / (xga.columns * xga.rows), "frame/s"),
+        "eth.drops_at_line_rate": (t["drops"], "records"),
+        "eth.stack_commit_latency_cycles": (t["commit_latency"], "cycles"),
+        "eth.rx_stall_cycles_at_line_rate": (t["rx_stalls"], "cycles"),
+        "eth.jumbo_frame_bytes": (t["frame_bytes"], "bytes"),
+    }
+
+
+if __name__ == "__main__":
+    for name, (value, unit) in run().items():
+        print(f"{name:40} {value:.6g} {unit}")

@@ -1,0 +1,118 @@
+"""Running the ingest block (:class:`gateware.net.ingest.Ingest`) in the Amaranth simulator.
+
+Frames go in as MAC byte beats with chosen gaps; everything that comes out is collected: image
+rows, transmitted frames, trigger pulses, the counters and the configuration at the end. Shared
+by the unit tests and the benchmark.
+"""
+
+import random
+
+from gateware.dlpc410.facts import TEST_DMD
+from gateware.net.ingest import Ingest
+from gateware.protocol import fields
+from sim.harness.amaranth_sim import simulate
+
+from .frames import Addresses, byte_beats
+
+__all__ = ["run", "plain", "assemble_rows"]
+
+
+def plain(const, table):
+    """A struct value read from the simulator -> ``{name: int}``."""
+    return {name: int(const[name]) for name, _ in table}
+
+
+def assemble_rows(pixels, columns):
+    """Pixel transfers ``(frame, row, column, value)`` -> ``[(frame, row, bytes)]`` in order,
+    checking that each row came whole and left to right."""
+    rows, current = [], None
+    for frame, row, column, value in pixels:
+        if column == 0:
+            assert current is None or len(current[2]) == columns, "a row was cut short"
+            current = (frame, row, bytearray())
+            rows.append(current)
+        assert current is not None and (current[0], current[1]) == (frame, row) \
+            and column == len(current[2]), f"pixel out of order at frame {frame} row {row} column {column}"
+        current[2].append(value)
+    assert current is None or len(current[2]) == columns, "the last row was cut short"
+    return [(f, r, bytes(b)) for f, r, b in rows]
+
+
+def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pixel_stall=0.0,
+        tx_stall=0.0, status=None, buffer_depth=16384, waves=None, settle=400, settle_each=None):
+    """Feed ``frames`` (a list of ``(bytes, bad)``) with ``gap`` idle cycles (uniform in the
+    range) between frames. Returns a dict of what came out.
+
+    With ``settle_each``, wait after each frame until nothing has come out for that many cycles
+    and record a snapshot (counters, pixels and frames sent so far) in ``snapshots``: the
+    effects of each frame, one by one."""
+    a = addresses or Addresses()
+    dut = Ingest(dmd, mac=a.mac, ip=a.ip, port=a.port, buffer_depth=buffer_depth)
+    rng = random.Random(seed)
+    out = {"pixels": [], "tx": [], "triggers": 0, "cycle": 0, "activity": 0, "last_in": [],
+           "first_pixel": [], "snapshots": [], "rx_stalls": 0}
+
+    async def clock(ctx):
+        async for _ in ctx.tick():
+            out["cycle"] += 1
+
+    async def feed(ctx):
+        if status is not None:
+            ctx.set(dut.status, status)
+        for raw, bad in frames:
+            for _ in range(rng.randint(*gap)):
+                await ctx.tick()
+            for beat in byte_beats(raw, bad):
+                ctx.set(dut.rx.payload, beat)
+                ctx.set(dut.rx.valid, 1)
+                while not (await ctx.tick().sample(dut.rx.ready))[2]:
+                    out["rx_stalls"] += 1
+            out["last_in"].append(out["cycle"])
+            ctx.set(dut.rx.valid, 0)
+            if settle_each:
+                await quiet(ctx, settle_each)
+                out["snapshots"].append(snapshot(ctx))
+        await quiet(ctx, settle)
+        out.update(snapshot(ctx))
+
+    async def quiet(ctx, cycles):
+        while out["cycle"] - max(out["activity"], out["last_in"][-1] if out["last_in"] else 0) < cycles:
+            await ctx.tick()
+
+    def snapshot(ctx):
+        return {"net": plain(ctx.get(dut.net_counters), fields.NET_COUNTERS),
+                "app": plain(ctx.get(dut.app_counters), fields.APP_COUNTERS),
+                "config": plain(ctx.get(dut.settings), fields.CONFIG),
+                "pixel_count": len(out["pixels"]), "tx_count": len(out["tx"]),
+                "triggers": out["triggers"]}
+
+    async def pixels(ctx):
+        prng = random.Random(seed + 1)
+        while True:
+            ready = not (pixel_stall and prng.random() < pixel_stall)
+            ctx.set(dut.pixels.ready, ready)
+            _, _, valid, p = await ctx.tick().sample(dut.pixels.valid, dut.pixels.payload)
+            if valid and ready:
+                out["pixels"].append((p.frame, p.row, p.column, p.pixels[0]))
+                out["activity"] = out["cycle"]
+                if p.column == 0:
+                    out["first_pixel"].append(out["cycle"])
+
+    async def tx(ctx):
+        trng = random.Random(seed + 2)
+        current = bytearray()
+        while True:
+            ready = not (tx_stall and trng.random() < tx_stall)
+            ctx.set(dut.tx.ready, ready)
+            _, _, valid, beat, trigger = await ctx.tick().sample(dut.tx.valid, dut.tx.payload, dut.trigger)
+            out["triggers"] += trigger
+            if valid and ready:
+                current.append(beat.data)
+                out["activity"] = out["cycle"]
+                if beat.last:
+                    out["tx"].append(bytes(current))
+                    current = bytearray()
+
+    simulate(dut, [feed], processes=[clock, pixels, tx], name=name, waves=waves, deadline=1.0)
+    out["rows"] = assemble_rows(out["pixels"], dmd.columns)
+    return out

@@ -1,0 +1,198 @@
+"""Reference model of the ingest block (network stack + application protocol), in plain Python.
+
+It reads frames byte by byte with its own parsing (only the application field tables are shared
+with the gateware, as the protocol's single definition) and predicts, frame by frame, every
+counter, every image row handed on, every configuration change and every reply.
+"""
+
+from dataclasses import dataclass, field
+
+from gateware.protocol import fields
+from gateware.protocol.fields import RecordType
+
+__all__ = ["Model", "ones_sum", "BROADCAST"]
+
+BROADCAST = b"\xff" * 6
+VLAN_TPIDS = (0x8100, 0x88A8, 0x9100)
+MIN_FRAME = 60
+
+
+def ones_sum(raw):
+    """RFC 1071 ones' complement sum of big-endian 16-bit words."""
+    if len(raw) % 2:
+        raw = raw + b"\0"
+    total = sum(int.from_bytes(raw[i:i + 2], "big") for i in range(0, len(raw), 2))
+    while total >> 16:
+        total = (total & 0xFFFF) + (total >> 16)
+    return total
+
+
+@dataclass
+class Model:
+    dmd: object
+    mac: int
+    ip: int
+    port: int
+    frame_bits: int = 4
+    counters: dict = field(default_factory=dict)
+    rows: list = field(default_factory=list)        # (frame tag, row, bytes) handed on
+    replies: list = field(default_factory=list)     # ("arp"|"icmp"|"status", details)
+    config: dict = field(default_factory=dict)
+    triggers: int = 0
+    _sequence: int | None = None
+
+    def __post_init__(self):
+        for name, _ in fields.NET_COUNTERS + fields.APP_COUNTERS:
+            self.counters.setdefault(name, 0)
+        from gateware.protocol.parser import config_init
+        self.config = {k: int(v) for k, v in config_init(mac=self.mac, ip=self.ip, port=self.port).items()}
+
+    def count(self, name, by=1):
+        self.counters[name] += by
+
+    # -- network ---------------------------------------------------------------------------
+
+    def frame(self, raw, bad=False):
+        """Feed one frame (destination MAC to end of payload); returns the drop cause or the
+        kind of frame accepted."""
+        raw = bytes(raw)
+        self.count("frames")
+        outcome = self._classify(raw, bad)
+        if outcome.startswith("drop_"):
+            self.count(outcome)
+        else:
+            self.count("accepted")
+        return outcome
+
+    def _classify(self, raw, bad):
+        cfg = self.config
+        mac, ip = cfg["mac"].to_bytes(6, "big"), cfg["ip"].to_bytes(4, "big")
+        n = len(raw)
+        if bad:
+            return "drop_mac"
+        if n < 14:
+            return "drop_ethertype"
+        if raw[0:6] not in (mac, BROADCAST):
+            return "drop_dst_mac"
+        ethertype = int.from_bytes(raw[12:14], "big")
+        if ethertype in VLAN_TPIDS:
+            return "drop_vlan"
+        if ethertype == 0x0806:
+            arp = raw[14:42]
+            if (n < 42 or arp[0:2] != b"\0\1" or arp[2:4] != b"\x08\0" or arp[4] != 6 or arp[5] != 4
+                    or arp[6:8] != b"\0\1" or arp[24:28] != ip):
+                return "drop_arp"
+            self.count("arp_replies")
+            self.replies.append(("arp", {"mac": arp[8:14], "ip": arp[14:18]}))
+            return "arp"
+        if ethertype != 0x0800:
+            return "drop_ethertype"
+        head = raw[14:34]
+        total = int.from_bytes(head[2:4], "big") if n >= 18 else 0
+        end = 14 + total
+        if n < 34 or total < 20 or not (n == end or (end < MIN_FRAME and n == MIN_FRAME)):
+            return "drop_ip_length"
+        if head[0] >> 4 != 4:
+            return "drop_ip_version"
+        if head[0] & 15 != 5:
+            return "drop_ip_options"
+        if ones_sum(head) != 0xFFFF:
+            return "drop_ip_checksum"
+        if head[6] & 0x20 or int.from_bytes(head[6:8], "big") & 0x1FFF:
+            return "drop_ip_fragment"
+        if head[16:20] != ip:
+            return "drop_ip_dst"
+        payload = raw[34:end]
+        if head[9] == 1:
+            if len(payload) < 8 or payload[0] != 8 or payload[1] != 0 or ones_sum(payload) != 0xFFFF:
+                return "drop_icmp"
+            self.count("icmp_replies")
+            self.replies.append(("icmp", {"mac": raw[6:12], "ip": head[12:16], "message": payload}))
+            return "icmp"
+        if head[9] != 17:
+            return "drop_ip_protocol"
+        udp_length = int.from_bytes(raw[38:40], "big")
+        if udp_length <= 8 or udp_length != len(payload):
+            return "drop_udp_length"
+        if int.from_bytes(raw[36:38], "big") != cfg["port"]:
+            return "drop_udp_port"
+        pseudo = head[12:20] + bytes([0, 17]) + udp_length.to_bytes(2, "big")
+        if raw[40:42] != b"\0\0" and ones_sum(pseudo + payload) != 0xFFFF:
+            return "drop_udp_checksum"
+        peer = {"mac": raw[6:12], "ip": head[12:16], "port": int.from_bytes(raw[34:36], "big")}
+        self.record(payload[8:], peer)
+        return "udp"
+
+    # -- application -----------------------------------------------------------------------
+
+    def record(self, data, peer=None):
+        """Feed one datagram's payload; returns the drop cause or the record type accepted."""
+        outcome = self._record(bytes(data), peer)
+        if outcome.startswith("drop_"):
+            self.count(outcome)
+        return outcome
+
+    def _record(self, data, peer):
+        header_size = fields.size(fields.HEADER)
+        image_end = header_size + fields.size(fields.IMAGE)
+        control_end = header_size + fields.size(fields.CONTROL)
+        padded = data + bytes(max(0, max(image_end, control_end) - len(data)))
+        head = fields.unpack(fields.HEADER, padded)
+        image = fields.unpack(fields.IMAGE, padded[header_size:])
+        kind = head["type"]
+        needed = {RecordType.IMAGE: image_end, RecordType.CONTROL: control_end}.get(kind, header_size)
+        expected = fields.image_record_length(image["row_count"], self.dmd.columns) \
+            if kind == RecordType.IMAGE else needed
+        if head["magic"] != fields.MAGIC:
+            return "drop_app_magic"
+        if head["version"] != fields.VERSION:
+            return "drop_app_version"
+        if kind not in (RecordType.IMAGE, RecordType.CONTROL, RecordType.STATUS_QUERY):
+            return "drop_app_type"
+        if head["length"] == 0:
+            return "drop_app_empty"
+        if head["length"] != len(data) or len(data) < needed:
+            return "drop_app_length"
+        if kind == RecordType.IMAGE and image["row_count"] == 0:
+            return "drop_app_empty"
+        if head["length"] != expected:
+            return "drop_app_length"
+        if kind == RecordType.IMAGE and (image["first_row"] + image["row_count"] > self.dmd.rows
+                                         or image["row_bytes"] != self.dmd.columns):
+            return "drop_app_rows"
+        if kind == RecordType.CONTROL:
+            control = fields.unpack(fields.CONTROL, data[header_size:])
+            names = [name for name, _ in fields.CONFIG]
+
+            def applies(name):
+                return control["apply"] >> names.index(name) & 1
+            if ((applies("bit_depth") and not 1 <= control["bit_depth"] <= 8)
+                    or (applies("trigger_mode") and control["trigger_mode"] > max(fields.TriggerMode))
+                    or (applies("armed") and control["armed"] > 1)
+                    or (applies("sequence_length") and control["sequence_length"] == 0)):
+                return "drop_app_value"
+        if self._sequence is not None and head["sequence"] != (self._sequence + 1) & 0xFFFFFFFF:
+            self.count("sequence_gaps")
+        self._sequence = head["sequence"]
+        if kind == RecordType.IMAGE:
+            pixels = data[image_end:]
+            tag = image["frame"] & ((1 << self.frame_bits) - 1)
+            for i in range(image["row_count"]):
+                row = image["first_row"] + i
+                self.rows.append((tag, row, pixels[i * self.dmd.columns:(i + 1) * self.dmd.columns]))
+            self.count("records_image")
+            self.count("rows", image["row_count"])
+            self.count("payload_bytes", len(pixels))
+            self.counters["last_row"] = image["first_row"] + image["row_count"] - 1
+            self.counters["last_frame"] = image["frame"]
+            return "image"
+        if kind == RecordType.CONTROL:
+            for i, (name, _) in enumerate(fields.CONFIG):
+                if control["apply"] >> i & 1:
+                    self.config[name] = control[name]
+            self.triggers += control["action"] & 1
+            self.count("records_control")
+            return "control"
+        self.count("records_status")
+        self.replies.append(("status", {**(peer or {}), "sequence": head["sequence"]}))
+        return "status"
