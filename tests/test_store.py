@@ -1,0 +1,345 @@
+"""The bit-plane store (slots, writer, reader) with the serialiser in front and the MCB model
+behind, in the Amaranth simulator on the test geometry, against numpy."""
+
+import random
+
+import numpy as np
+import pytest
+
+from gateware.dlpc410.facts import TEST_DMD
+from sim.harness.amaranth_sim import simulate, stream_feed
+from sim.models import store_stim
+from sim.models.mcb import McbModel, McbTiming, amaranth_process
+from sim.tb.store_chain import StoreChain
+
+DMD = TEST_DMD
+SYNC_HZ, DMD_HZ = 125e6, 200e6
+
+
+class Bench:
+    """A StoreChain with the MCB model on both ports and sequencer-side helpers (``dmd``)."""
+
+    def __init__(self, *, slots=4, timing=None):
+        self.slots = slots
+        self.dut = StoreChain(DMD, slots=slots)
+        self.model = McbModel(64 * 1024, timing=timing)
+        self.processes = [
+            amaranth_process(self.model.ports[0], self.dut.mcb_write, domain="sync", frequency=SYNC_HZ),
+            amaranth_process(self.model.ports[1], self.dut.mcb_read, domain="dmd", frequency=DMD_HZ),
+        ]
+
+    def run(self, testbenches, name, deadline=3e-4):
+        simulate(self.dut, testbenches, name=name, clocks={"sync": SYNC_HZ, "dmd": DMD_HZ},
+                 processes=self.processes, deadline=deadline)
+
+    async def feed(self, ctx, image, frame_id, rows=None, idle=0.0):
+        await stream_feed(ctx, self.dut.pixels, store_stim.frame_beats(image, frame_id, rows=rows),
+                          idle=idle)
+
+    async def ask(self, ctx):
+        """Ask for a frame and wait for the answer: (slot, frame_id, bit_depth)."""
+        dut = self.dut
+        ctx.set(dut.ask.valid, 1)
+        await ctx.tick("dmd").until(dut.ask.ready)
+        ctx.set(dut.ask.valid, 0)
+        ctx.set(dut.frames.ready, 1)
+        payload, = await ctx.tick("dmd").sample(dut.frames.payload).until(dut.frames.valid)
+        ctx.set(dut.frames.ready, 0)
+        return int(payload.slot), int(payload.frame_id), int(payload.bit_depth)
+
+    async def release(self, ctx, slot):
+        ctx.set(self.dut.release.payload, slot)
+        ctx.set(self.dut.release.valid, 1)
+        await ctx.tick("dmd").until(self.dut.release.ready)
+        ctx.set(self.dut.release.valid, 0)
+
+    async def read(self, ctx, slot, plane, first_row=0, row_count=DMD.rows, stall=0.0, rng=None):
+        dut = self.dut
+        ctx.set(dut.requests.payload, {"slot": slot, "plane": plane, "first_row": first_row,
+                                       "row_count": row_count})
+        ctx.set(dut.requests.valid, 1)
+        await ctx.tick("dmd").until(dut.requests.ready)
+        ctx.set(dut.requests.valid, 0)
+        words = []
+        while len(words) < row_count * DMD.words_per_row:
+            ready = not (stall and rng.random() < stall)
+            ctx.set(dut.planes.ready, ready)
+            _, _, valid, payload = await ctx.tick("dmd").sample(dut.planes.valid, dut.planes.payload)
+            if valid and ready:
+                words.append(payload)
+        ctx.set(dut.planes.ready, 0)
+        return words
+
+    async def occupancy(self, ctx, slot):
+        got = []
+        for block in range(DMD.blocks):
+            ctx.set(self.dut.occupancy.slot, slot)
+            ctx.set(self.dut.occupancy.block, block)
+            await ctx.tick("dmd")
+            await ctx.tick("dmd")
+            got.append(ctx.get(self.dut.occupancy.planes))
+        return got
+
+    async def check_frame(self, ctx, slot, image, depth, what="", stall=0.0):
+        rng = random.Random(slot)
+        for plane in store_stim.stored_planes(depth):
+            words = await self.read(ctx, slot, plane, stall=stall, rng=rng)
+            store_stim.check_plane(DMD, image, plane, words, what=what)
+        store_stim.check_occupancy(DMD, image, depth, await self.occupancy(ctx, slot), what=what)
+
+    def counters(self, ctx):
+        c = ctx.get(self.dut.counters)
+        return {name: int(getattr(c, name)) for name in (
+            "frames_complete", "frames_replaced", "frames_abandoned", "rows_outside", "rows_stale",
+            "rows_shown", "rows_duplicate", "rows_no_slot", "bad_releases")}
+
+
+async def wait_until(ctx, flag, domain="sync"):
+    while not flag():
+        await ctx.tick(domain)
+
+
+def play_one_by_one(bench, frames, *, consumer_stall=0.0, idle=0.0):
+    """frames: [(image, frame_id, depth)]; each is sent, then shown, read back and released."""
+    dut = bench.dut
+    shown = []
+    state = {"next": 0}
+
+    async def producer(ctx):
+        for i, (image, frame_id, depth) in enumerate(frames):
+            await wait_until(ctx, lambda: state["next"] == i)
+            ctx.set(dut.bit_depth, depth)
+            await bench.feed(ctx, image, frame_id, idle=idle)
+
+    async def consumer(ctx):
+        for i, (image, frame_id, depth) in enumerate(frames):
+            slot, got_id, got_depth = await bench.ask(ctx)
+            assert (got_id, got_depth) == (frame_id, depth)
+            await bench.check_frame(ctx, slot, image, depth, what=f"frame {frame_id}", stall=consumer_stall)
+            await bench.release(ctx, slot)
+            shown.append(got_id)
+            state["next"] = i + 1
+
+    return producer, consumer, shown
+
+
+def test_bit_depths(test_name):
+    """Random images at bit depths 8 and 1 (every depth runs in the Verilog test): every stored
+    plane reads back as numpy slices it."""
+    bench = Bench()
+    frames = [(store_stim.random_image(DMD, d), 100 + i, d) for i, d in enumerate((8, 1))]
+    producer, consumer, shown = play_one_by_one(bench, frames, consumer_stall=0.3, idle=0.1)
+    bench.run([producer, consumer], test_name)
+    assert shown == [f for _, f, _ in frames]
+
+
+def test_stalled_memory(test_name):
+    """A slow memory with long, frequent refreshes: full FIFOs on both sides, nothing lost."""
+    timing = McbTiming(efficiency=0.08, refresh_interval_s=1.0e-6, refresh_s=300e-9,
+                       read_latency_s=200e-9, calib_delay_s=3e-6)
+    bench = Bench(timing=timing)
+    frames = [(store_stim.random_image(DMD, 50), 1, 3)]
+    producer, consumer, shown = play_one_by_one(bench, frames, consumer_stall=0.5)
+    bench.run([producer, consumer], test_name, deadline=2e-3)
+    assert shown == [1]
+    assert bench.model.refreshes > 10
+
+
+def test_fast_producer_slow_consumer(test_name):
+    """Frames arrive while the sequencer holds one: when it asks again it gets the newest
+    complete frame, the ones in between are replaced (counted), and what it gets reads back whole."""
+    bench = Bench()
+    dut = bench.dut
+    images = {f: store_stim.random_image(DMD, 200 + f) for f in range(1, 5)}
+    got, sent = [], []
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        for f, image in images.items():
+            await bench.feed(ctx, image, f)
+        for _ in range(300):
+            await ctx.tick()
+        sent.append(True)
+
+    async def consumer(ctx):
+        slot, f, depth = await bench.ask(ctx)
+        got.append(f)
+        await wait_until(ctx, lambda: sent, domain="dmd")      # a slow consumer: shows 1 throughout
+        await bench.release(ctx, slot)
+        slot, f, depth = await bench.ask(ctx)
+        got.append(f)
+        await bench.check_frame(ctx, slot, images[f], depth, what=f"frame {f}")
+        counters = bench.counters(ctx)
+        assert counters["frames_complete"] == 4
+        assert counters["frames_replaced"] == 2
+        assert counters["frames_abandoned"] == 0
+
+    bench.run([producer, consumer], test_name, deadline=6e-4)
+    assert got == [1, 4]
+
+
+def test_slow_producer_fast_consumer(test_name):
+    """The consumer keeps an ask outstanding: it gets every frame, in order, none replaced."""
+    bench = Bench()
+    dut = bench.dut
+    images = {f: store_stim.random_image(DMD, 300 + f) for f in (65535, 0, 1)}  # id wraps
+    got = []
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        for f, image in images.items():
+            await bench.feed(ctx, image, f, idle=0.5)
+
+    async def consumer(ctx):
+        held = None
+        for _ in images:
+            slot, f, depth = await bench.ask(ctx)
+            got.append(f)
+            if held is not None:
+                await bench.release(ctx, held)
+            await bench.check_frame(ctx, slot, images[f], depth, what=f"frame {f}")
+            held = slot
+        counters = bench.counters(ctx)
+        assert counters["frames_replaced"] == 0 and counters["rows_stale"] == 0
+
+    bench.run([producer, consumer], test_name, deadline=6e-4)
+    assert got == list(images)
+
+
+def test_missing_row_never_shown(test_name):
+    """A frame with one row missing is never given out; the next complete one is, and the
+    incomplete one is counted as abandoned."""
+    bench = Bench()
+    dut = bench.dut
+    incomplete = store_stim.random_image(DMD, 1)
+    complete = store_stim.random_image(DMD, 2)
+    got = []
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 2)
+        await bench.feed(ctx, incomplete, 10, rows=[r for r in range(DMD.rows) if r != 37])
+        for _ in range(500):
+            await ctx.tick()
+        await bench.feed(ctx, complete, 11)
+
+    async def consumer(ctx):
+        slot, f, depth = await bench.ask(ctx)
+        got.append(f)
+        await bench.check_frame(ctx, slot, complete, depth)
+        counters = bench.counters(ctx)
+        assert counters["frames_abandoned"] == 1 and counters["frames_complete"] == 1
+
+    bench.run([producer, consumer], test_name)
+    assert got == [11]
+
+
+def test_shown_slot_never_written_and_hostile_headers(test_name):
+    """While frame 20 is shown: records with its id are refused, rows beyond the frame and
+    duplicated rows are refused, each counted; no word lands outside the receiving slots; the
+    shown frame reads back unchanged at the end."""
+    bench = Bench()
+    dut = bench.dut
+    amap_slots = bench.slots
+    first = store_stim.random_image(DMD, 5)
+    second = store_stim.random_image(DMD, 6)
+    hostile = store_stim.random_image(DMD, 7)
+    beyond = np.zeros((128, DMD.columns), np.uint8)     # rows 96..127 fit the row field
+    phase = {"shown": None}
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        await bench.feed(ctx, first, 20)
+        await wait_until(ctx, lambda: phase["shown"] is not None)
+        since = len(bench.model.write_log)
+        await bench.feed(ctx, hostile, 20, rows=range(0, 10))                       # shown frame id
+        await bench.feed(ctx, beyond, 21, rows=range(DMD.rows, 128))               # rows outside
+        order = list(range(DMD.rows))
+        order[50:50] = [3, 4, 90]                                                   # overlapping
+        await bench.feed(ctx, second, 21, rows=order)
+        await bench.feed(ctx, hostile, 19, rows=range(0, 2))                        # stale frame id
+        phase["since"] = since
+
+    async def consumer(ctx):
+        slot, f, _ = await bench.ask(ctx)
+        assert f == 20
+        phase["shown"] = slot
+        slot2, f2, depth = await bench.ask(ctx)
+        assert f2 == 21
+        await bench.check_frame(ctx, slot2, second, depth, what="frame 21")
+        await wait_until(ctx, lambda: "since" in phase, domain="dmd")
+        for _ in range(200):
+            await ctx.tick("dmd")
+        await bench.check_frame(ctx, slot, first, 1, what="shown frame 20")
+        counters = bench.counters(ctx)
+        assert counters["rows_shown"] == 10
+        assert counters["rows_outside"] == 128 - DMD.rows
+        assert counters["rows_duplicate"] == 3
+        assert counters["rows_stale"] == 2
+        store_stim.check_writes_inside(bench.model, DMD, amap_slots,
+                                       set(range(amap_slots)) - {slot}, since=phase["since"])
+
+    bench.run([producer, consumer], test_name, deadline=6e-4)
+
+
+def test_sequence_mode(test_name):
+    """Sequence of 3 frames sent out of order: played 0, 1, 2, 0, 1, 2, 0 with their ids."""
+    bench = Bench()
+    dut = bench.dut
+    images = {f: store_stim.random_image(DMD, 400 + f) for f in range(3)}
+    got = []
+
+    async def producer(ctx):
+        ctx.set(dut.sequence_length, 3)
+        ctx.set(dut.bit_depth, 1)
+        for _ in range(3):
+            await ctx.tick()
+        for f in (2, 0, 1):
+            await bench.feed(ctx, images[f], f)
+        await bench.feed(ctx, images[1], 3, rows=range(4))        # beyond the sequence: stale
+
+    async def consumer(ctx):
+        held = None
+        for _ in range(7):
+            slot, f, depth = await bench.ask(ctx)
+            assert slot == f and depth == 1
+            got.append(f)
+            if held is not None:
+                await bench.release(ctx, held)
+            held = slot
+            if len(got) <= 3:
+                await bench.check_frame(ctx, slot, images[f], depth, what=f"sequence frame {f}")
+        counters = bench.counters(ctx)
+        assert counters["frames_complete"] == 3 and counters["frames_replaced"] == 0
+        assert counters["rows_stale"] == 4
+
+    bench.run([producer, consumer], test_name, deadline=6e-4)
+    assert got == [0, 1, 2, 0, 1, 2, 0]
+
+
+def test_row_subsets_and_bad_requests(test_name):
+    """Runs of rows of a plane read back as numpy's slices; requests past the frame are dropped
+    and counted, and produce no words."""
+    bench = Bench()
+    dut = bench.dut
+    image = store_stim.random_image(DMD, 9)
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 8)
+        await bench.feed(ctx, image, 1)
+
+    async def consumer(ctx):
+        slot, _, _ = await bench.ask(ctx)
+        for bad in ({"slot": slot, "plane": 0, "first_row": 90, "row_count": 7},
+                    {"slot": slot, "plane": 0, "first_row": 0, "row_count": 0},
+                    {"slot": 9, "plane": 0, "first_row": 0, "row_count": 1}):
+            ctx.set(dut.requests.payload, bad)
+            ctx.set(dut.requests.valid, 1)
+            await ctx.tick("dmd").until(dut.requests.ready)
+        ctx.set(dut.requests.valid, 0)
+        for plane, first, count in ((7, 0, 1), (3, 24, 24), (0, 95, 1), (5, 10, 80)):
+            words = await bench.read(ctx, slot, plane, first, count)
+            store_stim.check_plane(DMD, image, plane, words, first, count)
+        assert ctx.get(dut.bad_requests) == 3
+        assert not ctx.get(dut.planes.valid)
+
+    bench.run([producer, consumer], test_name)
