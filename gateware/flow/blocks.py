@@ -13,6 +13,24 @@ def _serialiser():
     return Serialiser(DMDS["dlp7000"], lanes=8)
 
 
+def _store_slots():
+    from gateware.store.slots import FrameSlots
+    return FrameSlots(DMDS["dlp7000"], slots=4)
+
+
+def _store_writer():
+    from gateware.store.writer import Writer
+    return Writer(DMDS["dlp7000"], slots=4)
+
+
+def _store_reader():
+    from gateware.store.reader import Reader
+    return Reader(DMDS["dlp7000"], slots=4)
+
+
 BLOCKS = {
     "serialiser": _serialiser,
+    "store_slots": _store_slots,
+    "store_writer": _store_writer,
+    "store_reader": _store_reader,
 }

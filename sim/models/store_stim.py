@@ -51,3 +51,53 @@ def check_writes_inside(model, dmd, slots, allowed, since=0):
     for address, _port in model.write_log[since:]:
         assert any(lo <= address < hi for lo, hi in ranges), \
             f"word written at {address:#x}, outside slots {sorted(allowed)}"
+
+
+class PortDriver:
+    """Drives one port of :class:`sim.models.mcb.McbModel` from plain Python, cycle by cycle,
+    with the traffic the writer and reader make: the reference of the store's memory traffic."""
+
+    def __init__(self, model, port, period):
+        self.port, self.period, self.cycle = model.ports[port], period, 0
+
+    def tick(self, **inputs):
+        self.cycle += 1
+        return self.port.clock(self.cycle * self.period, **inputs)
+
+    def write(self, address, words):
+        """One burst as the writer gives it: the words first, then the command."""
+        while not self.port.outputs["calib_done"] or self.port.outputs["wr_count"] > 64 - len(words):
+            self.tick()
+        for w in words:
+            self.tick(wr_en=1, wr_data=int(w))
+        while self.port.outputs["cmd_full"]:
+            self.tick()
+        self.tick(cmd_en=1, cmd_instr=0, cmd_bl=len(words) - 1, cmd_byte_addr=address)
+
+    def read(self, address, count, lookahead=4):
+        """``count`` words from ``address`` in bursts of up to 64, ``lookahead`` in flight."""
+        out, issued, reserved = [], 0, 0
+        while len(out) < count:
+            o = self.port.outputs
+            inputs = {}
+            if not o["rd_empty"]:
+                inputs["rd_en"] = 1
+                out.append(o["rd_data"])
+                reserved -= 1
+            burst = min(64, count - issued)
+            if (burst and o["calib_done"] and not o["cmd_full"]
+                    and reserved + burst <= 64 * lookahead):
+                inputs.update(cmd_en=1, cmd_instr=1, cmd_bl=burst - 1,
+                              cmd_byte_addr=address + issued * 8)
+                issued += burst
+                reserved += burst
+            self.tick(**inputs)
+        return out
+
+
+def store_frame(driver, amap, image, slot, depth):
+    """Write ``image`` at ``depth`` into ``slot`` row by row, plane by plane, as the writer does."""
+    words = bitplane.plane_words(image)
+    for row in range(amap.dmd.rows):
+        for plane in stored_planes(depth):
+            driver.write(amap.address(slot, plane, row), words[plane, row])

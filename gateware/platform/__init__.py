@@ -1,0 +1,1 @@
+"""The platform layer: vendor primitives and instances, kept out of the simulated core."""
