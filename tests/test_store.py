@@ -4,7 +4,6 @@ behind, in the Amaranth simulator on the test geometry, against numpy."""
 import random
 
 import numpy as np
-import pytest
 
 from gateware.dlpc410.facts import TEST_DMD
 from sim.harness.amaranth_sim import simulate, stream_feed
@@ -107,7 +106,7 @@ def play_one_by_one(bench, frames, *, consumer_stall=0.0, idle=0.0):
 
     async def producer(ctx):
         for i, (image, frame_id, depth) in enumerate(frames):
-            await wait_until(ctx, lambda: state["next"] == i)
+            await wait_until(ctx, lambda i=i: state["next"] == i)
             ctx.set(dut.bit_depth, depth)
             await bench.feed(ctx, image, frame_id, idle=idle)
 

@@ -26,7 +26,8 @@ def test_slots_and_planes_tile_the_memory(dmd):
     assert amap.end <= MEMORY_BYTES
     spans = sorted((amap.address(s, p), amap.address(s, p) + amap.plane_bytes)
                    for s in range(slots) for p in range(PLANES))
-    assert all(a_end == b_start for (_, a_end), (b_start, _) in zip(spans, spans[1:])), "gap or overlap"
+    pairs = zip(spans, spans[1:], strict=False)
+    assert all(a_end == b_start for (_, a_end), (b_start, _) in pairs), "gap or overlap"
     assert amap.address(0, 0, geometry.rows - 1, geometry.words_per_row - 1) + 8 == amap.plane_bytes
 
 

@@ -17,7 +17,7 @@ from amaranth import ClockSignal, Instance, Module
 from amaranth.build import Attrs, Pins, Resource, Subsignal
 from amaranth.hdl import IOPort
 from amaranth.lib import wiring
-from amaranth.lib.wiring import In, Out
+from amaranth.lib.wiring import In
 
 from gateware.store import mcb
 
@@ -99,7 +99,7 @@ class McbInstance(wiring.Component):
             "i_c3_sys_rst_i": self.sys_rst,
         }
         calib_done = []
-        for n, (port, domain) in enumerate(zip((self.port0, self.port1), self._domains)):
+        for n, (port, domain) in enumerate(zip((self.port0, self.port1), self._domains, strict=True)):
             p = f"c3_p{n}_"
             clock = ClockSignal(domain)
             ports.update({

@@ -113,7 +113,10 @@ class Reader(wiring.Component):
             with m.State("ISSUE"):
                 with m.If(port.calib_done & ~port.cmd_full & (reserved + burst <= depth)):
                     m.d.comb += issue.eq(1)
-                    m.d.sync += [address.eq(address + burst * mcb.WORD_BYTES), remaining.eq(remaining - burst)]
+                    m.d.sync += [address.eq(address + burst * mcb.WORD_BYTES),
+                                 remaining.eq(remaining - burst)]
                     with m.If(remaining == burst):
                         m.next = "IDLE"
-        return DomainRenamer({"sync": self._domain})(m) if self._domain != "sync" else m
+        if self._domain != "sync":
+            return DomainRenamer({"sync": self._domain})(m)
+        return m

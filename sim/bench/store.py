@@ -54,7 +54,8 @@ def write_rate(rows=12, dmd="dlp7000"):
                         amaranth_process(model.ports[1], dut.mcb_read, domain="dmd", frequency=DMD_HZ)],
              waves=False, deadline=1e-3)
     pixels = rows * geometry.columns
-    return {"bytes_per_s": pixels / (result["elapsed"] / SYNC_HZ), "cycles": result["elapsed"], "pixels": pixels}
+    return {"bytes_per_s": pixels / (result["elapsed"] / SYNC_HZ), "cycles": result["elapsed"],
+            "pixels": pixels}
 
 
 def read_rate(dmd="dlp7000", timing=None):
