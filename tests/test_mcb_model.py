@@ -166,3 +166,20 @@ def test_read_while_empty():
         clk.until_calibrated()
         clk.tick(rd_en=1)
     violation("rd_empty", action)
+
+
+def test_random_stalls_slow_it_down():
+    """With random stalls the same reads take longer, and still arrive whole and in order."""
+    def run(timing):
+        model = McbModel(1 << 16, timing=timing, seed=5)
+        clk = Clocked(model, period=5e-9)
+        clk.until_calibrated()
+        model.memory[:64] = range(64)
+        start = clk.cycle
+        for _ in range(32):
+            assert read_burst(clk, 0, 64) == list(range(64))
+        return clk.cycle - start
+
+    calm = run(McbTiming())
+    stalled = run(McbTiming(stall_chance=0.5, stall_max_s=1e-6))
+    assert stalled > calm * 1.5

@@ -15,7 +15,8 @@ share it, commands are granted round robin. A command starts ``command_latency_s
 was pushed at the earliest; read words reach the read FIFO ``read_latency_s`` after their slot on
 the memory; written words leave the write FIFO one per word time. Every ``refresh_interval_s``
 (7.8 us) the memory is busy for ``refresh_s`` (about 160 ns) after the command in progress.
-``calib_done`` rises ``calib_delay_s`` after time 0.
+``calib_done`` rises ``calib_delay_s`` after time 0. With ``stall_chance`` > 0, a command waits
+up to ``stall_max_s`` more before it starts, at random (seeded): stalls at unpredictable times.
 
 Errors
 ------
@@ -29,6 +30,7 @@ controller finding the write FIFO empty during a write (``underrun``, reachable 
 a full read FIFO (``overflow``).
 """
 
+import random
 from collections import deque
 from dataclasses import dataclass
 
@@ -65,6 +67,8 @@ class McbTiming:
     calib_delay_s: float = 1e-6
     refresh_interval_s: float = 7.8e-6
     refresh_s: float = 160e-9
+    stall_chance: float = 0.0           # chance that a command waits a random extra time first
+    stall_max_s: float = 0.0            # (bank conflicts, the other port's turn, ...)
 
     @property
     def word_s(self):
@@ -79,8 +83,9 @@ class McbTiming:
 class McbModel:
     """The memory and its shared timing; ``ports`` user ports in ``self.ports``."""
 
-    def __init__(self, memory_bytes=16 * 2**20, *, ports=2, timing=None, check_write_data=True):
+    def __init__(self, memory_bytes=16 * 2**20, *, ports=2, timing=None, check_write_data=True, seed=0):
         self.timing = timing or McbTiming()
+        self.rng = random.Random(seed)
         self.memory = np.zeros(memory_bytes // WORD_BYTES, dtype=np.uint64)
         self.memory_bytes = memory_bytes
         self.check_write_data = check_write_data
@@ -124,6 +129,11 @@ class McbModel:
                 continue
             if start > now:
                 break
+            if t.stall_chance and self.rng.random() < t.stall_chance:
+                stall = self.rng.uniform(0, t.stall_max_s)
+                self.busy_until = start + stall
+                self.busy_s += stall
+                continue
             self._next_port = (port.index + 1) % len(self.ports)
             self._execute(port, start, *port.commands.popleft()[1:])
         for port in self.ports:
@@ -163,6 +173,7 @@ class McbPort:
         self.draining = 0            # write words owned by started write commands
         self.underrun = self.overflow = False
         self.words_written = self.words_read = 0
+        self.command_log = []        # (instr, words, byte address) of every command taken
         self.outputs = self._outputs(0.0)
 
     # -- the controller side
@@ -238,6 +249,7 @@ class McbPort:
                                                f"{address:#x} with {free} unclaimed words in the FIFO")
             self.claimed += words
         self.commands.append((now, instr, words, address))
+        self.command_log.append((instr, words, address))
 
     def _outputs(self, now):
         wr, rd = len(self.write_fifo), len(self.read_fifo)
