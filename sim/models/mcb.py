@@ -312,20 +312,37 @@ class CocotbPort:
     :meth:`run` with ``cocotb.start_soon``. ``period_ns`` is that of ``clock``."""
 
     def __init__(self, dut, prefix, clock, port_model, period_ns):
-        self.inputs = [getattr(dut, f"{prefix}__{name}") for name in INPUTS]
+        self.inputs = {name: getattr(dut, f"{prefix}__{name}") for name in INPUTS}
         self.outputs = {name: getattr(dut, f"{prefix}__{name}") for name in OUTPUTS}
         self.clock_signal, self.model, self.period = clock, port_model, period_ns * 1e-9
+        self._last = {}
         self._drive(port_model.outputs)
 
     def _drive(self, values):
+        # only what changed: each write is a simulator call
         for name, value in values.items():
-            self.outputs[name].value = value
+            if self._last.get(name) != value:
+                self.outputs[name].value = value
+                self._last[name] = value
+
+    def _sample(self):
+        """The inputs at this edge; the data and command fields only when their strobe is set."""
+        signals = self.inputs
+        values = {"cmd_en": int(signals["cmd_en"].value), "wr_en": int(signals["wr_en"].value),
+                  "rd_en": int(signals["rd_en"].value)}
+        if values["cmd_en"]:
+            for name in ("cmd_instr", "cmd_bl", "cmd_byte_addr"):
+                values[name] = int(signals[name].value)
+        if values["wr_en"]:
+            for name in ("wr_data", "wr_mask"):
+                values[name] = int(signals[name].value)
+        return values
 
     async def run(self):
         from cocotb.triggers import RisingEdge
         cycle = 0
+        edge = RisingEdge(self.clock_signal)
         while True:
-            await RisingEdge(self.clock_signal)
+            await edge
             cycle += 1
-            values = [int(signal.value) for signal in self.inputs]
-            self._drive(self.model.clock(cycle * self.period, *values))
+            self._drive(self.model.clock(cycle * self.period, **self._sample()))
