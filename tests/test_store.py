@@ -420,3 +420,96 @@ def test_read_rate_figure():
     from sim.bench.store import read_rate
     figure = read_rate()
     assert figure["fraction"] > 0.95
+
+
+def test_random_events_against_policy_model(test_name):
+    """Random records (new frames, parts and rests of frames, stale and shown ids, rows beyond
+    the frame, overlaps), asks and releases: after each event the gateware's counters and the
+    frames it gives equal the reference model's (sim.models.slots)."""
+    from sim.models.slots import SlotPolicy
+
+    rng = random.Random(14)
+    bench = Bench(slots=4)
+    dut = bench.dut
+    policy = SlotPolicy(DMD.rows, 4)
+    image = store_stim.random_image(DMD, 77)
+    tall = np.vstack([image, image[:32]])                       # rows 96..127 exist for hostile records
+    held = {}                                                   # gateware slot -> frame id
+    checked = {"events": 0}
+    state = {"turn": "producer", "event": None}
+    newest = 1
+
+    events = []
+    for _ in range(44):
+        kind = rng.choice(["full", "newpart", "part", "part", "rest", "old", "beyond", "ask", "ask",
+                           "release"])
+        if kind == "full":
+            newest += rng.choice([1, 1, 2])
+            events.append(("rows", newest, list(range(DMD.rows))))
+        elif kind == "newpart":
+            newest += 1
+            events.append(("rows", newest, list(range(rng.randrange(40), 60))))
+        elif kind == "part":
+            first = rng.randrange(DMD.rows)
+            events.append(("rows", newest, list(range(first, min(DMD.rows, first + rng.randrange(1, 30))))))
+        elif kind == "rest":
+            events.append(("rest", newest, None))
+        elif kind == "old":
+            events.append(("rows", newest - rng.randrange(1, 4), list(range(rng.randrange(8), 12))))
+        elif kind == "beyond":
+            events.append(("rows", newest, list(range(DMD.rows - 2, DMD.rows + rng.randrange(1, 20)))))
+        else:
+            events.append((kind, None, None))
+    # then for certain: overlapping records, and a sequencer holding three of the four slots
+    n = newest
+    events += [("release_all", None, None), ("rows", n + 1, list(range(20))),
+               ("rows", n + 1, list(range(10, 30)))]
+    for k in range(2, 5):
+        events += [("rows", n + k, list(range(DMD.rows))), ("ask", None, None)]
+    events += [("rows", n + 5, list(range(DMD.rows))), ("rows", n + 6, list(range(4)))]
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        for kind, frame, rows in events:
+            if kind == "rest":
+                have = policy.frames.get(frame, {"rows": set()})["rows"]
+                kind, rows = "rows", [r for r in range(DMD.rows) if r not in have]
+            if kind == "rows":
+                for row in rows:
+                    policy.row(frame & 0xFFFF, row, 1)
+                await bench.feed(ctx, tall, frame & 0xFFFF, rows=rows)
+                for _ in range(400):                            # the last rows reach memory
+                    await ctx.tick()
+            else:
+                state["event"] = kind
+                state["turn"] = "consumer"
+                await wait_until(ctx, lambda: state["turn"] == "producer")
+            assert bench.counters(ctx) == policy.counters, f"after {kind} {frame}"
+            checked["events"] += 1
+        state["turn"] = "done"
+
+    async def consumer(ctx):
+        while True:
+            await wait_until(ctx, lambda: state["turn"] != "producer", domain="dmd")
+            if state["turn"] == "done":
+                return
+            if state["event"] == "ask" and policy.can_answer():
+                want = policy.ask()
+                slot, frame, _ = await bench.ask(ctx)
+                assert frame == want
+                held[slot] = frame
+                if len(held) == 1:
+                    words = await bench.read(ctx, slot, 7, 0, 8)
+                    store_stim.check_plane(DMD, image, 7, words, 0, 8, what=f"frame {frame}")
+            elif state["event"] in ("release", "release_all") and held:
+                for slot in ([rng.choice(sorted(held))] if state["event"] == "release" else sorted(held)):
+                    policy.release(held.pop(slot))
+                    await bench.release(ctx, slot)
+                for _ in range(20):
+                    await ctx.tick("dmd")
+            state["turn"] = "producer"
+
+    bench.run([producer, consumer], test_name, deadline=3e-3)
+    assert checked["events"] == len(events)
+    exercised = {name for name, value in policy.counters.items() if value}
+    assert exercised >= set(policy.counters) - {"bad_releases"}, policy.counters
