@@ -4,23 +4,8 @@ client can break (each violation injected once)."""
 import pytest
 
 from sim.models.mcb import READ, REFRESH, WRITE, WRITE_PRECHARGE, McbError, McbModel, McbTiming
+from sim.models.store_stim import PortDriver
 
-PERIOD = 8e-9
-
-
-class Clocked:
-    """Drives one port cycle by cycle from plain Python."""
-
-    def __init__(self, model, port=0, period=PERIOD):
-        self.port, self.period, self.cycle = model.ports[port], period, 0
-
-    def tick(self, **inputs):
-        self.cycle += 1
-        return self.port.clock(self.cycle * self.period, **inputs)
-
-    def until_calibrated(self):
-        while not self.port.outputs["calib_done"]:
-            self.tick()
 
 
 def write_burst(clk, address, words, instr=WRITE):
@@ -45,7 +30,7 @@ def read_burst(clk, address, count):
 
 def test_write_then_read_back():
     model = McbModel(1 << 16)
-    clk = Clocked(model)
+    clk = PortDriver(model)
     clk.until_calibrated()
     data = [(0x0123456789ABCDEF * (i + 1)) & (2**64 - 1) for i in range(64)]
     write_burst(clk, 0x100, data)
@@ -59,7 +44,7 @@ def test_bandwidth_and_refresh():
     """A long stream of reads runs at the sustained rate; refreshes happen every 7.8 us."""
     timing = McbTiming()
     model = McbModel(1 << 20, timing=timing)
-    clk = Clocked(model, period=5e-9)
+    clk = PortDriver(model, period=5e-9)
     clk.until_calibrated()
     start, words = clk.cycle, 0
     for n in range(60):
@@ -73,7 +58,7 @@ def test_bandwidth_and_refresh():
 
 def test_user_refresh_instruction():
     model = McbModel(1 << 16)
-    clk = Clocked(model)
+    clk = PortDriver(model)
     clk.until_calibrated()
     clk.tick(cmd_en=1, cmd_instr=REFRESH)
     for _ in range(40):
@@ -83,7 +68,7 @@ def test_user_refresh_instruction():
 
 def violation(kind, action, **model_args):
     model = McbModel(1 << 16, **model_args)
-    clk = Clocked(model)
+    clk = PortDriver(model)
     with pytest.raises(McbError) as error:
         action(clk)
     assert error.value.kind == kind
@@ -172,7 +157,7 @@ def test_random_stalls_slow_it_down():
     """With random stalls the same reads take longer, and still arrive whole and in order."""
     def run(timing):
         model = McbModel(1 << 16, timing=timing, seed=5)
-        clk = Clocked(model, period=5e-9)
+        clk = PortDriver(model, period=5e-9)
         clk.until_calibrated()
         model.memory[:64] = range(64)
         start = clk.cycle

@@ -57,12 +57,16 @@ class PortDriver:
     """Drives one port of :class:`sim.models.mcb.McbModel` from plain Python, cycle by cycle,
     with the traffic the writer and reader make: the reference of the store's memory traffic."""
 
-    def __init__(self, model, port, period):
+    def __init__(self, model, port=0, period=8e-9):
         self.port, self.period, self.cycle = model.ports[port], period, 0
 
     def tick(self, **inputs):
         self.cycle += 1
         return self.port.clock(self.cycle * self.period, **inputs)
+
+    def until_calibrated(self):
+        while not self.port.outputs["calib_done"]:
+            self.tick()
 
     def write(self, address, words):
         """One burst as the writer gives it: the words first, then the command."""
