@@ -513,3 +513,51 @@ def test_random_events_against_policy_model(test_name):
     assert checked["events"] == len(events)
     exercised = {name for name, value in policy.counters.items() if value}
     assert exercised >= set(policy.counters) - {"bad_releases"}, policy.counters
+
+
+def test_mode_change_keeps_the_shown_frame(test_name):
+    """Streaming, then sequence mode while a streamed frame is shown: that slot is kept (records
+    for it are refused) until released, then the sequence loads and plays in order."""
+    bench = Bench()
+    dut = bench.dut
+    streamed = store_stim.random_image(DMD, 800)
+    images = {f: store_stim.random_image(DMD, 810 + f) for f in range(2)}
+    phase = {}
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        await bench.feed(ctx, streamed, 5)
+        await wait_until(ctx, lambda: "shown" in phase)
+        ctx.set(dut.sequence_length, 2)
+        for _ in range(4):
+            await ctx.tick()
+        shown = phase["shown"]
+        await bench.feed(ctx, images[shown], shown, rows=range(3))     # its slot is shown: refused
+        await bench.feed(ctx, images[1 - shown], 1 - shown)
+        phase["refused"] = True
+        await wait_until(ctx, lambda: "released" in phase)
+        await bench.feed(ctx, images[shown], shown)
+
+    async def consumer(ctx):
+        slot, f, depth = await bench.ask(ctx)
+        assert f == 5 and slot in (0, 1)
+        phase["shown"] = slot
+        await wait_until(ctx, lambda: "refused" in phase, domain="dmd")
+        for _ in range(50):
+            await ctx.tick("dmd")
+        assert bench.counters(ctx)["rows_shown"] == 3
+        await bench.check_frame(ctx, slot, streamed, depth, what="streamed frame kept")
+        await bench.release(ctx, slot)
+        phase["released"] = True
+        got = []
+        held = None
+        for _ in range(3):
+            slot, f, depth = await bench.ask(ctx)
+            got.append(f)
+            if held is not None:
+                await bench.release(ctx, held)
+            held = slot
+        assert got == [0, 1, 0]
+        await bench.check_frame(ctx, held, images[0], depth, what="sequence frame 0")
+
+    bench.run([producer, consumer], test_name)

@@ -226,9 +226,8 @@ class FrameSlots(wiring.Component):
 
         with m.FSM(name="ingest") as ingest:
             with m.State("ROW_START"):
-                with m.If(mode_pending):
-                    pass                                    # the mode changes first (below)
-                with m.Elif(self.words.valid):
+                # a change of mode is applied first, between rows (housekeeping, below)
+                with m.If(self.words.valid & ~mode_pending):
                     seq_slot = head.frame[:SLOT_BITS]
                     with m.If(head.row >= dmd.rows):
                         refuse(count.rows_outside)
