@@ -18,7 +18,7 @@ def test_xga_plane_is_0x3000_words():
     assert amap.address(1, 2, 3, 4) == 0xC0000 + 2 * 0x18000 + 3 * 0x80 + 4 * 8
 
 
-@pytest.mark.parametrize("dmd", ["dlp7000", "dlp9500", "test"])
+@pytest.mark.parametrize("dmd", ["dlp7000", "dlp9500", "dlp650lnir", "test"])
 def test_slots_and_planes_tile_the_memory(dmd):
     geometry = DMDS[dmd]
     slots = 16

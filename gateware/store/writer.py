@@ -56,10 +56,10 @@ class Writer(wiring.Component):
     slots : int
         Frame slots in the memory (the address map).
     max_burst : int
-        Longest burst in words, a multiple of ``words_per_row``. Rows that follow each other
-        in one slot go out together, up to this many words per plane: 32 (two XGA rows, one
-        1080p row), half the write FIFO, so that one burst fills the FIFO while the previous
-        one drains.
+        Longest burst in words. Rows that follow each other in one slot go out together, as
+        many whole rows as fit in this many words per plane: 32 (two XGA rows, one 1080p row,
+        one WXGA row of 20 words), half the write FIFO, so that one burst fills the FIFO while
+        the previous one drains.
     settle : int
         Cycles to wait after a command before trusting ``wr_count``, ``cmd_empty`` and
         ``wr_empty`` again (the MCB updates them a little late).
@@ -76,7 +76,7 @@ class Writer(wiring.Component):
     """
 
     def __init__(self, dmd, *, slots=16, max_burst=32, settle=2):
-        assert max_burst % dmd.words_per_row == 0 and max_burst <= mcb.MAX_BURST
+        assert dmd.words_per_row <= max_burst <= mcb.MAX_BURST
         self._dmd = dmd
         self._map = AddressMap(dmd, slots)
         self._max_burst = max_burst
