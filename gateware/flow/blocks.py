@@ -29,9 +29,27 @@ def _eth_stack():
     return Ingest(DMDS["dlp7000"], mac=0x02_00_00_00_00_01, ip=0xC0_A8_01_0A, port=5000)
 
 
+def _store_slots():
+    from gateware.store.slots import FrameSlots
+    return FrameSlots(DMDS["dlp7000"], slots=4)
+
+
+def _store_writer():
+    from gateware.store.writer import Writer
+    return Writer(DMDS["dlp7000"], slots=4)
+
+
+def _store_reader():
+    from gateware.store.reader import Reader
+    return Reader(DMDS["dlp7000"], slots=4)
+
+
 BLOCKS = {
     "serialiser": _serialiser,
     "eth_rx": _eth_rx,
     "eth_tx": _eth_tx,
     "eth_stack": _eth_stack,
+    "store_slots": _store_slots,
+    "store_writer": _store_writer,
+    "store_reader": _store_reader,
 }

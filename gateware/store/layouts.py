@@ -1,16 +1,40 @@
-"""What the store and the sequencer exchange (``dmd`` domain).
+"""What the store and the sequencer exchange (all in the ``dmd`` domain).
 
-The sequencer asks for the rows of one plane of one slot and receives the words in row order,
-``words_per_row`` words per row, word 0 (columns 0..63) first. It learns which frames are ready
-from the store and hands a slot back once its last plane has been read for the last time.
+Frames
+------
+The sequencer learns of showable frames by asking: each transfer on the store's ``ask`` port
+asks for one frame, and the store answers on ``frames`` with a :class:`FrameInfo` as soon as it
+has one to give: in streaming mode the newest complete frame (an older one that was never given
+out is replaced and counted), in sequence mode the next slot of the sequence, in order. From the
+answer on, the slot is *shown*: the store never writes it until the sequencer hands it back on
+``release`` (in streaming mode the slot is then free for a new frame; in sequence mode it stays
+in the sequence). A sequencer that wants the newest frame at each frame boundary asks at the
+boundary; one that wants no gap keeps one ask outstanding.
+
+Planes
+------
+The sequencer asks for the rows of one plane of a slot it holds with a :class:`PlaneRequest`
+and receives the words in row order, ``words_per_row`` words per row, word 0 (columns 0..63)
+first, ``row_count * words_per_row`` words per request, requests answered in order.
+
+Occupancy
+---------
+:class:`OccupancySignature`: the sequencer puts a slot and a DMD block on the port and reads,
+one ``dmd`` cycle later, which planes have any bit set in that block, so that it can clear an
+empty block instead of loading it. The map of a slot is written only while the slot receives
+and is stable from the moment the slot is complete, long before the slot can be given to the
+sequencer, so reading it from another clock domain is safe for every slot the sequencer holds.
 """
 
-from amaranth.lib import data
+from amaranth.lib import data, wiring
+from amaranth.lib.wiring import In, Out
 
-__all__ = ["SLOT_BITS", "PlaneRequest", "FrameInfo"]
+__all__ = ["SLOT_BITS", "BLOCK_BITS", "PlaneRequest", "FrameInfo", "OccupancySignature"]
 
 #: Frame slots are numbered in this many bits (16 slots; sequence mode spans slots).
 SLOT_BITS = 4
+#: DMD blocks are numbered in this many bits (16 blocks at most).
+BLOCK_BITS = 4
 
 
 class PlaneRequest(data.Struct):
@@ -26,3 +50,25 @@ class FrameInfo(data.Struct):
     slot: SLOT_BITS
     frame_id: 16
     bit_depth: 4      # 1..8 planes stored, most significant first: planes 8-bit_depth..7
+
+
+class OccupancySignature(wiring.Signature):
+    """Read port of the occupancy map, seen from the sequencer (``dmd`` domain).
+
+    Members
+    -------
+    slot, block : Out
+        Which slot and DMD block to look up.
+    planes : In(8)
+        One cycle later: bit ``k`` set when plane ``k`` of that block has any bit set.
+    """
+
+    def __init__(self):
+        super().__init__({
+            "slot": Out(SLOT_BITS),
+            "block": Out(BLOCK_BITS),
+            "planes": In(8),
+        })
+
+    def __eq__(self, other):
+        return isinstance(other, OccupancySignature)

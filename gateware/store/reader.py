@@ -1,0 +1,122 @@
+"""The plane reader (DESIGN.md block 6): planes out of DDR2 for the sequencer (``dmd`` domain).
+
+A :class:`~gateware.store.layouts.PlaneRequest` names a slot, a plane and a run of rows; the
+rows of a plane are one contiguous run of memory (:mod:`gateware.store.addresses`), so the
+reader cuts it into read commands of up to 64 words and gives them through MCB port 1, clocked
+by ``dmd``. The words go through a FIFO to the sequencer, in order, requests one after another.
+
+Look-ahead: the reader keeps issuing commands, across request boundaries, as long as the words
+it has asked for and not yet handed on fit in its FIFO (``fifo_depth`` words, several commands
+outstanding), so the memory's latency is hidden and one word per ``dmd`` cycle leaves whenever
+the memory delivers that fast. Because those words always have room, the reader takes every
+word from the MCB's read FIFO as soon as it is there: that FIFO never overflows.
+
+A request that does not fit the frame (slot beyond the slots, no rows, rows past the last) is
+dropped and counted; it produces no words.
+"""
+
+from amaranth import DomainRenamer, Module, Mux, Signal
+from amaranth.lib import stream, wiring
+from amaranth.lib.fifo import SyncFIFOBuffered
+from amaranth.lib.wiring import In, Out
+
+from . import mcb
+from .addresses import AddressMap
+from .layouts import PlaneRequest
+
+__all__ = ["Reader"]
+
+
+class Reader(wiring.Component):
+    """Read runs of plane rows from DDR2 into a FIFO.
+
+    Parameters
+    ----------
+    dmd : :class:`gateware.dlpc410.facts.DmdType`
+    slots : int
+        Frame slots in the memory (the address map).
+    fifo_depth : int
+        Words of look-ahead and buffering (a multiple of 64; 256 = four commands in flight).
+    domain : str
+        Clock domain of the reader and of its MCB port.
+
+    Members
+    -------
+    requests : In(stream.Signature(PlaneRequest))
+        What to read.
+    words : Out(stream.Signature(64))
+        The rows' words in order, ``words_per_row`` per row, word 0 first.
+    mcb : Out(mcb.PortSignature())
+        MCB port 1; only the read half is used.
+    bad_requests : Out(16)
+        Requests dropped because they do not fit the frame.
+    """
+
+    def __init__(self, dmd, *, slots=16, fifo_depth=256, domain="dmd"):
+        assert fifo_depth % mcb.MAX_BURST == 0
+        self._dmd, self._slots = dmd, slots
+        self._map = AddressMap(dmd, slots)
+        self._fifo_depth, self._domain = fifo_depth, domain
+        super().__init__({
+            "requests": In(stream.Signature(PlaneRequest)),
+            "words": Out(stream.Signature(64)),
+            "mcb": Out(mcb.PortSignature()),
+            "bad_requests": Out(16),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        dmd, depth = self._dmd, self._fifo_depth
+        port = self.mcb
+
+        m.submodules.fifo = fifo = SyncFIFOBuffered(width=64, depth=depth)
+        wiring.connect(m, wiring.flipped(self.words), fifo.r_stream)
+
+        address = Signal(30)
+        remaining = Signal(range(dmd.words_per_plane + 1))
+        reserved = Signal(range(depth + 1))      # asked for and not yet handed on
+        burst = Signal(range(mcb.MAX_BURST + 1))
+        m.d.comb += burst.eq(Mux(remaining > mcb.MAX_BURST, mcb.MAX_BURST, remaining))
+
+        issue = Signal()
+        handed = Signal()
+        m.d.comb += handed.eq(self.words.valid & self.words.ready)
+        m.d.sync += reserved.eq(reserved + Mux(issue, burst, 0) - handed)
+
+        # every word in the read FIFO has room in ours (reserved covers it)
+        m.d.comb += [
+            port.rd_en.eq(port.calib_done & ~port.rd_empty),
+            fifo.w_en.eq(port.rd_en),
+            fifo.w_data.eq(port.rd_data),
+            port.cmd_instr.eq(mcb.Instr.READ),
+            port.cmd_bl.eq(burst - 1),
+            port.cmd_byte_addr.eq(address),
+            port.cmd_en.eq(issue),
+            port.wr_en.eq(0),
+        ]
+
+        request = self.requests.payload
+        with m.FSM():
+            with m.State("IDLE"):
+                m.d.comb += self.requests.ready.eq(1)
+                with m.If(self.requests.valid):
+                    fits = ((request.slot < self._slots) & (request.row_count != 0)
+                            & (request.first_row + request.row_count <= dmd.rows))
+                    with m.If(fits):
+                        m.d.sync += [
+                            address.eq(self._map.address(request.slot, request.plane, request.first_row)),
+                            remaining.eq(request.row_count * dmd.words_per_row),
+                        ]
+                        m.next = "ISSUE"
+                    with m.Else():
+                        m.d.sync += self.bad_requests.eq(self.bad_requests + 1)
+            with m.State("ISSUE"):
+                with m.If(port.calib_done & ~port.cmd_full & (reserved + burst <= depth)):
+                    m.d.comb += issue.eq(1)
+                    m.d.sync += [address.eq(address + burst * mcb.WORD_BYTES),
+                                 remaining.eq(remaining - burst)]
+                    with m.If(remaining == burst):
+                        m.next = "IDLE"
+        if self._domain != "sync":
+            return DomainRenamer({"sync": self._domain})(m)
+        return m

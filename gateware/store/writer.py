@@ -1,0 +1,229 @@
+"""The DDR2 writer (DESIGN.md block 5): plane words in, MCB write bursts out (``sync`` domain).
+
+The serialiser emits the eight planes of every 64-pixel run in turn, but DDR2 keeps planes apart
+(:mod:`gateware.store.addresses`). The writer therefore gathers rows in a buffer and then writes
+them plane by plane. Consecutive rows of one plane are contiguous in memory, so rows that arrive
+in order (row r, then r+1, of the same slot) share a bank and go out as one burst per plane, up
+to ``max_burst`` words (32: two DLP7000 rows, one DLP9500 row); a row that does not follow on,
+a frame's completing row, or a full bank closes the bank. The buffer has two banks: one fills
+while the other drains, so words are taken one per cycle as long as the memory keeps up;
+otherwise ``words.ready`` falls and the pressure goes back to the network side. A bank holding
+rows of a frame that never completes may wait for the next row to be closed; such a frame is
+never shown.
+
+Rules of the MCB port it keeps: nothing before ``calib_done``; a burst's words are all pushed
+into the write FIFO (only when it has room for all of them) before its command is given; no
+command while ``cmd_full``.
+
+When the row that completes a frame has been written (its commands taken and the write FIFO
+empty), the writer says so on ``written``: only then may the frame be read through another port.
+"""
+
+from amaranth import Module, Signal
+from amaranth.lib import data, stream, wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
+from amaranth.utils import ceil_log2
+
+from . import mcb
+from .addresses import PLANES, AddressMap
+from .layouts import SLOT_BITS
+
+__all__ = ["Writer", "write_word_layout"]
+
+
+def write_word_layout(dmd):
+    """One word to store: its data, slot and place; ``last`` on the final word of a row (the
+    writer then writes the row), ``completes`` with ``last`` when that row completes its frame."""
+    return data.StructLayout({
+        "data": 64,
+        "slot": SLOT_BITS,
+        "plane": 3,
+        "row": ceil_log2(dmd.rows),
+        "word": max(1, ceil_log2(dmd.words_per_row)),
+        "last": 1,
+        "completes": 1,
+    })
+
+
+class Writer(wiring.Component):
+    """Write rows of plane words to DDR2 through an MCB port.
+
+    Parameters
+    ----------
+    dmd : :class:`gateware.dlpc410.facts.DmdType`
+        Geometry (words per row, rows).
+    slots : int
+        Frame slots in the memory (the address map).
+    max_burst : int
+        Longest burst in words. Rows that follow each other in one slot go out together, as
+        many whole rows as fit in this many words per plane: 32 (two XGA rows, one 1080p row,
+        one WXGA row of 20 words), half the write FIFO, so that one burst fills the FIFO while
+        the previous one drains.
+    settle : int
+        Cycles to wait after a command before trusting ``wr_count``, ``cmd_empty`` and
+        ``wr_empty`` again (the MCB updates them a little late).
+
+    Members
+    -------
+    words : In(stream.Signature(write_word_layout(dmd)))
+        The words of whole rows, in any order within the row; the planes present in a row are
+        the planes written for it.
+    written : Out(stream.Signature(SLOT_BITS))
+        The slot whose completing row (``completes``) is now in memory.
+    mcb : Out(mcb.PortSignature())
+        MCB port 0, clocked by ``sync``; only the write half is used.
+    """
+
+    def __init__(self, dmd, *, slots=16, max_burst=32, settle=2):
+        assert dmd.words_per_row <= max_burst <= mcb.MAX_BURST
+        self._dmd = dmd
+        self._map = AddressMap(dmd, slots)
+        self._max_burst = max_burst
+        self._settle = settle
+        super().__init__({
+            "words": In(stream.Signature(write_word_layout(dmd))),
+            "written": Out(stream.Signature(SLOT_BITS)),
+            "mcb": Out(mcb.PortSignature()),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        dmd, max_burst = self._dmd, self._max_burst
+        wpr = dmd.words_per_row
+        group = max_burst // wpr                 # rows per bank
+        bank_words = PLANES * max_burst
+
+        m.submodules.buffer = buffer = Memory(shape=64, depth=2 * bank_words, init=[])
+        fill_port = buffer.write_port()
+        drain_port = buffer.read_port()
+
+        # Per bank: a run of consecutive rows of one slot, which planes they have, whether the
+        # last of them completes its frame, and whether the bank is closed (ready to drain).
+        full = [Signal(name=f"full{b}") for b in range(2)]
+        planes = [Signal(PLANES, name=f"planes{b}") for b in range(2)]
+        slot = [Signal(SLOT_BITS, name=f"slot{b}") for b in range(2)]
+        first_row = [Signal.like(self.words.payload.row, name=f"first_row{b}") for b in range(2)]
+        rows = [Signal(range(group + 1), name=f"rows{b}") for b in range(2)]
+        completes = [Signal(name=f"completes{b}") for b in range(2)]
+
+        def of_bank(index, signals, name):
+            value = Signal.like(signals[0], name=name)
+            m.d.comb += value.eq(signals[0])
+            with m.If(index):
+                m.d.comb += value.eq(signals[1])
+            return value
+
+        # -- fill: one word per cycle into the open bank
+        fill_bank = Signal()
+        in_row = Signal()                        # a row has started and not ended
+        word = self.words.payload
+        f_full = of_bank(fill_bank, full, "fill_full")
+        f_rows = of_bank(fill_bank, rows, "fill_rows")
+        f_slot = of_bank(fill_bank, slot, "fill_slot")
+        f_first = of_bank(fill_bank, first_row, "fill_first_row")
+        continues = Signal()
+        m.d.comb += continues.eq((f_rows == 0) | ((word.slot == f_slot) & (word.row == f_first + f_rows)))
+        breaks = Signal()                        # this word starts a row that cannot join the bank
+        m.d.comb += breaks.eq(~in_row & ~continues)
+        take = Signal()
+        m.d.comb += [
+            self.words.ready.eq(~f_full & ~breaks),
+            take.eq(self.words.valid & self.words.ready),
+            fill_port.addr.eq(fill_bank * bank_words + word.plane * max_burst + f_rows * wpr + word.word),
+            fill_port.data.eq(word.data),
+            fill_port.en.eq(take),
+        ]
+        closes = Signal()
+        with m.If(self.words.valid & ~f_full & breaks):
+            m.d.comb += closes.eq(1)
+        with m.If(take):
+            m.d.sync += in_row.eq(~word.last)
+            with m.If(word.last & (word.completes | (f_rows == group - 1))):
+                m.d.comb += closes.eq(1)
+        for b in range(2):
+            with m.If(fill_bank == b):
+                with m.If(take):
+                    m.d.sync += planes[b].eq(planes[b] | (1 << word.plane))
+                    with m.If(~in_row & (rows[b] == 0)):
+                        m.d.sync += [slot[b].eq(word.slot), first_row[b].eq(word.row)]
+                    with m.If(word.last):
+                        m.d.sync += [rows[b].eq(rows[b] + 1), completes[b].eq(word.completes)]
+                with m.If(closes):
+                    m.d.sync += full[b].eq(1)
+        with m.If(closes):
+            m.d.sync += fill_bank.eq(~fill_bank)
+
+        # -- drain: plane by plane, data first, then the command
+        port = self.mcb
+        drain_bank = Signal()
+        plane = Signal(range(PLANES))
+        index = Signal(range(max_burst + 1))
+        pushing = Signal()          # the buffer word read last cycle goes into the write FIFO now
+        settle = Signal(range(self._settle + 1))
+        d_full = of_bank(drain_bank, full, "drain_full")
+        d_planes = of_bank(drain_bank, planes, "drain_planes")
+        d_slot = of_bank(drain_bank, slot, "drain_slot")
+        d_first = of_bank(drain_bank, first_row, "drain_first_row")
+        d_completes = of_bank(drain_bank, completes, "drain_completes")
+        d_words = Signal(range(max_burst + 1))
+        m.d.comb += d_words.eq(of_bank(drain_bank, rows, "drain_rows") * wpr)
+
+        m.d.comb += [
+            drain_port.addr.eq(drain_bank * bank_words + plane * max_burst + index),
+            port.wr_en.eq(pushing),
+            port.wr_data.eq(drain_port.data),
+            port.wr_mask.eq(0),
+            port.cmd_instr.eq(mcb.Instr.WRITE),
+            port.cmd_bl.eq(d_words - 1),
+            port.cmd_byte_addr.eq(self._map.address(d_slot, plane, d_first)),
+            self.written.payload.eq(d_slot),
+        ]
+        m.d.sync += pushing.eq(0)
+        with m.If(settle != 0):
+            m.d.sync += settle.eq(settle - 1)
+
+        def release_bank():
+            for b in range(2):
+                with m.If(drain_bank == b):
+                    m.d.sync += [full[b].eq(0), planes[b].eq(0), rows[b].eq(0), completes[b].eq(0)]
+            m.d.sync += drain_bank.eq(~drain_bank)
+
+        with m.FSM():
+            with m.State("IDLE"):
+                with m.If(d_full):
+                    m.d.sync += plane.eq(0)
+                    m.next = "PLANE"
+            with m.State("PLANE"):
+                with m.If(~d_planes.bit_select(plane, 1)):
+                    m.d.sync += plane.eq(plane + 1)
+                    with m.If(plane == PLANES - 1):
+                        m.next = "DONE"
+                with m.Elif(port.calib_done & (settle == 0) & (port.wr_count + d_words <= mcb.FIFO_DEPTH)):
+                    m.d.sync += index.eq(0)
+                    m.next = "PUSH"
+            with m.State("PUSH"):
+                m.d.sync += [pushing.eq(1), index.eq(index + 1)]
+                with m.If(index == d_words - 1):
+                    m.next = "COMMAND"
+            with m.State("COMMAND"):
+                # the last word was pushed in this cycle's edge at the latest; give the command after
+                with m.If(~pushing & ~port.cmd_full):
+                    m.d.comb += port.cmd_en.eq(1)
+                    m.d.sync += [plane.eq(plane + 1), settle.eq(self._settle)]
+                    with m.If(plane == PLANES - 1):
+                        m.next = "DONE"
+                    with m.Else():
+                        m.next = "PLANE"
+            with m.State("DONE"):
+                with m.If(~d_completes):
+                    release_bank()
+                    m.next = "IDLE"
+                with m.Elif((settle == 0) & port.cmd_empty & port.wr_empty):
+                    m.next = "WRITTEN"
+            with m.State("WRITTEN"):
+                m.d.comb += self.written.valid.eq(1)
+                with m.If(self.written.ready):
+                    release_bank()
+                    m.next = "IDLE"
+        return m

@@ -1,0 +1,348 @@
+"""A model of the Spartan-6 MCB's native user ports that checks its clients.
+
+One plain-Python :class:`McbModel` holds the memory (numpy, 64-bit words) and the shared DRAM
+timing; each :class:`McbPort` has the fabric-side FIFOs of one 64-bit port (4 commands, 64 write
+words, 64 read words) and is clocked by its own clock: :meth:`McbPort.clock` is called once per
+rising edge of that clock with the inputs sampled at the edge and returns the registered outputs
+for the next cycle. Thin adapters drive it from the Amaranth simulator
+(:func:`amaranth_process`) and from cocotb (:class:`CocotbPort`).
+
+Timing
+------
+The memory moves one 64-bit word every ``8 / (peak_bytes_per_s * efficiency)`` seconds (DDR2-800
+x16: 1.6 GB/s peak, about 85-90 % sustained on sequential bursts); reads and writes of all ports
+share it, commands are granted round robin. A command starts ``command_latency_s`` after it
+was pushed at the earliest; read words reach the read FIFO ``read_latency_s`` after their slot on
+the memory; written words leave the write FIFO one per word time. Every ``refresh_interval_s``
+(7.8 us) the memory is busy for ``refresh_s`` (about 160 ns) after the command in progress.
+``calib_done`` rises ``calib_delay_s`` after time 0. With ``stall_chance`` > 0, a command waits
+up to ``stall_max_s`` more before it starts, at random (seeded): stalls at unpredictable times.
+
+Errors
+------
+:class:`McbError` (with a ``kind``) is raised on: traffic before ``calib_done``
+(``before_calib``), a command while ``cmd_full`` (``cmd_full``), a byte address that is not a
+multiple of 8 or a burst outside the memory (``misaligned``, ``out_of_range``), a write command
+whose words are not all in the write FIFO when it is pushed (``data_missing``), a write word
+pushed while ``wr_full`` (``wr_full``), a read word taken while ``rd_empty`` (``rd_empty``), the
+controller finding the write FIFO empty during a write (``underrun``, reachable only with
+``check_write_data=False``, as the real MCB does not check at push time), read data arriving at
+a full read FIFO (``overflow``).
+"""
+
+import random
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["McbError", "McbTiming", "McbModel", "McbPort", "amaranth_process", "CocotbPort",
+           "WRITE", "READ", "WRITE_PRECHARGE", "READ_PRECHARGE", "REFRESH"]
+
+WRITE, READ, WRITE_PRECHARGE, READ_PRECHARGE, REFRESH = 0b000, 0b001, 0b010, 0b011, 0b100
+COMMAND_DEPTH = 4
+FIFO_DEPTH = 64
+WORD_BYTES = 8
+MASK64 = (1 << 64) - 1
+
+INPUTS = ("cmd_en", "cmd_instr", "cmd_bl", "cmd_byte_addr", "wr_en", "wr_data", "wr_mask", "rd_en")
+OUTPUTS = ("cmd_full", "cmd_empty", "wr_full", "wr_empty", "wr_count", "wr_underrun", "wr_error",
+           "rd_data", "rd_full", "rd_empty", "rd_count", "rd_overflow", "rd_error", "calib_done")
+
+
+class McbError(AssertionError):
+    """A client broke a rule of the MCB port; ``kind`` names the rule."""
+
+    def __init__(self, kind, message):
+        super().__init__(f"MCB {kind}: {message}")
+        self.kind = kind
+
+
+@dataclass
+class McbTiming:
+    peak_bytes_per_s: float = 1.6e9     # DDR2-800 x16
+    efficiency: float = 0.875           # sustained sequential efficiency
+    read_latency_s: float = 60e-9
+    command_latency_s: float = 10e-9
+    calib_delay_s: float = 1e-6
+    refresh_interval_s: float = 7.8e-6
+    refresh_s: float = 160e-9
+    stall_chance: float = 0.0           # chance that a command waits a random extra time first
+    stall_max_s: float = 0.0            # (bank conflicts, the other port's turn, ...)
+
+    @property
+    def word_s(self):
+        return WORD_BYTES / (self.peak_bytes_per_s * self.efficiency)
+
+    @property
+    def sustained_bytes_per_s(self):
+        """Bandwidth with refresh taken off: what all ports together can get at most."""
+        return self.peak_bytes_per_s * self.efficiency * (1 - self.refresh_s / self.refresh_interval_s)
+
+
+class McbModel:
+    """The memory and its shared timing; ``ports`` user ports in ``self.ports``."""
+
+    def __init__(self, memory_bytes=16 * 2**20, *, ports=2, timing=None, check_write_data=True, seed=0):
+        self.timing = timing or McbTiming()
+        self.rng = random.Random(seed)
+        self.memory = np.zeros(memory_bytes // WORD_BYTES, dtype=np.uint64)
+        self.memory_bytes = memory_bytes
+        self.check_write_data = check_write_data
+        self.ports = [McbPort(self, i) for i in range(ports)]
+        self.now = 0.0
+        self.busy_until = 0.0
+        self.busy_s = 0.0
+        self.next_refresh = self.timing.refresh_interval_s
+        self.refreshes = 0
+        self._next_port = 0
+        #: every word written, as (byte address, port): to check nothing was written outside
+        self.write_log = []
+
+    def calibrated(self, now):
+        return now >= self.timing.calib_delay_s
+
+    def _next_command(self):
+        """(start time, port) of the next command the arbiter would grant, or (inf, None)."""
+        best, chosen = float("inf"), None
+        n = len(self.ports)
+        for k in range(n):
+            port = self.ports[(self._next_port + k) % n]
+            if port.commands:
+                ready = max(self.busy_until, port.commands[0][0] + self.timing.command_latency_s)
+                if ready < best:
+                    best, chosen = ready, port
+        return best, chosen
+
+    def advance(self, now):
+        """Run the memory up to time ``now``."""
+        now = max(now, self.now)
+        t = self.timing
+        while True:
+            start, port = self._next_command()
+            due = max(self.next_refresh, self.busy_until)
+            if self.next_refresh <= now and due <= start:
+                self.busy_until = due + t.refresh_s
+                self.busy_s += t.refresh_s
+                self.next_refresh += t.refresh_interval_s
+                self.refreshes += 1
+                continue
+            if start > now:
+                break
+            if t.stall_chance and self.rng.random() < t.stall_chance:
+                stall = self.rng.uniform(0, t.stall_max_s)
+                self.busy_until = start + stall
+                self.busy_s += stall
+                continue
+            self._next_port = (port.index + 1) % len(self.ports)
+            self._execute(port, start, *port.commands.popleft()[1:])
+        for port in self.ports:
+            port._deliver(now)
+        self.now = now
+
+    def _execute(self, port, start, instr, words, address):
+        t = self.timing
+        if instr == REFRESH:
+            duration = t.refresh_s
+        else:
+            duration = words * t.word_s
+            first = address // WORD_BYTES
+            for i in range(words):
+                if instr in (WRITE, WRITE_PRECHARGE):
+                    port.events.append((start + (i + 1) * t.word_s, "w", first + i))
+                else:
+                    port.events.append((start + t.read_latency_s + (i + 1) * t.word_s, "r", first + i))
+            if instr in (WRITE, WRITE_PRECHARGE):
+                port.claimed -= words
+                port.draining += words
+        self.busy_until = start + duration
+        self.busy_s += duration
+
+
+class McbPort:
+    """The fabric side of one user port; see the module's documentation."""
+
+    def __init__(self, model, index):
+        self.model = model
+        self.index = index
+        self.commands = deque()      # (push time, instr, words, byte address)
+        self.write_fifo = deque()    # (data, mask)
+        self.read_fifo = deque()
+        self.events = deque()        # (time, "w"|"r", word address), in time order
+        self.claimed = 0             # write words owned by queued write commands
+        self.draining = 0            # write words owned by started write commands
+        self.underrun = self.overflow = False
+        self.words_written = self.words_read = 0
+        self.command_log = []        # (instr, words, byte address) of every command taken
+        self.outputs = self._outputs(0.0)
+
+    # -- the controller side
+
+    def _deliver(self, now):
+        model = self.model
+        while self.events and self.events[0][0] <= now:
+            _time, kind, word = self.events.popleft()
+            if kind == "w":
+                self.draining -= 1
+                if not self.write_fifo:
+                    self.underrun = True
+                    raise McbError("underrun", f"port {self.index}: write FIFO empty during a write "
+                                               f"command (word address {word:#x})")
+                data, mask = self.write_fifo.popleft()
+                if mask:
+                    old = int(model.memory[word])
+                    keep = sum(0xFF << (8 * b) for b in range(8) if mask >> b & 1)
+                    data = (old & keep) | (data & ~keep & MASK64)
+                model.memory[word] = data
+                model.write_log.append((word * WORD_BYTES, self.index))
+                self.words_written += 1
+            else:
+                if len(self.read_fifo) >= FIFO_DEPTH:
+                    self.overflow = True
+                    raise McbError("overflow", f"port {self.index}: read data arrived at a full read FIFO "
+                                               f"(word address {word:#x})")
+                self.read_fifo.append(int(model.memory[word]))
+                self.words_read += 1
+
+    # -- the fabric side
+
+    def clock(self, now, cmd_en=0, cmd_instr=0, cmd_bl=0, cmd_byte_addr=0, wr_en=0, wr_data=0,
+              wr_mask=0, rd_en=0):
+        """One rising edge of the port clock at time ``now`` (seconds), with the inputs sampled
+        there. Returns the outputs for the next cycle (a dict)."""
+        seen = self.outputs
+        if (cmd_en or wr_en or rd_en) and not seen["calib_done"]:
+            raise McbError("before_calib", f"port {self.index}: traffic before calib_done")
+        if rd_en:
+            if seen["rd_empty"]:
+                raise McbError("rd_empty", f"port {self.index}: rd_en while rd_empty")
+            self.read_fifo.popleft()
+        if cmd_en:
+            self._command(now, cmd_instr, cmd_bl, cmd_byte_addr, seen)
+        if wr_en:
+            if seen["wr_full"]:
+                raise McbError("wr_full", f"port {self.index}: wr_en while wr_full")
+            self.write_fifo.append((wr_data & MASK64, wr_mask))
+        self.model.advance(now)
+        self.outputs = self._outputs(now)
+        return self.outputs
+
+    def _command(self, now, instr, bl, address, seen):
+        model = self.model
+        if seen["cmd_full"]:
+            raise McbError("cmd_full", f"port {self.index}: cmd_en while cmd_full")
+        words = bl + 1
+        if instr not in (WRITE, READ, WRITE_PRECHARGE, READ_PRECHARGE, REFRESH):
+            raise McbError("bad_instruction", f"port {self.index}: instruction {instr:#05b}")
+        if instr != REFRESH:
+            if address % WORD_BYTES:
+                raise McbError("misaligned", f"port {self.index}: byte address {address:#x} is not "
+                                             f"a multiple of {WORD_BYTES}")
+            if address + words * WORD_BYTES > model.memory_bytes:
+                raise McbError("out_of_range", f"port {self.index}: burst at {address:#x} ends past "
+                                               f"the memory")
+        if instr in (WRITE, WRITE_PRECHARGE):
+            # only words pushed before this cycle count: the data must be there first
+            free = len(self.write_fifo) - self.claimed - self.draining
+            if model.check_write_data and free < words:
+                raise McbError("data_missing", f"port {self.index}: write of {words} words at "
+                                               f"{address:#x} with {free} unclaimed words in the FIFO")
+            self.claimed += words
+        self.commands.append((now, instr, words, address))
+        self.command_log.append((instr, words, address))
+
+    def _outputs(self, now):
+        wr, rd = len(self.write_fifo), len(self.read_fifo)
+        return {
+            "cmd_full": int(len(self.commands) >= COMMAND_DEPTH),
+            "cmd_empty": int(not self.commands),
+            "wr_full": int(wr >= FIFO_DEPTH),
+            "wr_empty": int(wr == 0),
+            "wr_count": min(wr, FIFO_DEPTH),
+            "wr_underrun": int(self.underrun),
+            "wr_error": int(self.underrun),
+            "rd_data": self.read_fifo[0] if rd else 0,
+            "rd_full": int(rd >= FIFO_DEPTH),
+            "rd_empty": int(rd == 0),
+            "rd_count": min(rd, FIFO_DEPTH),
+            "rd_overflow": int(self.overflow),
+            "rd_error": int(self.overflow),
+            "calib_done": int(self.model.calibrated(now)),
+        }
+
+    def idle(self):
+        """No command queued or running and no data in flight on this port."""
+        return not (self.commands or self.events or self.write_fifo or self.read_fifo)
+
+
+def _plain(value):
+    return value.value if hasattr(value, "value") else int(value)
+
+
+def amaranth_process(port_model, port, *, domain, frequency):
+    """An Amaranth simulator process that connects ``port_model`` to ``port`` (a component's
+    :class:`gateware.store.mcb.PortSignature` member), clocked by ``domain`` at ``frequency``.
+    Add it with ``simulate(..., processes=[...])``."""
+    period = 1 / frequency
+    inputs = [getattr(port, name) for name in INPUTS]
+    outputs = {name: getattr(port, name) for name in OUTPUTS}
+
+    async def process(ctx):
+        last = {}
+
+        def drive(values):
+            for name, value in values.items():
+                if last.get(name) != value:
+                    ctx.set(outputs[name], value)
+                    last[name] = value
+
+        drive(port_model.outputs)
+        cycle = 0
+        async for _clk, rst, *values in ctx.tick(domain).sample(*inputs):
+            cycle += 1
+            if rst:
+                continue
+            drive(port_model.clock(cycle * period, *map(_plain, values)))
+
+    return process
+
+
+class CocotbPort:
+    """Connects ``port_model`` to the Verilog ports ``<prefix>__<member>`` of ``dut``; start
+    :meth:`run` with ``cocotb.start_soon``. ``period_ns`` is that of ``clock``."""
+
+    def __init__(self, dut, prefix, clock, port_model, period_ns):
+        self.inputs = {name: getattr(dut, f"{prefix}__{name}") for name in INPUTS}
+        self.outputs = {name: getattr(dut, f"{prefix}__{name}") for name in OUTPUTS}
+        self.clock_signal, self.model, self.period = clock, port_model, period_ns * 1e-9
+        self._last = {}
+        self._drive(port_model.outputs)
+
+    def _drive(self, values):
+        # only what changed: each write is a simulator call
+        for name, value in values.items():
+            if self._last.get(name) != value:
+                self.outputs[name].value = value
+                self._last[name] = value
+
+    def _sample(self):
+        """The inputs at this edge; the data and command fields only when their strobe is set."""
+        signals = self.inputs
+        values = {"cmd_en": int(signals["cmd_en"].value), "wr_en": int(signals["wr_en"].value),
+                  "rd_en": int(signals["rd_en"].value)}
+        if values["cmd_en"]:
+            for name in ("cmd_instr", "cmd_bl", "cmd_byte_addr"):
+                values[name] = int(signals[name].value)
+        if values["wr_en"]:
+            for name in ("wr_data", "wr_mask"):
+                values[name] = int(signals[name].value)
+        return values
+
+    async def run(self):
+        from cocotb.triggers import RisingEdge
+        cycle = 0
+        edge = RisingEdge(self.clock_signal)
+        while True:
+            await edge
+            cycle += 1
+            self._drive(self.model.clock(cycle * self.period, **self._sample()))

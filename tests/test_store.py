@@ -1,0 +1,563 @@
+"""The bit-plane store (slots, writer, reader) with the serialiser in front and the MCB model
+behind, in the Amaranth simulator on the test geometry, against numpy."""
+
+import random
+
+import numpy as np
+
+from gateware.dlpc410.facts import TEST_DMD
+from sim.harness.amaranth_sim import simulate, stream_feed
+from sim.models import store_stim
+from sim.models.mcb import McbModel, McbTiming, amaranth_process
+from sim.tb.store_chain import StoreChain
+
+DMD = TEST_DMD
+SYNC_HZ, DMD_HZ = 125e6, 200e6
+
+
+class Bench:
+    """A StoreChain with the MCB model on both ports and sequencer-side helpers (``dmd``)."""
+
+    def __init__(self, *, slots=4, timing=None):
+        self.slots = slots
+        self.dut = StoreChain(DMD, slots=slots)
+        self.model = McbModel(64 * 1024, timing=timing)
+        self.processes = [
+            amaranth_process(self.model.ports[0], self.dut.mcb_write, domain="sync", frequency=SYNC_HZ),
+            amaranth_process(self.model.ports[1], self.dut.mcb_read, domain="dmd", frequency=DMD_HZ),
+        ]
+
+    def run(self, testbenches, name, deadline=3e-4):
+        simulate(self.dut, testbenches, name=name, clocks={"sync": SYNC_HZ, "dmd": DMD_HZ},
+                 processes=self.processes, deadline=deadline)
+
+    async def feed(self, ctx, image, frame_id, rows=None, idle=0.0):
+        await stream_feed(ctx, self.dut.pixels, store_stim.frame_beats(image, frame_id, rows=rows),
+                          idle=idle)
+
+    async def ask(self, ctx):
+        """Ask for a frame and wait for the answer: (slot, frame_id, bit_depth)."""
+        dut = self.dut
+        ctx.set(dut.ask.valid, 1)
+        await ctx.tick("dmd").until(dut.ask.ready)
+        ctx.set(dut.ask.valid, 0)
+        ctx.set(dut.frames.ready, 1)
+        payload, = await ctx.tick("dmd").sample(dut.frames.payload).until(dut.frames.valid)
+        ctx.set(dut.frames.ready, 0)
+        return int(payload.slot), int(payload.frame_id), int(payload.bit_depth)
+
+    async def release(self, ctx, slot):
+        ctx.set(self.dut.release.payload, slot)
+        ctx.set(self.dut.release.valid, 1)
+        await ctx.tick("dmd").until(self.dut.release.ready)
+        ctx.set(self.dut.release.valid, 0)
+
+    async def read(self, ctx, slot, plane, first_row=0, row_count=DMD.rows, stall=0.0, rng=None):
+        dut = self.dut
+        ctx.set(dut.requests.payload, {"slot": slot, "plane": plane, "first_row": first_row,
+                                       "row_count": row_count})
+        ctx.set(dut.requests.valid, 1)
+        await ctx.tick("dmd").until(dut.requests.ready)
+        ctx.set(dut.requests.valid, 0)
+        words = []
+        while len(words) < row_count * DMD.words_per_row:
+            ready = not (stall and rng.random() < stall)
+            ctx.set(dut.planes.ready, ready)
+            _, _, valid, payload = await ctx.tick("dmd").sample(dut.planes.valid, dut.planes.payload)
+            if valid and ready:
+                words.append(payload)
+        ctx.set(dut.planes.ready, 0)
+        return words
+
+    async def occupancy(self, ctx, slot):
+        got = []
+        for block in range(DMD.blocks):
+            ctx.set(self.dut.occupancy.slot, slot)
+            ctx.set(self.dut.occupancy.block, block)
+            await ctx.tick("dmd")
+            await ctx.tick("dmd")
+            got.append(ctx.get(self.dut.occupancy.planes))
+        return got
+
+    async def check_frame(self, ctx, slot, image, depth, what="", stall=0.0):
+        rng = random.Random(slot)
+        for plane in store_stim.stored_planes(depth):
+            words = await self.read(ctx, slot, plane, stall=stall, rng=rng)
+            store_stim.check_plane(DMD, image, plane, words, what=what)
+        store_stim.check_occupancy(DMD, image, depth, await self.occupancy(ctx, slot), what=what)
+
+    def counters(self, ctx):
+        c = ctx.get(self.dut.counters)
+        return {name: int(getattr(c, name)) for name in (
+            "frames_complete", "frames_replaced", "frames_abandoned", "rows_outside", "rows_stale",
+            "rows_shown", "rows_duplicate", "rows_no_slot", "bad_releases")}
+
+
+async def wait_until(ctx, flag, domain="sync"):
+    while not flag():
+        await ctx.tick(domain)
+
+
+def play_one_by_one(bench, frames, *, consumer_stall=0.0, idle=0.0):
+    """frames: [(image, frame_id, depth)]; each is sent, then shown, read back and released."""
+    dut = bench.dut
+    shown = []
+    state = {"next": 0}
+
+    async def producer(ctx):
+        for i, (image, frame_id, depth) in enumerate(frames):
+            await wait_until(ctx, lambda i=i: state["next"] == i)
+            ctx.set(dut.bit_depth, depth)
+            await bench.feed(ctx, image, frame_id, idle=idle)
+
+    async def consumer(ctx):
+        for i, (image, frame_id, depth) in enumerate(frames):
+            slot, got_id, got_depth = await bench.ask(ctx)
+            assert (got_id, got_depth) == (frame_id, depth)
+            await bench.check_frame(ctx, slot, image, depth, what=f"frame {frame_id}", stall=consumer_stall)
+            await bench.release(ctx, slot)
+            shown.append(got_id)
+            state["next"] = i + 1
+
+    return producer, consumer, shown
+
+
+def test_bit_depths(test_name):
+    """Random images at bit depths 8 and 1 (every depth runs in the Verilog test): every stored
+    plane reads back as numpy slices it. Rows in order go out in bursts of 32 words (16 rows)."""
+    bench = Bench()
+    frames = [(store_stim.random_image(DMD, d), 100 + i, d) for i, d in enumerate((8, 1))]
+    producer, consumer, shown = play_one_by_one(bench, frames, consumer_stall=0.3, idle=0.1)
+    bench.run([producer, consumer], test_name)
+    assert shown == [f for _, f, _ in frames]
+    bursts = [words for _instr, words, _address in bench.model.ports[0].command_log]
+    assert max(bursts) == 32 and len(bursts) == (8 + 1) * DMD.rows // 16
+
+
+def test_rows_in_any_order(test_name):
+    """Rows shuffled: bursts break where rows stop following each other; the frame still reads
+    back whole."""
+    bench = Bench()
+    dut = bench.dut
+    image = store_stim.random_image(DMD, 12)
+    order = list(range(DMD.rows))
+    random.Random(3).shuffle(order)
+    order[10:10] = [40, 41, 42]                          # a run that can share bursts
+    order = [r for i, r in enumerate(order) if r not in order[:i]]
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 2)
+        await bench.feed(ctx, image, 1, rows=order)
+
+    async def consumer(ctx):
+        slot, _, depth = await bench.ask(ctx)
+        await bench.check_frame(ctx, slot, image, depth, what="shuffled")
+
+    bench.run([producer, consumer], test_name)
+    bursts = [words for _instr, words, _address in bench.model.ports[0].command_log]
+    assert 2 * DMD.words_per_row in bursts and sum(bursts) == 2 * DMD.rows * DMD.words_per_row
+
+
+def test_stalled_memory(test_name):
+    """A slow memory with long, frequent refreshes and random stalls: full FIFOs on both sides,
+    nothing lost, nothing corrupted."""
+    timing = McbTiming(efficiency=0.08, refresh_interval_s=1.0e-6, refresh_s=300e-9,
+                       read_latency_s=200e-9, calib_delay_s=3e-6, stall_chance=0.3, stall_max_s=400e-9)
+    bench = Bench(timing=timing)
+    frames = [(store_stim.random_image(DMD, 50), 1, 3)]
+    producer, consumer, shown = play_one_by_one(bench, frames, consumer_stall=0.5)
+    bench.run([producer, consumer], test_name, deadline=2e-3)
+    assert shown == [1]
+    assert bench.model.refreshes > 10
+
+
+def test_fast_producer_slow_consumer(test_name):
+    """Frames arrive while the sequencer holds one: when it asks again it gets the newest
+    complete frame, the ones in between are replaced (counted), and what it gets reads back whole."""
+    bench = Bench()
+    dut = bench.dut
+    images = {f: store_stim.random_image(DMD, 200 + f) for f in range(1, 5)}
+    got, sent = [], []
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        for f, image in images.items():
+            await bench.feed(ctx, image, f)
+        for _ in range(300):
+            await ctx.tick()
+        sent.append(True)
+
+    async def consumer(ctx):
+        slot, f, depth = await bench.ask(ctx)
+        got.append(f)
+        await wait_until(ctx, lambda: sent, domain="dmd")      # a slow consumer: shows 1 throughout
+        await bench.release(ctx, slot)
+        slot, f, depth = await bench.ask(ctx)
+        got.append(f)
+        await bench.check_frame(ctx, slot, images[f], depth, what=f"frame {f}")
+        counters = bench.counters(ctx)
+        assert counters["frames_complete"] == 4
+        assert counters["frames_replaced"] == 2
+        assert counters["frames_abandoned"] == 0
+
+    bench.run([producer, consumer], test_name, deadline=6e-4)
+    assert got == [1, 4]
+
+
+def test_slow_producer_fast_consumer(test_name):
+    """The consumer keeps an ask outstanding: it gets every frame, in order, none replaced."""
+    bench = Bench()
+    dut = bench.dut
+    images = {f: store_stim.random_image(DMD, 300 + f) for f in (65535, 0, 1)}  # id wraps
+    got = []
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        for f, image in images.items():
+            await bench.feed(ctx, image, f, idle=0.5)
+
+    async def consumer(ctx):
+        held = None
+        for _ in images:
+            slot, f, depth = await bench.ask(ctx)
+            got.append(f)
+            if held is not None:
+                await bench.release(ctx, held)
+            await bench.check_frame(ctx, slot, images[f], depth, what=f"frame {f}")
+            held = slot
+        counters = bench.counters(ctx)
+        assert counters["frames_replaced"] == 0 and counters["rows_stale"] == 0
+
+    bench.run([producer, consumer], test_name, deadline=6e-4)
+    assert got == list(images)
+
+
+def test_missing_row_never_shown(test_name):
+    """A frame with one row missing is never given out; the next complete one is, and the
+    incomplete one is counted as abandoned."""
+    bench = Bench()
+    dut = bench.dut
+    incomplete = store_stim.random_image(DMD, 1)
+    complete = store_stim.random_image(DMD, 2)
+    got = []
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 2)
+        await bench.feed(ctx, incomplete, 10, rows=[r for r in range(DMD.rows) if r != 37])
+        for _ in range(500):
+            await ctx.tick()
+        await bench.feed(ctx, complete, 11)
+
+    async def consumer(ctx):
+        slot, f, depth = await bench.ask(ctx)
+        got.append(f)
+        await bench.check_frame(ctx, slot, complete, depth)
+        counters = bench.counters(ctx)
+        assert counters["frames_abandoned"] == 1 and counters["frames_complete"] == 1
+
+    bench.run([producer, consumer], test_name)
+    assert got == [11]
+
+
+def test_shown_slot_never_written_and_hostile_headers(test_name):
+    """While frame 20 is shown: records with its id are refused, rows beyond the frame and
+    duplicated rows are refused, each counted; no word lands outside the receiving slots; the
+    shown frame reads back unchanged at the end."""
+    bench = Bench()
+    dut = bench.dut
+    amap_slots = bench.slots
+    first = store_stim.random_image(DMD, 5)
+    second = store_stim.random_image(DMD, 6)
+    hostile = store_stim.random_image(DMD, 7)
+    beyond = np.zeros((128, DMD.columns), np.uint8)     # rows 96..127 fit the row field
+    phase = {"shown": None}
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        await bench.feed(ctx, first, 20)
+        await wait_until(ctx, lambda: phase["shown"] is not None)
+        since = len(bench.model.write_log)
+        await bench.feed(ctx, hostile, 20, rows=range(0, 10))                       # shown frame id
+        await bench.feed(ctx, beyond, 21, rows=range(DMD.rows, 128))               # rows outside
+        order = list(range(DMD.rows))
+        order[50:50] = [3, 4, 90]                                                   # overlapping
+        await bench.feed(ctx, second, 21, rows=order)
+        await bench.feed(ctx, hostile, 19, rows=range(0, 2))                        # stale frame id
+        phase["since"] = since
+
+    async def consumer(ctx):
+        slot, f, _ = await bench.ask(ctx)
+        assert f == 20
+        phase["shown"] = slot
+        slot2, f2, depth = await bench.ask(ctx)
+        assert f2 == 21
+        await bench.check_frame(ctx, slot2, second, depth, what="frame 21")
+        await wait_until(ctx, lambda: "since" in phase, domain="dmd")
+        for _ in range(200):
+            await ctx.tick("dmd")
+        await bench.check_frame(ctx, slot, first, 1, what="shown frame 20")
+        counters = bench.counters(ctx)
+        assert counters["rows_shown"] == 10
+        assert counters["rows_outside"] == 128 - DMD.rows
+        assert counters["rows_duplicate"] == 3
+        assert counters["rows_stale"] == 2
+        store_stim.check_writes_inside(bench.model, DMD, amap_slots,
+                                       set(range(amap_slots)) - {slot}, since=phase["since"])
+
+    bench.run([producer, consumer], test_name, deadline=6e-4)
+
+
+def test_sequence_mode(test_name):
+    """Sequence of 3 frames sent out of order: played 0, 1, 2, 0, 1, 2, 0 with their ids."""
+    bench = Bench()
+    dut = bench.dut
+    images = {f: store_stim.random_image(DMD, 400 + f) for f in range(3)}
+    got = []
+
+    async def producer(ctx):
+        ctx.set(dut.sequence_length, 3)
+        ctx.set(dut.bit_depth, 1)
+        for _ in range(3):
+            await ctx.tick()
+        for f in (2, 0, 1):
+            await bench.feed(ctx, images[f], f)
+        await bench.feed(ctx, images[1], 3, rows=range(4))        # beyond the sequence: stale
+
+    async def consumer(ctx):
+        held = None
+        for _ in range(7):
+            slot, f, depth = await bench.ask(ctx)
+            assert slot == f and depth == 1
+            got.append(f)
+            if held is not None:
+                await bench.release(ctx, held)
+            held = slot
+            if len(got) <= 3:
+                await bench.check_frame(ctx, slot, images[f], depth, what=f"sequence frame {f}")
+        counters = bench.counters(ctx)
+        assert counters["frames_complete"] == 3 and counters["frames_replaced"] == 0
+        assert counters["rows_stale"] == 4
+
+    bench.run([producer, consumer], test_name, deadline=6e-4)
+    assert got == [0, 1, 2, 0, 1, 2, 0]
+
+
+def test_row_subsets_and_bad_requests(test_name):
+    """Runs of rows of a plane read back as numpy's slices; requests past the frame are dropped
+    and counted, and produce no words."""
+    bench = Bench()
+    dut = bench.dut
+    image = store_stim.random_image(DMD, 9)
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 8)
+        await bench.feed(ctx, image, 1)
+
+    async def consumer(ctx):
+        slot, _, _ = await bench.ask(ctx)
+        for bad in ({"slot": slot, "plane": 0, "first_row": 90, "row_count": 7},
+                    {"slot": slot, "plane": 0, "first_row": 0, "row_count": 0},
+                    {"slot": 9, "plane": 0, "first_row": 0, "row_count": 1}):
+            ctx.set(dut.requests.payload, bad)
+            ctx.set(dut.requests.valid, 1)
+            await ctx.tick("dmd").until(dut.requests.ready)
+        ctx.set(dut.requests.valid, 0)
+        for plane, first, count in ((7, 0, 1), (3, 24, 24), (0, 95, 1), (5, 10, 80)):
+            words = await bench.read(ctx, slot, plane, first, count)
+            store_stim.check_plane(DMD, image, plane, words, first, count)
+        assert ctx.get(dut.bad_requests) == 3
+        assert not ctx.get(dut.planes.valid)
+
+    bench.run([producer, consumer], test_name)
+
+
+def test_no_free_slot_and_bad_release(test_name):
+    """Three slots, the sequencer holding two: a complete frame waits in the third; a newer
+    frame finds no slot and is refused row by row (counted), the waiting one is still given;
+    releasing a slot that is not shown is counted and changes nothing."""
+    bench = Bench(slots=3)
+    dut = bench.dut
+    images = {f: store_stim.random_image(DMD, 600 + f) for f in range(1, 5)}
+    phase = {}
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        for f in (1, 2):
+            await bench.feed(ctx, images[f], f)
+            await wait_until(ctx, lambda f=f: phase.get("held") == f)
+        await bench.feed(ctx, images[3], 3)
+        await bench.feed(ctx, images[4], 4)
+        phase["sent"] = True
+
+    async def consumer(ctx):
+        held = []
+        for f in (1, 2):
+            slot, got, _ = await bench.ask(ctx)
+            assert got == f
+            held.append(slot)
+            phase["held"] = f
+        await wait_until(ctx, lambda: "sent" in phase, domain="dmd")
+        for _ in range(100):
+            await ctx.tick("dmd")
+        counters = bench.counters(ctx)
+        assert counters["rows_no_slot"] == DMD.rows and counters["frames_complete"] == 3
+        ready_slot = ({0, 1, 2} - set(held)).pop()
+        await bench.release(ctx, ready_slot)                 # not shown: refused
+        for _ in range(20):
+            await ctx.tick("dmd")
+        assert bench.counters(ctx)["bad_releases"] == 1
+        await bench.release(ctx, held[0])
+        slot, got, depth = await bench.ask(ctx)
+        assert (slot, got) == (ready_slot, 3)
+        await bench.check_frame(ctx, slot, images[3], depth, what="frame 3")
+
+    bench.run([producer, consumer], test_name)
+
+
+def test_read_rate_figure():
+    """The benchmark's plane read on the DLP7000 geometry keeps up with the model: the look-ahead
+    hides the latency (the figure itself is printed by ``python -m sim.bench.store``)."""
+    from sim.bench.store import read_rate
+    figure = read_rate()
+    assert figure["fraction"] > 0.95
+
+
+def test_random_events_against_policy_model(test_name):
+    """Random records (new frames, parts and rests of frames, stale and shown ids, rows beyond
+    the frame, overlaps), asks and releases: after each event the gateware's counters and the
+    frames it gives equal the reference model's (sim.models.slots)."""
+    from sim.models.slots import SlotPolicy
+
+    rng = random.Random(14)
+    bench = Bench(slots=4)
+    dut = bench.dut
+    policy = SlotPolicy(DMD.rows, 4)
+    image = store_stim.random_image(DMD, 77)
+    tall = np.vstack([image, image[:32]])                       # rows 96..127 exist for hostile records
+    held = {}                                                   # gateware slot -> frame id
+    checked = {"events": 0}
+    state = {"turn": "producer", "event": None}
+    newest = 1
+
+    events = []
+    for _ in range(44):
+        kind = rng.choice(["full", "newpart", "part", "part", "rest", "old", "beyond", "ask", "ask",
+                           "release"])
+        if kind == "full":
+            newest += rng.choice([1, 1, 2])
+            events.append(("rows", newest, list(range(DMD.rows))))
+        elif kind == "newpart":
+            newest += 1
+            events.append(("rows", newest, list(range(rng.randrange(40), 60))))
+        elif kind == "part":
+            first = rng.randrange(DMD.rows)
+            events.append(("rows", newest, list(range(first, min(DMD.rows, first + rng.randrange(1, 30))))))
+        elif kind == "rest":
+            events.append(("rest", newest, None))
+        elif kind == "old":
+            events.append(("rows", newest - rng.randrange(1, 4), list(range(rng.randrange(8), 12))))
+        elif kind == "beyond":
+            events.append(("rows", newest, list(range(DMD.rows - 2, DMD.rows + rng.randrange(1, 20)))))
+        else:
+            events.append((kind, None, None))
+    # then for certain: overlapping records, and a sequencer holding three of the four slots
+    n = newest
+    events += [("release_all", None, None), ("rows", n + 1, list(range(20))),
+               ("rows", n + 1, list(range(10, 30)))]
+    for k in range(2, 5):
+        events += [("rows", n + k, list(range(DMD.rows))), ("ask", None, None)]
+    events += [("rows", n + 5, list(range(DMD.rows))), ("rows", n + 6, list(range(4)))]
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        for kind, frame, rows in events:
+            if kind == "rest":
+                have = policy.frames.get(frame, {"rows": set()})["rows"]
+                kind, rows = "rows", [r for r in range(DMD.rows) if r not in have]
+            if kind == "rows":
+                for row in rows:
+                    policy.row(frame & 0xFFFF, row, 1)
+                await bench.feed(ctx, tall, frame & 0xFFFF, rows=rows)
+                for _ in range(400):                            # the last rows reach memory
+                    await ctx.tick()
+            else:
+                state["event"] = kind
+                state["turn"] = "consumer"
+                await wait_until(ctx, lambda: state["turn"] == "producer")
+            assert bench.counters(ctx) == policy.counters, f"after {kind} {frame}"
+            checked["events"] += 1
+        state["turn"] = "done"
+
+    async def consumer(ctx):
+        while True:
+            await wait_until(ctx, lambda: state["turn"] != "producer", domain="dmd")
+            if state["turn"] == "done":
+                return
+            if state["event"] == "ask" and policy.can_answer():
+                want = policy.ask()
+                slot, frame, _ = await bench.ask(ctx)
+                assert frame == want
+                held[slot] = frame
+                if len(held) == 1:
+                    words = await bench.read(ctx, slot, 7, 0, 8)
+                    store_stim.check_plane(DMD, image, 7, words, 0, 8, what=f"frame {frame}")
+            elif state["event"] in ("release", "release_all") and held:
+                for slot in ([rng.choice(sorted(held))] if state["event"] == "release" else sorted(held)):
+                    policy.release(held.pop(slot))
+                    await bench.release(ctx, slot)
+                for _ in range(20):
+                    await ctx.tick("dmd")
+            state["turn"] = "producer"
+
+    bench.run([producer, consumer], test_name, deadline=3e-3)
+    assert checked["events"] == len(events)
+    exercised = {name for name, value in policy.counters.items() if value}
+    assert exercised >= set(policy.counters) - {"bad_releases"}, policy.counters
+
+
+def test_mode_change_keeps_the_shown_frame(test_name):
+    """Streaming, then sequence mode while a streamed frame is shown: that slot is kept (records
+    for it are refused) until released, then the sequence loads and plays in order."""
+    bench = Bench()
+    dut = bench.dut
+    streamed = store_stim.random_image(DMD, 800)
+    images = {f: store_stim.random_image(DMD, 810 + f) for f in range(2)}
+    phase = {}
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        await bench.feed(ctx, streamed, 5)
+        await wait_until(ctx, lambda: "shown" in phase)
+        ctx.set(dut.sequence_length, 2)
+        for _ in range(4):
+            await ctx.tick()
+        shown = phase["shown"]
+        await bench.feed(ctx, images[shown], shown, rows=range(3))     # its slot is shown: refused
+        await bench.feed(ctx, images[1 - shown], 1 - shown)
+        phase["refused"] = True
+        await wait_until(ctx, lambda: "released" in phase)
+        await bench.feed(ctx, images[shown], shown)
+
+    async def consumer(ctx):
+        slot, f, depth = await bench.ask(ctx)
+        assert f == 5 and slot in (0, 1)
+        phase["shown"] = slot
+        await wait_until(ctx, lambda: "refused" in phase, domain="dmd")
+        for _ in range(50):
+            await ctx.tick("dmd")
+        assert bench.counters(ctx)["rows_shown"] == 3
+        await bench.check_frame(ctx, slot, streamed, depth, what="streamed frame kept")
+        await bench.release(ctx, slot)
+        phase["released"] = True
+        got = []
+        held = None
+        for _ in range(3):
+            slot, f, depth = await bench.ask(ctx)
+            got.append(f)
+            if held is not None:
+                await bench.release(ctx, held)
+            held = slot
+        assert got == [0, 1, 0]
+        await bench.check_frame(ctx, held, images[0], depth, what="sequence frame 0")
+
+    bench.run([producer, consumer], test_name)
