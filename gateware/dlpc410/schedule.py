@@ -50,10 +50,16 @@ from .facts import TIMING, BlockMode
 from .params import PlaneOrder, ResetMode, Source, TriggerMode, group_size
 
 __all__ = ["Params", "Frame", "Result", "exponents", "groups", "pulse_encoding", "simulate",
-           "plan", "bound", "level_light", "INIT_TO_DVALID", "even"]
+           "plan", "bound", "level_light", "INIT_TO_DVALID", "RST_MARGIN", "even", "ready_cycle"]
 
 #: First load this many cycles after INIT_ACTIVE falls (DLPC910: first DVALID >= 64 clocks).
 INIT_TO_DVALID = int(TIMING["init_to_dvalid_clocks"].value)
+
+
+#: Cycles added to the RST_ACTIVE time: the command leaves one cycle after its decision, and the
+#: sequencer sees RST_ACTIVE through a two-flip-flop synchroniser; ``t_rst`` must cover the
+#: pin's high time plus this.
+RST_MARGIN = 4
 
 
 def even(t):
@@ -336,7 +342,7 @@ def level_light(dmd, p, result, images):
         by_group.setdefault(g, []).append((t, kind, fi, e))
     for g, seq in by_group.items():
         rows = slice(grp[g][0] * dmd.rows_per_block, (grp[g][-1] + 1) * dmd.rows_per_block)
-        for (t, kind, fi, e), (t2, *_rest) in zip(seq, seq[1:]):
+        for (t, kind, fi, e), (t2, *_rest) in zip(seq, seq[1:], strict=False):
             if kind != "plane":
                 continue
             img = np.asarray(images[fi], dtype=np.int64)
@@ -387,7 +393,7 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     ``frame`` is given): no pulse may be late.
     """
     R = dmd.dclk_per_row
-    t_rst = _cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s, dclk_hz)
+    t_rst = even(_cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s, dclk_hz) + RST_MARGIN)
     t_settle = _cycles(TIMING["t_settle"].value if t_settle_s is None else t_settle_s, dclk_hz)
     words = dmd.words_per_row
     row_period = even(max(R, math.ceil(words / words_per_cycle - 1e-9)))

@@ -93,7 +93,8 @@ class Sequencer(wiring.Component):
     sync_out : Out(1)
         High while a frame is shown (first pulse to the last group's final dark pulse).
     camera_out : Out(1)
-        Camera trigger: ``camera_width`` cycles, ``camera_offset`` after a frame's first pulse.
+        Camera trigger: ``camera_width`` cycles, starting ``camera_offset`` cycles after the
+        frame's first clocking pulse appears on the pins.
     frames : In(stream.Signature(FrameInfo))
         The newest complete frame; taken when a new frame is due (else the last one repeats).
     requests : Out(stream.Signature(PlaneRequest))
@@ -410,7 +411,9 @@ class Sequencer(wiring.Component):
             m.d.sync += [cam_at.eq(now + regs.camera_offset), cam_armed.eq(1)]
         with m.Elif(cam_armed & (_diff(now, cam_at + regs.camera_width) >= 0)):
             m.d.sync += cam_armed.eq(0)
-        m.d.comb += self.camera_out.eq(cam_armed & (_diff(now, cam_at) >= 0)
+        # registered like the command pins: the pulse leaves ``camera_offset`` after the frame's
+        # first clocking pulse leaves
+        m.d.sync += self.camera_out.eq(cam_armed & (_diff(now, cam_at) >= 0)
                                        & (_diff(now, cam_at + regs.camera_width) < 0))
 
         # ---- start: take the first frame, queue every group's first plane ----

@@ -2,7 +2,8 @@
 
 The stand-in holds ECP2_FINISHED high, INIT_ACTIVE high for ``init_cycles`` and raises
 RST_ACTIVE for ``rst_high`` cycles after each clocking pulse (``rst_high`` must not exceed the
-``t_rst`` parameter, as on the real part after calibration). Everything else is recorded by a
+``t_rst`` parameter less :data:`~gateware.dlpc410.schedule.RST_MARGIN`, as the plan
+assumes). Everything else is recorded by a
 :class:`sim.models.dlpc410_commands.CommandDecoder` in the sequencer's time base
 (``status.now``; a command's cycle is its decision cycle, one before the pins show it).
 """
@@ -11,6 +12,7 @@ from dataclasses import dataclass, field
 
 from gateware.dlpc410.facts import BlockMode
 from gateware.dlpc410.params import Registers
+from gateware.dlpc410.schedule import RST_MARGIN
 from sim.harness.amaranth_sim import simulate
 from sim.models.dlpc410_commands import CommandDecoder
 from sim.tb.plane_source import SequencerBench
@@ -34,7 +36,7 @@ def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, nam
     dut = SequencerBench(dmd, frames, images)
     regs = Registers.const(params.registers(dmd))
     run = Run(CommandDecoder(dmd))
-    rst_high = params.t_rst if rst_high is None else rst_high
+    rst_high = params.t_rst - RST_MARGIN if rst_high is None else rst_high
     pins, soft, sync_pins = set(pins), set(soft), set(sync_pins)
 
     async def bench(ctx):
@@ -47,7 +49,8 @@ def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, nam
         last_sync = last_cam = 0
         p = dut.pins
         sigs = (dut.status.now, p.dvalid, p.rowmd, p.rowad, p.blkmd, p.blkad, p.rst2blkz,
-                p.din_a.rise, p.din_b.rise, p.din_a.fall, p.din_b.fall, dut.sync_out, dut.camera_out)
+                p.din_a.rise, p.din_b.rise, p.din_a.fall, p.din_b.fall,
+                dut.sync_out, dut.camera_out)
         for i in range(init_cycles):
             ctx.set(dut.trigger_in, i in early_pins)
             await ctx.tick()
@@ -55,7 +58,8 @@ def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, nam
         ctx.set(dut.pins.init_active, 0)
         running = False
         for _ in range(cycles):
-            *_, now, dv, rowmd, rowad, blkmd, blkad, r2, ar, br, af, bf, so, co = await ctx.tick().sample(*sigs)
+            values = await ctx.tick().sample(*sigs)
+            now, dv, rowmd, rowad, blkmd, blkad, r2, ar, br, af, bf, so, co = values[2:]
             running = running or now > 0
             if running:
                 lanes = {("A", "rise"): ar, ("B", "rise"): br, ("A", "fall"): af, ("B", "fall"): bf}
