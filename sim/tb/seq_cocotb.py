@@ -1,6 +1,6 @@
 """cocotb testbench of the sequencer's generated Verilog (with the plane-source fixture).
 
-One triggered 8-bit frame of the ramp image (every grey level on every row) on the DMD named in
+One triggered frame (bit depth from the parameters) of the ramp image (every grey level on every row) on the DMD named in
 the parameters, with RST_ACTIVE and settle scaled down: the decoded command stream must equal
 the schedule model's cycle for cycle, and every pixel must integrate exactly its grey level.
 """
@@ -24,14 +24,15 @@ def plan_from(prm):
     dmd = DMDS[prm["dmd"]]
     return dmd, schedule.plan(dmd, 200e6, t_rst_s=prm["t_rst"] / 200e6, t_settle_s=prm["t_settle"] / 200e6,
                               reset_mode=ResetMode[prm["mode"]], strict_rst=prm["strict"],
-                              order=PlaneOrder[prm["order"]]).params
+                              order=PlaneOrder[prm["order"]], depth=prm["depth"]).params
 
 
 @cocotb.test()
 async def ramp_frame_matches_model(dut):
     prm = params()
     dmd, p = plan_from(prm)
-    frames = [schedule.Frame(0, 8), schedule.Frame(1, 8)]
+    depth = prm["depth"]
+    frames = [schedule.Frame(0, depth), schedule.Frame(1, depth)]
     ready = max(g.loaded_at for g in schedule.simulate(dmd, p, frames[:1]).groups)
     pin = ready + 6
     model = schedule.simulate(dmd, p, frames, [pin + PIN_TO_STROBE])
@@ -90,5 +91,5 @@ async def ramp_frame_matches_model(dut):
     assert got == want, f"{len(got)} vs {len(want)} commands; first difference at {first_diff}: " \
         f"{got[first_diff] if first_diff is not None else None} vs {want[first_diff] if first_diff is not None else None}"
     assert light is not None, "the frame did not end"
-    assert np.array_equal(light, ramp_image(dmd, 0).astype(np.int64) * p.lsb)
+    assert np.array_equal(light, (ramp_image(dmd, 0).astype(np.int64) >> (8 - depth)) * p.lsb)
     dut._log.info("%d commands equal, %d pixels exact", len(got), light.size)
