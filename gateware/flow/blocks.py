@@ -13,6 +13,12 @@ def _serialiser():
     return Serialiser(DMDS["dlp7000"], lanes=8)
 
 
+def _seq():
+    from gateware.dlpc410.sequencer import Sequencer
+    return Sequencer(DMDS["dlp7000"])
+
+
 BLOCKS = {
     "serialiser": _serialiser,
+    "seq": _seq,
 }

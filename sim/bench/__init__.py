@@ -7,4 +7,5 @@ each comes from a simulation or a synthesis run made by the benchmark itself.
 
 MODULES = [
     "sim.bench.bitplane",
+    "sim.bench.seq",
 ]
