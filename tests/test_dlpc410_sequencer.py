@@ -36,6 +36,14 @@ def next_ready(p, frames, strobes):
     return max(g.loaded_at for g in r.groups)
 
 
+def same_commands(run, model):
+    """Both command lists agree up to the end of the shorter run."""
+    horizon = run.status["now"] - 2 * DMD.dclk_per_row
+    got = [c for c in run.decoder.commands if c[0] < horizon]
+    assert got == [c for c in model.commands if c[0] < horizon]
+    return got
+
+
 def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), early_pins=()):
     """Run gateware and model; assert equal commands, counters, and exact light per frame."""
     mframes = model_frames(frames, images)
@@ -149,12 +157,12 @@ def test_trigger_modes(mode, test_name):
     ready = next_ready(p, model_frames(frames, None), [])
     if mode == TriggerMode.PERIODIC:
         p.period = ready + 1
-        strobes = [p.period - 1, 2 * p.period - 1, 3 * p.period - 1]
-        model = schedule.simulate(DMD, p, model_frames(frames, None), strobes)
-        end = max(c[0] for c in model.commands) + 100
-        run = run_bench(DMD, p, frames, None, cycles=end, name=test_name)
-        assert run.decoder.commands == model.commands
+        strobes = [k * p.period - 1 for k in range(1, 7)]
+        model = schedule.simulate(DMD, p, model_frames(frames, None), strobes, until=strobes[-1] - 4)
+        run = run_bench(DMD, p, frames, None, cycles=strobes[-1] - 4, name=test_name)
+        same_commands(run, model)
         assert run.status["triggers"] == len(model.accepted) >= 2
+        assert run.status["overruns"] == model.overruns >= 1
     elif mode == TriggerMode.SOFTWARE:
         run, model = check(p, frames, None, [], test_name, soft=[ready, ready + 40])
         assert run.status["triggers"] == 1 and run.status["overruns"] == 1
@@ -170,12 +178,75 @@ def test_binary_prng_chain(test_name):
                   strict_rst=False).params
     ready = next_ready(p, [schedule.Frame(0, 1)], [])
     model = schedule.simulate(DMD, p, [], [ready + PIN_TO_STROBE], until=ready + 6 * p.lsb)
-    run = run_bench(DMD, p, [], None, pins=[ready], cycles=ready + 6 * p.lsb, name=test_name)
-    assert run.decoder.commands == model.commands
-    shown = prng_model.shown_patterns(DMD, model.commands, 0)
-    pulses = [t for t, k, _a in model.commands if k == "pulse"]
+    run = run_bench(DMD, p, [], None, pins=[ready], cycles=ready + 6 * p.lsb, name=test_name,
+                    seed=0x1234)
+    commands = same_commands(run, model)
+    shown = prng_model.shown_patterns(DMD, commands, 0x1234)
+    pulses = [t for t, k, _a in commands if k == "pulse"]
     assert len(pulses) >= 8
     # the frame period is the bus limit: one full load per pattern
     assert p.lsb == p.stagger * DMD.blocks
-    # the decoder's mirrors hold the last shown pattern
+    # the decoder's mirrors hold the last shown pattern, the host's rebuild of it
     assert np.array_equal(run.decoder.mirrors, shown[-1])
+    assert not np.array_equal(shown[-1], prng_model.shown_patterns(DMD, commands, 0)[-1])
+
+
+def test_init_training_and_first_dvalid(test_name):
+    """Training pattern until ECP2_FINISHED is high and INIT_ACTIVE low; no command meanwhile;
+    the first DVALID at least 64 clocks after INIT_ACTIVE falls."""
+    from gateware.dlpc410.facts import BlockMode, RowMode
+    from gateware.dlpc410.init import TRAINING_FALL, TRAINING_RISE
+    from gateware.dlpc410.params import Registers
+    from sim.harness.amaranth_sim import simulate
+    from sim.tb.plane_source import SequencerBench
+
+    dut = SequencerBench(DMD, [(0, 8)])
+    p = fast_plan().params
+    seen = {"training": 0, "toggles": 0}
+
+    async def bench(ctx):
+        ctx.set(dut.regs, Registers.const(p.registers(DMD)))
+        last_dvalid = 0
+        for ecp2, init_active in ((0, 0), (0, 1), (1, 1)):
+            ctx.set(dut.pins.ecp2_finished, ecp2)
+            ctx.set(dut.pins.init_active, init_active)
+            for _ in range(30):
+                await ctx.tick()
+                pins = dut.pins
+                dvalid = ctx.get(pins.dvalid)
+                if ctx.get(dut.status.now) == 0 and ctx.get(pins.din_a.rise) == TRAINING_RISE \
+                        and ctx.get(pins.din_b.fall) == TRAINING_FALL:
+                    seen["training"] += 1
+                seen["toggles"] += dvalid != last_dvalid
+                last_dvalid = dvalid
+                assert ctx.get(pins.rowmd) == RowMode.NOOP and ctx.get(pins.blkmd) == BlockMode.NOOP
+        ctx.set(dut.pins.init_active, 0)
+        for cycle in range(1, 200):
+            await ctx.tick()
+            if ctx.get(dut.pins.dvalid) and ctx.get(dut.status.now) > 0:
+                assert cycle >= 64, f"first DVALID {cycle} clocks after INIT_ACTIVE fell"
+                seen["first"] = cycle
+                break
+
+    simulate(dut, [bench], name=test_name, clocks={"sync": 200e6})
+    assert seen["training"] >= 85 and seen["toggles"] >= 85
+    assert 64 <= seen["first"] < 80
+
+
+def test_binary_chain_from_memory(test_name):
+    """1-bit frames from the store back to back: each pattern is loaded behind the one shown."""
+    rng = np.random.default_rng(9)
+    images = {s: rng.integers(0, 256, (DMD.rows, DMD.columns), dtype=np.uint8) for s in (0, 1)}
+    frames = [(0, 1), (1, 1), (0, 1), (1, 1)]
+    p = fast_plan(depth=1, chain=True).params
+    mframes = model_frames(frames, images)
+    ready = next_ready(p, mframes, [])
+    until = ready + 5 * p.lsb
+    model = schedule.simulate(DMD, p, mframes, [ready + PIN_TO_STROBE], until=until)
+    run = run_bench(DMD, p, frames, images, pins=[ready], cycles=until, name=test_name)
+    commands = same_commands(run, model)
+    pulses = [t for t, k, _a in commands if k == "pulse"]
+    assert len(pulses) == 5 and set(np.diff(pulses)) == {p.lsb}
+    # the last pattern shown: frame 4 (slot 1) while it lasts, then the last frame repeats
+    assert np.array_equal(run.decoder.mirrors, images[1] >> 7)
+    assert run.status["frames"] == 5 and run.sync_out == [(pulses[0], 1)]

@@ -1,8 +1,9 @@
 """cocotb testbench of the sequencer's generated Verilog (with the plane-source fixture).
 
-One triggered frame (bit depth from the parameters) of the ramp image (every grey level on every row) on the DMD named in
-the parameters, with RST_ACTIVE and settle scaled down: the decoded command stream must equal
-the schedule model's cycle for cycle, and every pixel must integrate exactly its grey level.
+One triggered frame (bit depth from the parameters) of the ramp image (every grey level on
+every row) on the DMD named in the parameters, with RST_ACTIVE and settle scaled down: the
+decoded command stream must equal the schedule model's cycle for cycle, and every pixel must
+integrate exactly its grey level.
 """
 
 import cocotb
@@ -87,9 +88,9 @@ async def ramp_frame_matches_model(dut):
     assert dut.status.value.to_unsigned() & now_mask == now, "lost track of the time base"
     got = decoder.commands
     want = [c for c in model.commands if c[0] < end]
-    first_diff = next((i for i, (x, y) in enumerate(zip(got, want)) if x != y), None)
-    assert got == want, f"{len(got)} vs {len(want)} commands; first difference at {first_diff}: " \
-        f"{got[first_diff] if first_diff is not None else None} vs {want[first_diff] if first_diff is not None else None}"
+    first = next((i for i, (x, y) in enumerate(zip(got, want, strict=False)) if x != y), None)
+    where = None if first is None else (got[first], want[first])
+    assert got == want, f"{len(got)} vs {len(want)} commands; first difference at {first}: {where}"
     assert light is not None, "the frame did not end"
     assert np.array_equal(light, (ramp_image(dmd, 0).astype(np.int64) >> (8 - depth)) * p.lsb)
     dut._log.info("%d commands equal, %d pixels exact", len(got), light.size)

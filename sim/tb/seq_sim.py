@@ -30,7 +30,7 @@ class Run:
 
 
 def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, name, init_cycles=20,
-              rst_high=None, early_pins=(), sync_pins=()):
+              rst_high=None, early_pins=(), sync_pins=(), seed=None):
     """``pins``: ``now`` values at which the trigger pin rises (high for 4 cycles);
     ``early_pins``: testbench cycles (before initialisation ends) of extra rising edges."""
     dut = SequencerBench(dmd, frames, images)
@@ -43,6 +43,11 @@ def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, nam
         ctx.set(dut.regs, regs)
         ctx.set(dut.pins.ecp2_finished, 1)
         ctx.set(dut.pins.init_active, 1)
+        if seed is not None:
+            ctx.set(dut.seed, seed)
+            ctx.set(dut.reseed, 1)
+            await ctx.tick()
+            ctx.set(dut.reseed, 0)
         rst_left = 0
         high_left = 0
         sync_left = 0
