@@ -101,6 +101,8 @@ def test_random_images_every_depth_with_empty_blocks(test_name):
         pins.append(next_ready(p, mframes, [t + PIN_TO_STROBE for t in pins]) - PIN_TO_STROBE)
     run, model = check(p, frames, images, pins, test_name)
     assert len(run.lights) == len(frames)
+    # each slot is handed back when every group has moved to the next frame's slot
+    assert [s for _t, s in run.releases] == [k % 2 for k in range(len(frames) - 1)]
     assert any(k == "clear" for _t, k, _a in model.commands[:200])
 
 

@@ -106,6 +106,9 @@ class Sequencer(wiring.Component):
         in the block, for slot ``occ_slot`` as it was one cycle earlier.
     seed, reseed : In(64), In(1)
         Seed of the Bernoulli pattern source.
+    release : Out(stream.Signature(SLOT_BITS))
+        A slot the sequencer will request no more rows from (every group has moved on to a
+        frame in another slot); the store may reuse it once it has answered those requests.
     status : Out(Status)
     """
 
@@ -128,6 +131,7 @@ class Sequencer(wiring.Component):
             "occupancy": In(data.ArrayLayout(8, dmd.blocks)),
             "seed": In(64),
             "reseed": In(1),
+            "release": Out(stream.Signature(SLOT_BITS)),
             "status": Out(Status),
         })
 
@@ -232,11 +236,23 @@ class Sequencer(wiring.Component):
             self.requests.payload.first_row.eq(req_block * rpb),
             self.requests.payload.row_count.eq(rpb),
         ]
+        m.submodules.releases = releases = fifo.SyncFIFOBuffered(width=SLOT_BITS, depth=4)
+        last_slot = Signal(SLOT_BITS)
+        seen_slot = Signal()
+        m.d.comb += [
+            releases.w_data.eq(last_slot),
+            self.release.valid.eq(releases.r_rdy), self.release.payload.eq(releases.r_data),
+            releases.r_en.eq(self.release.ready),
+        ]
         with m.FSM(name="requester"):
             with m.State("IDLE"):
-                with m.If(queue.r_rdy):
-                    m.d.comb += queue.r_en.eq(1)
+                # the last group's first load from a new slot: no group reads the old one again
+                leaves = (head.group == n_groups - 1) & ~head.clear & seen_slot & (head.slot != last_slot)
+                with m.If(queue.r_rdy & (~leaves | releases.w_rdy)):
+                    m.d.comb += [queue.r_en.eq(1), releases.w_en.eq(leaves)]
                     m.d.sync += req_entry.eq(head)
+                    with m.If((head.group == n_groups - 1) & ~head.clear):
+                        m.d.sync += [last_slot.eq(head.slot), seen_slot.eq(1)]
                     m.next = "LOOK"
             with m.State("LOOK"):
                 mask = Cat(

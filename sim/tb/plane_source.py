@@ -113,6 +113,7 @@ class SequencerBench(wiring.Component):
             "camera_out": Out(1),
             "seed": In(64),
             "reseed": In(1),
+            "release": Out(stream.Signature(4)),
             "status": Out(Status),
         })
 
@@ -123,6 +124,7 @@ class SequencerBench(wiring.Component):
         wiring.connect(m, seq.requests, src.requests)
         wiring.connect(m, src.words, seq.words)
         wiring.connect(m, src.frames, seq.frames)
+        wiring.connect(m, seq.release, wiring.flipped(self.release))
         m.d.comb += [src.occ_slot.eq(seq.occ_slot), seq.occupancy.eq(src.occupancy)]
         wiring.connect(m, wiring.flipped(self.pins), seq.pins)
         for name in ("regs", "trigger_in", "sync_in", "soft_trigger", "seed", "reseed"):

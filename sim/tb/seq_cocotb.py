@@ -45,6 +45,7 @@ async def ramp_frame_matches_model(dut):
     dut.pins__init_active.value = 1
     dut.pins__rst_active.value = 0
     dut.trigger_in.value = 0
+    dut.release__ready.value = 1
     dut.rst.value = 1
     await ClockCycles(dut.clk, 3)
     dut.rst.value = 0

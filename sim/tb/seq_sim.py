@@ -27,6 +27,7 @@ class Run:
     sync_out: list = field(default_factory=list)     # (now, level) at each change
     camera_out: list = field(default_factory=list)
     lights: list = field(default_factory=list)       # light taken at each sync_out fall
+    releases: list = field(default_factory=list)     # (now, slot) handed back
 
 
 def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, name, init_cycles=20,
@@ -41,6 +42,7 @@ def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, nam
 
     async def bench(ctx):
         ctx.set(dut.regs, regs)
+        ctx.set(dut.release.ready, 1)
         ctx.set(dut.pins.ecp2_finished, 1)
         ctx.set(dut.pins.init_active, 1)
         if seed is not None:
@@ -55,7 +57,7 @@ def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, nam
         p = dut.pins
         sigs = (dut.status.now, p.dvalid, p.rowmd, p.rowad, p.blkmd, p.blkad, p.rst2blkz,
                 p.din_a.rise, p.din_b.rise, p.din_a.fall, p.din_b.fall,
-                dut.sync_out, dut.camera_out)
+                dut.sync_out, dut.camera_out, dut.release.valid, dut.release.payload)
         for i in range(init_cycles):
             ctx.set(dut.trigger_in, i in early_pins)
             await ctx.tick()
@@ -64,7 +66,9 @@ def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, nam
         running = False
         for _ in range(cycles):
             values = await ctx.tick().sample(*sigs)
-            now, dv, rowmd, rowad, blkmd, blkad, r2, ar, br, af, bf, so, co = values[2:]
+            now, dv, rowmd, rowad, blkmd, blkad, r2, ar, br, af, bf, so, co, rv, rs = values[2:]
+            if rv:
+                run.releases.append((now, rs))
             running = running or now > 0
             if running:
                 lanes = {("A", "rise"): ar, ("B", "rise"): br, ("A", "fall"): af, ("B", "fall"): bf}
