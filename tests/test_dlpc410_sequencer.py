@@ -252,3 +252,17 @@ def test_binary_chain_from_memory(test_name):
     # the last pattern shown: frame 4 (slot 1) while it lasts, then the last frame repeats
     assert np.array_equal(run.decoder.mirrors, images[1] >> 7)
     assert run.status["frames"] == 5 and run.sync_out == [(pulses[0], 1)]
+
+
+def test_too_short_lsb_is_counted_late(test_name):
+    """A least significant plane shorter than the settle rule allows: the pulses come late
+    (never while RST_ACTIVE is high, never into a settling block), both gateware and model
+    count them, and the command streams still agree."""
+    p = fast_plan(depth=3).params
+    p.lsb -= 16
+    frames = [(0, 3)]
+    ready = next_ready(p, model_frames(frames, None), [])
+    model = schedule.simulate(DMD, p, model_frames(frames, None), [ready + PIN_TO_STROBE])
+    run = run_bench(DMD, p, frames, None, pins=[ready], cycles=model.commands[-1][0] + 50, name=test_name)
+    same_commands(run, model)
+    assert run.status["late"] == model.late > 0

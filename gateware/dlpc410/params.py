@@ -40,7 +40,8 @@ class TriggerMode(enum.Enum, shape=2):
     EXTERNAL = 0   # rising edge of the TTL trigger input
     PERIODIC = 1   # free-running, every ``period`` cycles
     SOFTWARE = 2   # a pulse on the ``soft_trigger`` port (a control record)
-    SYNC = 3       # rising edge of the sync input (tiled projectors: every board starts together)
+    SYNC = 3       # rising edge of the sync input: tiled projectors start their first plane
+                   # together (MSB_FIRST: the most significant plane on every board at once)
 
 
 class Source(enum.Enum, shape=1):

@@ -49,7 +49,7 @@ import numpy as np
 from .facts import TIMING, BlockMode
 from .params import PlaneOrder, ResetMode, Source, TriggerMode, group_size
 
-__all__ = ["Params", "Frame", "Result", "exponents", "groups", "pulse_encoding", "simulate",
+__all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate",
            "plan", "bound", "level_light", "INIT_TO_DVALID", "RST_MARGIN", "even", "ready_cycle"]
 
 #: First load this many cycles after INIT_ACTIVE falls (DLPC910: first DVALID >= 64 clocks).
@@ -357,6 +357,9 @@ def level_light(dmd, p, result, images):
 
 @dataclass
 class Plan:
+    """A checked parameter set: ``frame_cycles`` is the shortest trigger-to-trigger period
+    (or the chained frame period), ``lsb_min`` the shortest legal least significant plane and
+    ``binds`` the constraint that sets it."""
     params: Params
     frame_cycles: int             # trigger-to-trigger minimum (or chained frame period)
     lsb_min: int
@@ -391,6 +394,11 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     one). ``words_per_cycle`` is the store's read bandwidth in 64-bit words per DCLK cycle; it
     sets the row pacing. The plan is checked by simulating one frame (all blocks full unless
     ``frame`` is given): no pulse may be late.
+
+    Phased modes: every step of a group's timeline is a multiple of the LSB duration, which is
+    chosen (searching upward from the shortest legal one) so that the offsets ``g * stagger``
+    never bring pulses of two groups closer than the RST rule allows (strict: ``t_rst``; loose:
+    one row cycle) and the loads squeezed between other groups' pulses still finish on time.
     """
     R = dmd.dclk_per_row
     t_rst = even(_cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s, dclk_hz) + RST_MARGIN)
@@ -410,8 +418,8 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     binds = "settle (t_rst + t_settle + clears)"
     if depth == 1 and chain:
         lsb_min = max(t_rst + t_settle + load_g, bus_path, 2)
-        binds = "bus (row loads)" if bus_path >= t_rst + t_settle + load_g or G == 1 and \
-            load_g >= t_rst + t_settle else "settle + load"
+        binds = "bus (row loads)" if G > 1 and bus_path >= t_rst + t_settle + load_g \
+            else "settle + load (a pulse freezes its group's memory)"
     want = _cycles(exposure_s, dclk_hz)
     if want > lsb_min:
         lsb_min, binds = want, "requested exposure"
