@@ -44,16 +44,20 @@ def same_commands(run, model):
     return got
 
 
-def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), early_pins=()):
-    """Run gateware and model; assert equal commands, counters, and exact light per frame."""
-    mframes = model_frames(frames, images)
+def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), early_pins=(),
+          offered=None):
+    """Run gateware and model; assert equal commands, counters, and exact light per frame.
+    ``frames``: the frames expected on the DMD; ``offered``: what the store offers (default:
+    the same)."""
+    offered = frames if offered is None else offered
+    mframes = model_frames(offered, images)
     if p.trigger == TriggerMode.SOFTWARE:
         strobes = list(soft)
     else:
         strobes = [t + PIN_TO_STROBE for t in (sync_pins if p.trigger == TriggerMode.SYNC else pins)]
     model = schedule.simulate(DMD, p, mframes, strobes)
     end = max(c[0] for c in model.commands) + extra
-    run = run_bench(DMD, p, frames, images, pins=pins, soft=soft, sync_pins=sync_pins,
+    run = run_bench(DMD, p, offered, images, pins=pins, soft=soft, sync_pins=sync_pins,
                     early_pins=early_pins, cycles=end, name=name)
     assert run.decoder.commands == model.commands
     assert run.status["late"] == 0 == model.late
@@ -126,7 +130,7 @@ def test_triggers(test_name):
     """Before init ends, early, during a frame, a burst faster than frames, one cycle before the
     next frame is ready and exactly when it is: counted right, never half-obeyed."""
     p = fast_plan().params
-    frames = [(0, 4), (1, 4), (0, 4)]
+    frames = [(0, 4), (1, 0), (1, 4), (1, 9), (0, 4)]   # two frames with bad depths: dropped
     mframes = model_frames(frames, None)
     first = next_ready(p, mframes, []) - PIN_TO_STROBE
     second = next_ready(p, mframes, [first + PIN_TO_STROBE]) - PIN_TO_STROBE
@@ -136,9 +140,10 @@ def test_triggers(test_name):
             second - 1,                          # one cycle early: overrun
             second + 7,                          # accepted (edge after the early one's pulse)
             third]                               # exactly when ready: accepted
-    run, model = check(p, frames, None, pins, test_name, early_pins=(3, 9))
+    run, model = check(p, [f for f in frames if 1 <= f[1] <= 8], None, pins, test_name,
+                       early_pins=(3, 9), offered=frames)
     assert model.overruns == 5 and len(model.accepted) == 3
-    assert run.status["frames"] == 3
+    assert run.status["frames"] == 3 and run.status["bad_frames"] == model.bad_frames == 2
 
 
 def test_sync_out_and_camera(test_name):

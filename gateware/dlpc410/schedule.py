@@ -121,6 +121,7 @@ class Result:
     pulses: list                 # (cycle, group, kind, frame_index, exponent or None for dark)
     late: int = 0
     overruns: int = 0
+    bad_frames: int = 0
     accepted: list = field(default_factory=list)   # strobe cycles obeyed
     frame_starts: list = field(default_factory=list)
     shown: list = field(default_factory=list)        # frames taken, in order
@@ -198,6 +199,10 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
         offered = [Frame(0, 1)]
 
     def take_frame():
+        # frames with a bit depth outside 1..8 are dropped (and counted) as soon as offered
+        while offered and offered[0].ready <= t_now[0] and not 1 <= offered[0].depth <= 8:
+            offered.pop(0)
+            res.bad_frames += 1
         if offered and offered[0].ready <= t_now[0]:
             shown.append(offered.pop(0))
         assert shown, "no frame offered before it was needed"

@@ -43,7 +43,8 @@ class Status(data.Struct):
     ``triggers`` triggers obeyed; ``overruns`` triggers ignored because a frame was playing or
     the next one was not loaded yet; ``early`` triggers before initialisation ended; ``late``
     pulses made after their time (a parameter set the schedule model rejects); ``underruns``
-    bus decisions that waited for row data from the store.
+    bus decisions that waited for row data from the store; ``bad_frames`` frames offered with
+    a bit depth outside 1..8, dropped.
     """
     now: TIME_BITS
     frames: COUNTER_BITS
@@ -52,6 +53,7 @@ class Status(data.Struct):
     early: COUNTER_BITS
     late: COUNTER_BITS
     underruns: COUNTER_BITS
+    bad_frames: COUNTER_BITS
 
 
 def _diff(a, b):
@@ -386,12 +388,19 @@ class Sequencer(wiring.Component):
         m.d.comb += plane_len.eq(regs.lsb << pe)
         hidden = ~pdark & (plane_len >= regs.hide) & (~last | regs.chain)
         new_frame = last & (pdark | hidden)
+        # a frame with a bit depth outside 1..8 is dropped as soon as it is offered, and counted
+        depth_in = self.frames.payload.bit_depth
+        frame_ok = (depth_in != 0) & (depth_in <= 8)
+        with m.If(self.frames.valid & ~frame_ok):
+            m.d.comb += self.frames.ready.eq(1)
+            m.d.sync += self.status.bad_frames.eq(self.status.bad_frames + 1)
         take = Signal()
         n_slot = Mux(take, self.frames.payload.slot, next_slot)
         n_depth = Mux(take, self.frames.payload.bit_depth, next_depth)
-        m.d.comb += take.eq(do_pulse & new_frame & (p == 0) & self.frames.valid & ~use_prng)
+        m.d.comb += take.eq(do_pulse & new_frame & (p == 0) & self.frames.valid & frame_ok & ~use_prng)
+        with m.If(take):
+            m.d.comb += self.frames.ready.eq(1)
         with m.If(do_pulse):
-            m.d.comb += self.frames.ready.eq(take)
             with m.If(_diff(pulse_at[p], now) < 0):
                 m.d.sync += self.status.late.eq(self.status.late + 1)
             m.d.sync += [
@@ -436,7 +445,7 @@ class Sequencer(wiring.Component):
         start_group = Signal(grp_bits + 1)
         with m.FSM(name="start"):
             with m.State("WAIT"):
-                with m.If(init.running & (self.frames.valid | use_prng)):
+                with m.If(init.running & (self.frames.valid & frame_ok | use_prng)):
                     m.d.comb += self.frames.ready.eq(~use_prng)
                     f_slot = Mux(use_prng, 0, self.frames.payload.slot)
                     f_depth = Mux(use_prng, 1, self.frames.payload.bit_depth)

@@ -23,7 +23,9 @@ FAST = {"t_rst_s": 20 / 200e6, "t_settle_s": 30 / 200e6}
 
 def trigger_latencies():
     """Pin edge to the first clocking pulse on the pins, in cycles, for pin edges on each
-    phase of the DCLK/2 command grid; ``newer``: a newer frame completed just before."""
+    phase of the DCLK/2 command grid; ``newer``: a newer frame completed just before the
+    trigger. The frame preloaded when the previous one ended is the one a trigger shows (a
+    newer frame waits for the next trigger), so the latency does not depend on it."""
     p = schedule.plan(TEST_DMD, 200e6, depth=1, **FAST).params
     out = {}
     for newer in (False, True):

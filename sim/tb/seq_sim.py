@@ -98,7 +98,7 @@ def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, nam
             rst_left = max(0, rst_left - 1)
         st = ctx.get(dut.status)
         run.status = {k: int(getattr(st, k)) for k in
-                      ("now", "frames", "triggers", "overruns", "early", "late", "underruns")}
+                      ("now", "frames", "triggers", "overruns", "early", "late", "underruns", "bad_frames")}
 
     simulate(dut, [bench], name=name, clocks={"sync": 200e6})
     return run
