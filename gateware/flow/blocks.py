@@ -44,6 +44,11 @@ def _store_reader():
     return Reader(DMDS["dlp7000"], slots=4)
 
 
+def _seq():
+    from gateware.dlpc410.sequencer import Sequencer
+    return Sequencer(DMDS["dlp7000"])
+
+
 BLOCKS = {
     "serialiser": _serialiser,
     "eth_rx": _eth_rx,
@@ -52,4 +57,5 @@ BLOCKS = {
     "store_slots": _store_slots,
     "store_writer": _store_writer,
     "store_reader": _store_reader,
+    "seq": _seq,
 }

@@ -11,4 +11,5 @@ MODULES = [
     "sim.bench.mac",
     "sim.bench.net",
     "sim.bench.store",
+    "sim.bench.seq",
 ]

@@ -1,0 +1,57 @@
+"""DLPC410 start-up: wait for the controller, send the training pattern meanwhile.
+
+After ARSTZ rises the DLPC410 configures itself (ECP2_FINISHED rises) and initialises the DMD
+(INIT_ACTIVE high, about 220 ms, DLP7000 8.3). INIT_ACTIVE is read only once ECP2_FINISHED is
+high (DLPC910). Until then the applications FPGA sends the training pattern on every data pin
+and DVALID and no command. ``running`` rises once ECP2_FINISHED is high and INIT_ACTIVE low,
+and stays high; the sequencer then keeps DVALID low for at least ``init_to_dvalid`` clocks
+(see :mod:`gateware.dlpc410.schedule`).
+"""
+
+from amaranth import Module, Signal
+from amaranth.lib import wiring
+from amaranth.lib.cdc import FFSynchronizer
+from amaranth.lib.wiring import In, Out
+
+from .facts import TIMING
+
+__all__ = ["Init", "TRAINING_RISE", "TRAINING_FALL"]
+
+_pattern = int(TIMING["training_pattern"].value)
+#: Training pattern bits of each pin on the rising and on the falling DCLK edge.
+TRAINING_RISE = _pattern & 0xffff
+TRAINING_FALL = _pattern >> 16
+
+
+class Init(wiring.Component):
+    """Start-up sequencing.
+
+    Members
+    -------
+    ecp2_finished, init_active : In(1)
+        From the DLPC410 (asynchronous; synchronised here).
+    running : Out(1)
+        Sticky: the controller is ready for commands.
+    training : Out(1)
+        High while the training pattern must be sent (not ``running``).
+    rst_active : In(1), rst_active_synced : Out(1)
+        RST_ACTIVE, synchronised.
+    """
+    ecp2_finished: In(1)
+    init_active: In(1)
+    rst_active: In(1)
+    running: Out(1)
+    training: Out(1)
+    rst_active_synced: Out(1)
+
+    def elaborate(self, platform):
+        m = Module()
+        ecp2 = Signal()
+        init = Signal(init=1)
+        m.submodules.ecp2_sync = FFSynchronizer(self.ecp2_finished, ecp2)
+        m.submodules.init_sync = FFSynchronizer(self.init_active, init, init=1)
+        m.submodules.rst_sync = FFSynchronizer(self.rst_active, self.rst_active_synced)
+        with m.If(ecp2 & ~init):
+            m.d.sync += self.running.eq(1)
+        m.d.comb += self.training.eq(~self.running)
+        return m

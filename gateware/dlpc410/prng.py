@@ -1,0 +1,55 @@
+"""On-chip Bernoulli pattern source: pseudo-random 1-bit rows that need no memory bandwidth.
+
+xorshift64 (shifts 13, 7, 17), one 64-bit word per step: every bit is a fair coin, so each
+pattern is a row of a Bernoulli(1/2) measurement matrix for compressed sensing. The host
+rebuilds the same patterns with :mod:`gateware.dlpc410.prng_model`.
+"""
+
+from amaranth import Module, Mux, Signal
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+from .prng_model import ZERO_SEED
+
+__all__ = ["Prng"]
+
+
+def _step(state):
+    a = state ^ (state << 13)[:64]
+    b = a ^ (a >> 7)
+    return b ^ (b << 17)[:64]
+
+
+class Prng(wiring.Component):
+    """xorshift64 word source.
+
+    Members
+    -------
+    seed : In(64)
+        Loaded when ``reseed`` is high (zero is replaced by :data:`prng_model.ZERO_SEED`).
+    reseed : In(1)
+    next : In(1)
+        Take ``word`` this cycle; the next word follows on the next cycle.
+    word : Out(64)
+        The current word (the state after one step from the seed, then one step per ``next``).
+    """
+    seed: In(64)
+    reseed: In(1)
+    next: In(1)
+    word: Out(64)
+
+    def elaborate(self, platform):
+        m = Module()
+        state = Signal(64, init=_const_step(ZERO_SEED))
+        seeded = Mux(self.seed == 0, ZERO_SEED, self.seed)
+        with m.If(self.reseed):
+            m.d.sync += state.eq(_step(seeded))
+        with m.Elif(self.next):
+            m.d.sync += state.eq(_step(state))
+        m.d.comb += self.word.eq(state)
+        return m
+
+
+def _const_step(value):
+    from .prng_model import step
+    return step(value)

@@ -1,0 +1,490 @@
+"""The schedule model: every DLPC410 command of a PWM frame, its cycle, the light per grey level.
+
+Pure Python, shared by the host (what rate can this scene reach?) and the tests (the gateware's
+command stream must equal this model's, cycle for cycle). It runs the very algorithm of
+:class:`gateware.dlpc410.sequencer.Sequencer`, event by event instead of cycle by cycle.
+
+The algorithm
+-------------
+Blocks are pulsed in *groups* (:func:`gateware.dlpc410.params.group_size`): one group of all
+blocks in global mode, groups of 4, 2 or 1 in the phased modes. Every group plays the same
+timeline; group ``g`` runs ``g * stagger`` cycles behind group 0.
+
+A frame of bit depth ``d`` is shown as ``d`` planes in the configured order; the plane of weight
+``2**e`` is shown for ``lsb << e`` cycles, measured from its clocking pulse to the next pulse of
+the same group. After each pulse the group's memory is frozen for ``t_rst + t_settle`` cycles;
+then the group is loaded with what its next pulse shows:
+
+* a plane at least ``hide`` long has the next plane loaded behind it, and the next pulse comes
+  exactly ``lsb << e`` after this one;
+* a shorter plane (and the last plane of a frame unless frames are chained) has its group's
+  blocks cleared behind it and is ended by a *dark pulse* exactly on time; the next plane is
+  loaded after that pulse's settle time and pulsed ``dark_gap`` after the dark pulse.
+
+Loading a group: for each block, its rows (one row cycle each, ``row_period`` apart) when the
+occupancy map says the plane has a bit set in the block, else one block clear
+(``clear_row_cycles`` row cycles). Loads are served in the order they were queued (the order of
+the pulses that freed them).
+
+The command bus makes one decision every even cycle on which no row cycle is running (the
+DLPC410 runs at DCLK/2, so gaps are even): a pulse whose time has come and whose group is
+loaded, if the RST_ACTIVE rule allows it (strict: ``t_rst`` after any pulse; otherwise after the
+same group's); else the next load operation, if its group's settle time is over, the row pacing
+allows it, and no loaded pulse falls due before the operation ends; else nothing. A pulse that
+cannot be made on time is made late and counted (the plan below never lets that happen).
+
+A trigger strobe at cycle ``s`` is obeyed when every group is loaded and waiting: group ``g``'s
+first pulse is then at ``even(s + 1) + g * stagger``; otherwise it is counted as an overrun.
+
+Time base: cycle 0 is the first cycle after initialisation (INIT_ACTIVE low); the first loads
+may start at ``init_to_dvalid`` (64 clocks, DLPC910). Command cycles are decision cycles; the
+pins show each command one cycle later.
+"""
+
+from dataclasses import dataclass, field, replace
+import math
+
+import numpy as np
+
+from .facts import TIMING, BlockMode
+from .params import PlaneOrder, ResetMode, Source, TriggerMode, group_size
+
+__all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate",
+           "plan", "bound", "level_light", "INIT_TO_DVALID", "RST_MARGIN", "even", "ready_cycle"]
+
+#: First load this many cycles after INIT_ACTIVE falls (DLPC910: first DVALID >= 64 clocks).
+INIT_TO_DVALID = int(TIMING["init_to_dvalid_clocks"].value)
+
+
+#: Cycles added to the RST_ACTIVE time: the command leaves one cycle after its decision, and the
+#: sequencer sees RST_ACTIVE through a two-flip-flop synchroniser; ``t_rst`` must cover the
+#: pin's high time plus this.
+RST_MARGIN = 4
+
+
+def even(t):
+    """Round a cycle count up to even."""
+    return t + (t & 1)
+
+
+@dataclass
+class Params:
+    """Run-time parameters, as in :class:`gateware.dlpc410.params.Registers` (cycles)."""
+    lsb: int
+    t_rst: int
+    t_settle: int
+    hide: int
+    dark_gap: int
+    reset_mode: ResetMode = ResetMode.GLOBAL
+    order: PlaneOrder = PlaneOrder.MSB_FIRST
+    order_table: tuple = (7, 6, 5, 4, 3, 2, 1, 0)
+    chain: bool = False
+    strict_rst: bool = True
+    trigger: TriggerMode = TriggerMode.EXTERNAL
+    source: Source = Source.STORE
+    stagger: int = 0
+    row_period: int = 0          # 0: DCLK-per-row of the DMD
+    period: int = 0
+    camera_offset: int = 0
+    camera_width: int = 1
+    ns_flip: bool = False
+    park: bool = False
+
+    def registers(self, dmd):
+        """The values of :class:`~gateware.dlpc410.params.Registers`, as a dict."""
+        regs = {k: getattr(self, k) for k in (
+            "lsb", "t_rst", "t_settle", "hide", "dark_gap", "stagger", "period",
+            "camera_offset", "camera_width")}
+        regs.update(reset_mode=self.reset_mode, order=self.order, order_table=list(self.order_table),
+                    chain=int(self.chain), strict_rst=int(self.strict_rst), trigger=self.trigger,
+                    source=self.source, row_period=self.row_period or dmd.dclk_per_row,
+                    ns_flip=int(self.ns_flip), park=int(self.park))
+        return regs
+
+
+@dataclass
+class Frame:
+    """A frame the store offers: its slot, bit depth and occupancy (blocks,) bytes, bit k =
+    stored plane k has a bit set in the block (:func:`sim.models.bitplane.occupancy`)."""
+    slot: int
+    depth: int
+    occupancy: tuple = None      # None: every block full
+    ready: int = 0               # cycle from which the store offers it
+
+    def occupied(self, plane, block):
+        return self.occupancy is None or bool((self.occupancy[block] >> plane) & 1)
+
+
+@dataclass
+class Result:
+    commands: list               # (cycle, kind, arg): row/row, clear/block, noop/None, pulse/blocks
+    pulses: list                 # (cycle, group, kind, frame_index, exponent or None for dark)
+    late: int = 0
+    overruns: int = 0
+    bad_frames: int = 0
+    accepted: list = field(default_factory=list)   # strobe cycles obeyed
+    frame_starts: list = field(default_factory=list)
+    shown: list = field(default_factory=list)        # frames taken, in order
+
+
+def exponents(order, table, depth):
+    """Weight exponents (0 = least significant) in display order for a frame of ``depth``."""
+    if order == PlaneOrder.MSB_FIRST:
+        return list(range(depth - 1, -1, -1))
+    if order == PlaneOrder.LSB_FIRST:
+        return list(range(depth))
+    exps = [int(e) for e in table[:depth]]
+    assert sorted(exps) == list(range(depth)), "order table must be a permutation"
+    return exps
+
+
+def groups(dmd, mode):
+    """List of block lists, one per pulse group."""
+    size = group_size(mode, dmd.blocks)
+    return [list(range(b, min(b + size, dmd.blocks))) for b in range(0, dmd.blocks, size)]
+
+
+def pulse_encoding(dmd, mode, g):
+    """(BLKMD, BLKAD, RST2BLKZ) of group ``g``'s clocking pulse (facts: block commands)."""
+    mode = ResetMode(mode)
+    if mode == ResetMode.GLOBAL:
+        return BlockMode.MULTI, 0b1000, 1
+    if mode == ResetMode.QUAD:
+        return BlockMode.MULTI, g << 1, 1
+    if mode == ResetMode.DUAL:
+        return BlockMode.MULTI, g, 0
+    return BlockMode.RESET, g, 1
+
+
+class _Group:
+    def __init__(self):
+        self.pending = False
+        self.pulse_at = 0
+        self.loaded_at = None     # cycle from which the group counts as loaded
+        self.writable = INIT_TO_DVALID
+        self.rst_free = 0
+        self.pos = None           # ("plane", frame_index, j) or ("dark", frame_index, j)
+        self.frame = None
+
+
+def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
+    """Run the sequencer's algorithm.
+
+    Parameters
+    ----------
+    dmd : DmdType
+    p : Params
+    frames : list of Frame
+        Offered in turn: each time group 0 needs a new frame it takes the next one whose
+        ``ready`` has passed, else shows the current one again.
+    strobes : iterable of int
+        Cycles at which the trigger block signals a trigger (see :mod:`.trigger`).
+    until : int
+        Stop at this cycle (default: when nothing is left to do).
+    """
+    R = dmd.dclk_per_row
+    row_period = p.row_period or R
+    clear_len = dmd.clear_row_cycles * R
+    grp = groups(dmd, p.reset_mode)
+    G = len(grp)
+    st = [_Group() for _ in range(G)]
+    res = Result([], [])
+    res.groups = st
+    queue = []                     # [group, ops, index]
+    offered = list(frames)
+    shown = res.shown              # frames taken, by index
+    strobes = sorted(strobes)
+    state = {"next_row": 0, "rst_any": 0, "next_frame": None}
+    if p.source == Source.PRNG:
+        offered = [Frame(0, 1)]
+
+    def take_frame():
+        # frames with a bit depth outside 1..8 are dropped (and counted) as soon as offered
+        while offered and offered[0].ready <= t_now[0] and not 1 <= offered[0].depth <= 8:
+            offered.pop(0)
+            res.bad_frames += 1
+        if offered and offered[0].ready <= t_now[0]:
+            shown.append(offered.pop(0))
+        assert shown, "no frame offered before it was needed"
+        return len(shown) - 1
+
+    def exps_of(fi):
+        return exponents(p.order, p.order_table, shown[fi].depth)
+
+    def enqueue(g, fi, j):
+        """Queue the load of frame ``fi``'s display position ``j`` (None: clears) for group g."""
+        ops = []
+        for b in grp[g]:
+            if j is not None:
+                plane = 8 - shown[fi].depth + exps_of(fi)[j]
+                if p.source == Source.PRNG or shown[fi].occupied(plane, b):
+                    ops += [("row", r) for r in range(b * dmd.rows_per_block, (b + 1) * dmd.rows_per_block)]
+                    continue
+            ops.append(("clear", b))
+        queue.append([g, ops, 0])
+        st[g].loaded_at = None
+
+    def next_frame_for(g):
+        if g == 0:
+            state["next_frame"] = take_frame()
+        return state["next_frame"]
+
+    def after_pulse(g, t):
+        s = st[g]
+        kind, fi, j = s.pos
+        exps = exps_of(fi)
+        last = j == len(exps) - 1
+        if kind == "plane":
+            d = p.lsb << exps[j]
+            s.pulse_at = t + d
+            if d >= p.hide and (not last or p.chain):
+                nfi, nj = (fi, j + 1) if not last else (next_frame_for(g), 0)
+                s.pos = ("plane", nfi, nj)
+                enqueue(g, nfi, nj)
+            else:
+                s.pos = ("dark", fi, j)
+                enqueue(g, fi, None)
+        else:
+            s.pulse_at = t + p.dark_gap
+            nfi, nj = (fi, j + 1) if not last else (next_frame_for(g), 0)
+            s.pos = ("plane", nfi, nj)
+            if last and not p.chain:
+                s.pending = False
+            enqueue(g, nfi, nj)
+
+    t_now = [0]
+    fi0 = take_frame()
+    state["next_frame"] = fi0
+    for g in range(G):
+        st[g].pos = ("plane", fi0, 0)
+        enqueue(g, fi0, 0)
+
+    t = 0
+    bus_free = 0
+    si = 0
+    while True:
+        t_now[0] = t
+        # --- decision at t ---
+        if t % 2 == 0 and t >= bus_free:
+            rst_ok = [t - (state["rst_any"] if p.strict_rst else st[g].rst_free) >= 0 for g in range(G)]
+            due = [g for g in range(G) if st[g].pending and st[g].loaded_at is not None
+                   and st[g].loaded_at <= t and st[g].pulse_at <= t and rst_ok[g]]
+            if due:
+                g = due[0]
+                s = st[g]
+                if s.pulse_at < t:
+                    res.late += 1
+                kind, fi, j = s.pos
+                res.commands.append((t, "pulse", tuple(grp[g])))
+                res.pulses.append((t, g, kind, fi, exps_of(fi)[j] if kind == "plane" else None))
+                if kind == "plane" and j == 0 and g == 0:
+                    res.frame_starts.append(t)
+                s.rst_free = t + p.t_rst
+                state["rst_any"] = t + p.t_rst
+                s.writable = t + p.t_rst + p.t_settle
+                bus_free = t + R
+                after_pulse(g, t)
+                if max_frames is not None and len(res.frame_starts) > max_frames:
+                    break
+            elif queue:
+                g, ops, i = queue[0]
+                op, arg = ops[i]
+                length = R if op == "row" else clear_len
+                imminent = any(st[h].pending and st[h].loaded_at is not None and st[h].loaded_at <= t
+                               and st[h].pulse_at < t + length for h in range(G))
+                if t >= st[g].writable and not imminent and (op != "row" or t >= state["next_row"]):
+                    res.commands.append((t, op, arg))
+                    for k in range(1, dmd.clear_row_cycles if op == "clear" else 1):
+                        res.commands.append((t + k * R, "noop", None))
+                    if op == "row":
+                        state["next_row"] = t + row_period
+                    bus_free = t + length
+                    queue[0][2] += 1
+                    if queue[0][2] == len(ops):
+                        queue.pop(0)
+                        st[g].loaded_at = t + length
+        # --- trigger strobe at t (reads the state before this cycle's decision) ---
+        while si < len(strobes) and strobes[si] <= t:
+            s_t = strobes[si]
+            si += 1
+            ready = all(not s.pending and s.loaded_at is not None and s.loaded_at <= s_t for s in st)
+            if ready:
+                res.accepted.append(s_t)
+                start = even(s_t + 1)
+                for g, s in enumerate(st):
+                    s.pending = True
+                    s.pulse_at = start + g * p.stagger
+            else:
+                res.overruns += 1
+        # --- next interesting cycle ---
+        cands = []
+        if si < len(strobes):
+            cands.append(strobes[si])
+        for s in st:
+            if s.pending and s.loaded_at is not None:
+                cands.append(max(s.pulse_at, s.rst_free if not p.strict_rst else state["rst_any"]))
+        if queue:
+            g = queue[0][0]
+            cands.append(max(st[g].writable, state["next_row"]))
+        if not cands:
+            break
+        nt = max(t + 1, min(cands), bus_free)
+        if nt % 2 and not (si < len(strobes) and strobes[si] == nt):
+            nt += 1
+        if until is not None and nt >= until:
+            break
+        t = nt
+    return res
+
+
+def level_light(dmd, p, result, images):
+    """On-cycles per pixel from the model's pulses: {frame index: (rows, columns) int array},
+    ``images[i]`` being the 8-bit image of the i-th frame taken (planes 8-depth..7 shown)."""
+    grp = groups(dmd, p.reset_mode)
+    light = {}
+    by_group = {}
+    for (t, g, kind, fi, e) in result.pulses:
+        by_group.setdefault(g, []).append((t, kind, fi, e))
+    for g, seq in by_group.items():
+        rows = slice(grp[g][0] * dmd.rows_per_block, (grp[g][-1] + 1) * dmd.rows_per_block)
+        for (t, kind, fi, e), (t2, *_rest) in zip(seq, seq[1:], strict=False):
+            if kind != "plane":
+                continue
+            img = np.asarray(images[fi], dtype=np.int64)
+            bit = (img[rows] >> (8 - result.shown[fi].depth + e)) & 1
+            acc = light.setdefault(fi, np.zeros(img.shape, dtype=np.int64))
+            acc[rows] += bit * (t2 - t)
+    return light
+
+
+# ---------------------------------------------------------------------------------------------
+# Planning: from physical numbers to a consistent parameter set, and the bounds.
+
+@dataclass
+class Plan:
+    """A checked parameter set: ``frame_cycles`` is the shortest trigger-to-trigger period
+    (or the chained frame period), ``lsb_min`` the shortest legal least significant plane and
+    ``binds`` the constraint that sets it."""
+    params: Params
+    frame_cycles: int             # trigger-to-trigger minimum (or chained frame period)
+    lsb_min: int
+    binds: str                    # which constraint sets the LSB
+    dclk_hz: float
+
+    @property
+    def rate_hz(self):
+        return self.dclk_hz / self.frame_cycles
+
+
+def _cycles(seconds, dclk_hz):
+    return even(math.ceil(seconds * dclk_hz - 1e-9))
+
+
+def _lattice_ok(M, s, G, sep):
+    """Pulses of distinct groups keep ``sep`` cycles apart when every timeline step is a
+    multiple of ``M`` and group g is offset by ``g * s``."""
+    for k in range(1, G):
+        r = (k * s) % M
+        if r < sep or M - r < sep:
+            return False
+    return True
+
+
+def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetMode.GLOBAL,
+         exposure_s=0.0, strict_rst=True, chain=False, words_per_cycle=1.0, source=Source.STORE,
+         t_rst_s=None, t_settle_s=None, frame=None, order_table=(7, 6, 5, 4, 3, 2, 1, 0)):
+    """A parameter set that shows every plane exactly on time, and the rate it reaches.
+
+    ``exposure_s`` asks for a least significant plane at least that long (0: the shortest legal
+    one). ``words_per_cycle`` is the store's read bandwidth in 64-bit words per DCLK cycle; it
+    sets the row pacing. The plan is checked by simulating one frame (all blocks full unless
+    ``frame`` is given): no pulse may be late.
+
+    Phased modes: every step of a group's timeline is a multiple of the LSB duration, which is
+    chosen (searching upward from the shortest legal one) so that the offsets ``g * stagger``
+    never bring pulses of two groups closer than the RST rule allows (strict: ``t_rst``; loose:
+    one row cycle) and the loads squeezed between other groups' pulses still finish on time.
+    """
+    R = dmd.dclk_per_row
+    t_rst = even(_cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s, dclk_hz) + RST_MARGIN)
+    t_settle = _cycles(TIMING["t_settle"].value if t_settle_s is None else t_settle_s, dclk_hz)
+    words = dmd.words_per_row
+    row_period = even(max(R, math.ceil(words / words_per_cycle - 1e-9)))
+    grp = groups(dmd, reset_mode)
+    G = len(grp)
+    rows_g = max(len(b) for b in grp) * dmd.rows_per_block
+    load_g = (rows_g - 1) * row_period + R
+    clear_g = max(len(b) for b in grp) * dmd.clear_row_cycles * R
+    stagger = 0 if G == 1 else even(max(load_g, t_rst if strict_rst else R))
+    sep = t_rst if strict_rst else R
+    settle_path = t_rst + t_settle + clear_g
+    bus_path = stagger * G if G > 1 else 0
+    lsb_min = max(settle_path, 2)
+    binds = "settle (t_rst + t_settle + clears)"
+    if depth == 1 and chain:
+        lsb_min = max(t_rst + t_settle + load_g, bus_path, 2)
+        binds = "bus (row loads)" if G > 1 and bus_path >= t_rst + t_settle + load_g \
+            else "settle + load (a pulse freezes its group's memory)"
+    want = _cycles(exposure_s, dclk_hz)
+    if want > lsb_min:
+        lsb_min, binds = want, "requested exposure"
+    # slack for other groups' pulses stealing row cycles during a load
+    slack = 0 if G == 1 else 4 * R
+    hide = t_rst + t_settle + load_g + slack
+    lsb = even(lsb_min)
+    for _ in range(100000):
+        if G == 1 or _lattice_ok(lsb, stagger, G, sep):
+            dark_gap = lsb * math.ceil((t_rst + t_settle + load_g + slack) / lsb)
+            p = Params(lsb=lsb, t_rst=t_rst, t_settle=t_settle, hide=hide, dark_gap=dark_gap,
+                       reset_mode=reset_mode, order=order, order_table=order_table, chain=chain,
+                       strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period)
+            fr = frame or Frame(0, depth)
+            r = simulate(dmd, p, [replace(fr, ready=0)] * 3, [ready_cycle(dmd, p, fr)], max_frames=2)
+            if r.late == 0:
+                break
+        lsb += max(2, even(lsb // 128))
+    else:
+        raise ValueError("no feasible schedule found")
+    if lsb > lsb_min and binds != "requested exposure":
+        binds += " + pulse spacing" if G > 1 else ""
+    frame_cycles = _frame_cycles(dmd, p, fr)
+    return Plan(p, frame_cycles, lsb_min, binds, dclk_hz)
+
+
+def ready_cycle(dmd, p, fr):
+    """First cycle at which a trigger strobe is obeyed after initialisation."""
+    r = simulate(dmd, p, [fr])
+    return max(st.loaded_at for st in r.groups)
+
+
+def _frame_cycles(dmd, p, fr):
+    """Shortest trigger-to-trigger period (triggered) or frame period (chained)."""
+    if p.chain:
+        r = simulate(dmd, p, [fr] * 4, [ready_cycle(dmd, p, fr)], max_frames=3)
+        return r.frame_starts[2] - r.frame_starts[1]
+    # trigger as soon as ready: find the first cycle a second strobe is obeyed
+    first = ready_cycle(dmd, p, fr)
+    lo, hi = first + 1, first + 1
+    while True:
+        r2 = simulate(dmd, p, [fr] * 3, [first, hi])
+        if len(r2.accepted) == 2:
+            break
+        lo, hi = hi, hi * 2
+    while lo < hi:
+        mid = (lo + hi) // 2
+        r2 = simulate(dmd, p, [fr] * 3, [first, mid])
+        if len(r2.accepted) == 2:
+            hi = mid
+        else:
+            lo = mid + 1
+    return hi - first
+
+
+def bound(dmd, dclk_hz, depth=8, *, t_rst_s=None, t_settle_s=None):
+    """Upper bound on the continuous-light PWM frame rate, any schedule: the least significant
+    plane lasts at least RST_ACTIVE + settle + one clear row cycle, and a frame is
+    ``2**depth - 1`` such units (DLPC410.md, "Derived bounds")."""
+    t_rst = (TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s) * dclk_hz
+    t_settle = (TIMING["t_settle"].value if t_settle_s is None else t_settle_s) * dclk_hz
+    t0 = t_rst + t_settle + dmd.clear_row_cycles * dmd.dclk_per_row
+    return dclk_hz / ((2 ** depth - 1) * t0)

@@ -1,0 +1,273 @@
+"""The sequencer in the Amaranth simulator (TEST_DMD): its command stream equals the schedule
+model's cycle for cycle, and every pixel receives exactly its grey level in LSB units."""
+
+import numpy as np
+import pytest
+
+from gateware.dlpc410 import prng_model, schedule
+from gateware.dlpc410.facts import TEST_DMD
+from gateware.dlpc410.params import PlaneOrder, ResetMode, Source, TriggerMode
+from gateware.dlpc410.trigger import PIN_TO_STROBE
+from sim.models import bitplane
+from sim.tb.plane_source import ramp_image
+from sim.tb.seq_sim import run_bench
+
+DMD = TEST_DMD
+#: RST_ACTIVE and settle scaled down (run-time parameters) so that frames simulate quickly.
+FAST = {"t_rst_s": 20 / 200e6, "t_settle_s": 30 / 200e6}
+
+
+def fast_plan(**kw):
+    return schedule.plan(DMD, 200e6, **FAST, **kw)
+
+
+def model_frames(frames, images):
+    out = []
+    for slot, depth in frames:
+        occ = None if images is None else \
+            tuple(int(x) for x in bitplane.occupancy(images[slot], DMD.rows_per_block))
+        out.append(schedule.Frame(slot, depth, occ))
+    return out
+
+
+def next_ready(p, frames, strobes):
+    """The first cycle a trigger is obeyed after the given strobes played out."""
+    r = schedule.simulate(DMD, p, frames, strobes)
+    return max(g.loaded_at for g in r.groups)
+
+
+def same_commands(run, model):
+    """Both command lists agree up to the end of the shorter run."""
+    horizon = run.status["now"] - 2 * DMD.dclk_per_row
+    got = [c for c in run.decoder.commands if c[0] < horizon]
+    assert got == [c for c in model.commands if c[0] < horizon]
+    return got
+
+
+def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), early_pins=(),
+          offered=None):
+    """Run gateware and model; assert equal commands, counters, and exact light per frame.
+    ``frames``: the frames expected on the DMD; ``offered``: what the store offers (default:
+    the same)."""
+    offered = frames if offered is None else offered
+    mframes = model_frames(offered, images)
+    if p.trigger == TriggerMode.SOFTWARE:
+        strobes = list(soft)
+    else:
+        strobes = [t + PIN_TO_STROBE for t in (sync_pins if p.trigger == TriggerMode.SYNC else pins)]
+    model = schedule.simulate(DMD, p, mframes, strobes)
+    end = max(c[0] for c in model.commands) + extra
+    run = run_bench(DMD, p, offered, images, pins=pins, soft=soft, sync_pins=sync_pins,
+                    early_pins=early_pins, cycles=end, name=name)
+    assert run.decoder.commands == model.commands
+    assert run.status["late"] == 0 == model.late
+    assert run.status["underruns"] == 0
+    assert run.status["overruns"] == model.overruns
+    assert run.status["triggers"] == len(model.accepted)
+    assert run.status["early"] == len(early_pins)
+    for k, light in enumerate(run.lights):
+        slot, depth = frames[min(k, len(frames) - 1)]
+        image = ramp_image(DMD, slot) if images is None else images[slot]
+        assert np.array_equal(light, (image.astype(np.int64) >> (8 - depth)) * p.lsb), f"frame {k}"
+    return run, model
+
+
+@pytest.mark.parametrize("mode,strict,order", [
+    (ResetMode.GLOBAL, True, PlaneOrder.MSB_FIRST),
+    (ResetMode.GLOBAL, True, PlaneOrder.LSB_FIRST),
+    (ResetMode.SINGLE, False, PlaneOrder.LSB_FIRST),
+    (ResetMode.DUAL, True, PlaneOrder.MSB_FIRST),
+    (ResetMode.QUAD, True, PlaneOrder.TABLE),
+])
+def test_every_level_exact(mode, strict, order, test_name):
+    """Ramp image (every grey level in every block), one frame: commands equal, light exact."""
+    p = fast_plan(reset_mode=mode, strict_rst=strict, order=order,
+                  order_table=(3, 7, 0, 5, 1, 6, 2, 4)).params
+    ready = next_ready(p, model_frames([(0, 8)], None), [])
+    run, _ = check(p, [(0, 8)], None, [ready + 10], test_name)
+    assert len(run.lights) == 1
+
+
+def test_random_images_every_depth_with_empty_blocks(test_name):
+    """Random images at bit depths 1..8 back to back (triggered as soon as ready); one slot has
+    empty blocks and empty planes, cleared instead of loaded."""
+    rng = np.random.default_rng(5)
+    a = rng.integers(0, 256, (DMD.rows, DMD.columns), dtype=np.uint8)
+    b = rng.integers(0, 256, (DMD.rows, DMD.columns), dtype=np.uint8) & 0b10110101
+    b[:DMD.rows_per_block] = 0
+    b[2 * DMD.rows_per_block:3 * DMD.rows_per_block] &= 0x0f
+    images = {0: a, 1: b}
+    frames = [(k % 2, depth) for k, depth in enumerate(range(1, 9))]
+    p = fast_plan(reset_mode=ResetMode.DUAL).params
+    mframes = model_frames(frames, images)
+    pins = []
+    for _ in frames:
+        pins.append(next_ready(p, mframes, [t + PIN_TO_STROBE for t in pins]) - PIN_TO_STROBE)
+    run, model = check(p, frames, images, pins, test_name)
+    assert len(run.lights) == len(frames)
+    # each slot is handed back when every group has moved to the next frame's slot
+    assert [s for _t, s in run.releases] == [k % 2 for k in range(len(frames) - 1)]
+    assert any(k == "clear" for _t, k, _a in model.commands[:200])
+
+
+def test_extremes_all_dark_all_bright(test_name):
+    """All-0 (every block empty: clears only) and all-255 (every block full), depth 8 and 1."""
+    shape = (DMD.rows, DMD.columns)
+    images = {0: np.zeros(shape, np.uint8), 1: np.full(shape, 255, np.uint8)}
+    frames = [(0, 8), (1, 8), (0, 1), (1, 1)]
+    p = fast_plan().params
+    mframes = model_frames(frames, images)
+    pins = []
+    for _ in frames:
+        pins.append(next_ready(p, mframes, [t + PIN_TO_STROBE for t in pins]) - PIN_TO_STROBE)
+    run, model = check(p, frames, images, pins, test_name)
+    assert len(run.lights) == 4
+    first_rows = [k for _t, k, _a in model.commands[:DMD.blocks]]
+    assert first_rows == ["clear"] * DMD.blocks
+
+
+def test_triggers(test_name):
+    """Before init ends, early, during a frame, a burst faster than frames, one cycle before the
+    next frame is ready and exactly when it is: counted right, never half-obeyed."""
+    p = fast_plan().params
+    frames = [(0, 4), (1, 0), (1, 4), (1, 9), (0, 4)]   # two frames with bad depths: dropped
+    mframes = model_frames(frames, None)
+    first = next_ready(p, mframes, []) - PIN_TO_STROBE
+    second = next_ready(p, mframes, [first + PIN_TO_STROBE]) - PIN_TO_STROBE
+    third = next_ready(p, mframes, [first + PIN_TO_STROBE, second + 7 + PIN_TO_STROBE]) - PIN_TO_STROBE
+    pins = [20,                                  # before the first plane is loaded: overrun
+            first, first + 300, first + 310, first + 320,   # a frame plays: burst of overruns
+            second - 1,                          # one cycle early: overrun
+            second + 7,                          # accepted (edge after the early one's pulse)
+            third]                               # exactly when ready: accepted
+    run, model = check(p, [f for f in frames if 1 <= f[1] <= 8], None, pins, test_name,
+                       early_pins=(3, 9), offered=frames)
+    assert model.overruns == 5 and len(model.accepted) == 3
+    assert run.status["frames"] == 3 and run.status["bad_frames"] == model.bad_frames == 2
+
+
+def test_sync_out_and_camera(test_name):
+    p = fast_plan().params
+    p.camera_offset, p.camera_width = 100, 7
+    ready = next_ready(p, model_frames([(0, 8)], None), [])
+    run, model = check(p, [(0, 8)], None, [ready], test_name)
+    pulses = [t for t, k, _a in model.commands if k == "pulse"]
+    assert run.sync_out == [(pulses[0], 1), (pulses[-1], 0)]
+    assert run.camera_out == [(pulses[0] + 1 + 100, 1), (pulses[0] + 1 + 107, 0)]
+
+
+@pytest.mark.parametrize("mode", [TriggerMode.PERIODIC, TriggerMode.SOFTWARE, TriggerMode.SYNC])
+def test_trigger_modes(mode, test_name):
+    p = fast_plan().params
+    p.trigger = mode
+    frames = [(0, 2), (1, 2)]
+    ready = next_ready(p, model_frames(frames, None), [])
+    if mode == TriggerMode.PERIODIC:
+        p.period = ready + 1
+        strobes = [k * p.period - 1 for k in range(1, 7)]
+        model = schedule.simulate(DMD, p, model_frames(frames, None), strobes, until=strobes[-1] - 4)
+        run = run_bench(DMD, p, frames, None, cycles=strobes[-1] - 4, name=test_name)
+        same_commands(run, model)
+        assert run.status["triggers"] == len(model.accepted) >= 2
+        assert run.status["overruns"] == model.overruns >= 1
+    elif mode == TriggerMode.SOFTWARE:
+        run, model = check(p, frames, None, [], test_name, soft=[ready, ready + 40])
+        assert run.status["triggers"] == 1 and run.status["overruns"] == 1
+    else:
+        run, model = check(p, frames, None, [ready], test_name, sync_pins=[ready + 50])
+        assert run.status["triggers"] == 1    # the TTL pin is ignored in sync mode
+
+
+def test_binary_prng_chain(test_name):
+    """1-bit Bernoulli frames back to back at the bus limit: the patterns the host rebuilds
+    from the seed are exactly the ones shown."""
+    p = fast_plan(depth=1, chain=True, source=Source.PRNG, reset_mode=ResetMode.SINGLE,
+                  strict_rst=False).params
+    ready = next_ready(p, [schedule.Frame(0, 1)], [])
+    model = schedule.simulate(DMD, p, [], [ready + PIN_TO_STROBE], until=ready + 6 * p.lsb)
+    run = run_bench(DMD, p, [], None, pins=[ready], cycles=ready + 6 * p.lsb, name=test_name,
+                    seed=0x1234)
+    commands = same_commands(run, model)
+    shown = prng_model.shown_patterns(DMD, commands, 0x1234)
+    pulses = [t for t, k, _a in commands if k == "pulse"]
+    assert len(pulses) >= 8
+    # the frame period is the bus limit: one full load per pattern
+    assert p.lsb == p.stagger * DMD.blocks
+    # the decoder's mirrors hold the last shown pattern, the host's rebuild of it
+    assert np.array_equal(run.decoder.mirrors, shown[-1])
+    assert not np.array_equal(shown[-1], prng_model.shown_patterns(DMD, commands, 0)[-1])
+
+
+def test_init_training_and_first_dvalid(test_name):
+    """Training pattern until ECP2_FINISHED is high and INIT_ACTIVE low; no command meanwhile;
+    the first DVALID at least 64 clocks after INIT_ACTIVE falls."""
+    from gateware.dlpc410.facts import BlockMode, RowMode
+    from gateware.dlpc410.init import TRAINING_FALL, TRAINING_RISE
+    from gateware.dlpc410.params import Registers
+    from sim.harness.amaranth_sim import simulate
+    from sim.tb.plane_source import SequencerBench
+
+    dut = SequencerBench(DMD, [(0, 8)])
+    p = fast_plan().params
+    seen = {"training": 0, "toggles": 0}
+
+    async def bench(ctx):
+        ctx.set(dut.regs, Registers.const(p.registers(DMD)))
+        last_dvalid = 0
+        for ecp2, init_active in ((0, 0), (0, 1), (1, 1)):
+            ctx.set(dut.pins.ecp2_finished, ecp2)
+            ctx.set(dut.pins.init_active, init_active)
+            for _ in range(30):
+                await ctx.tick()
+                pins = dut.pins
+                dvalid = ctx.get(pins.dvalid)
+                if ctx.get(dut.status.now) == 0 and ctx.get(pins.din_a.rise) == TRAINING_RISE \
+                        and ctx.get(pins.din_b.fall) == TRAINING_FALL:
+                    seen["training"] += 1
+                seen["toggles"] += dvalid != last_dvalid
+                last_dvalid = dvalid
+                assert ctx.get(pins.rowmd) == RowMode.NOOP and ctx.get(pins.blkmd) == BlockMode.NOOP
+        ctx.set(dut.pins.init_active, 0)
+        for cycle in range(1, 200):
+            await ctx.tick()
+            if ctx.get(dut.pins.dvalid) and ctx.get(dut.status.now) > 0:
+                assert cycle >= 64, f"first DVALID {cycle} clocks after INIT_ACTIVE fell"
+                seen["first"] = cycle
+                break
+
+    simulate(dut, [bench], name=test_name, clocks={"sync": 200e6})
+    assert seen["training"] >= 85 and seen["toggles"] >= 85
+    assert 64 <= seen["first"] < 80
+
+
+def test_binary_chain_from_memory(test_name):
+    """1-bit frames from the store back to back: each pattern is loaded behind the one shown."""
+    rng = np.random.default_rng(9)
+    images = {s: rng.integers(0, 256, (DMD.rows, DMD.columns), dtype=np.uint8) for s in (0, 1)}
+    frames = [(0, 1), (1, 1), (0, 1), (1, 1)]
+    p = fast_plan(depth=1, chain=True).params
+    mframes = model_frames(frames, images)
+    ready = next_ready(p, mframes, [])
+    until = ready + 5 * p.lsb
+    model = schedule.simulate(DMD, p, mframes, [ready + PIN_TO_STROBE], until=until)
+    run = run_bench(DMD, p, frames, images, pins=[ready], cycles=until, name=test_name)
+    commands = same_commands(run, model)
+    pulses = [t for t, k, _a in commands if k == "pulse"]
+    assert len(pulses) == 5 and set(np.diff(pulses)) == {p.lsb}
+    # the last pattern shown: frame 4 (slot 1) while it lasts, then the last frame repeats
+    assert np.array_equal(run.decoder.mirrors, images[1] >> 7)
+    assert run.status["frames"] == 5 and run.sync_out == [(pulses[0], 1)]
+
+
+def test_too_short_lsb_is_counted_late(test_name):
+    """A least significant plane shorter than the settle rule allows: the pulses come late
+    (never while RST_ACTIVE is high, never into a settling block), both gateware and model
+    count them, and the command streams still agree."""
+    p = fast_plan(depth=3).params
+    p.lsb -= 16
+    frames = [(0, 3)]
+    ready = next_ready(p, model_frames(frames, None), [])
+    model = schedule.simulate(DMD, p, model_frames(frames, None), [ready + PIN_TO_STROBE])
+    run = run_bench(DMD, p, frames, None, pins=[ready], cycles=model.commands[-1][0] + 50, name=test_name)
+    same_commands(run, model)
+    assert run.status["late"] == model.late > 0
