@@ -1,0 +1,173 @@
+"""The projector's core: every block from the GMII pins to the DLPC410 pins, no vendor primitive.
+
+Layers, as data flows through them (one banner each below):
+
+* MAC (``gmii_rx`` / ``gmii_tx``), crossed into ``sync`` by its FIFOs;
+* network stack and application protocol (``sync``);
+* bit-plane serialiser and the store's writer (``sync``), DDR2 through MCB port 0;
+* the store's slots and plane reader (``dmd``), MCB port 1;
+* the frame broker and the DLPC410 sequencer (``dmd``);
+* status: counters of every domain carried into ``sync`` for the status reply.
+
+The top that instantiates this defines the four clock domains and connects the MCB ports to the
+memory controller (platform) or the MCB model (simulation).
+"""
+
+from amaranth import Cat, DomainRenamer, Module, Signal
+from amaranth.lib import wiring
+from amaranth.lib.cdc import FFSynchronizer, PulseSynchronizer
+from amaranth.lib.wiring import In, Out
+
+from gateware.bitplane import Serialiser
+from gateware.dlpc410 import interface
+from gateware.dlpc410.params import Registers
+from gateware.dlpc410.sequencer import Sequencer
+from gateware.mac import gmii
+from gateware.mac.cdc import CountSynchronizer
+from gateware.mac.mdio import StatusPoller
+from gateware.mac.path import ReceivePath, TransmitPath
+from gateware.net.ingest import Ingest
+from gateware.store import mcb
+from gateware.store.store import Store
+
+from .broker import FrameBroker
+
+__all__ = ["Projector"]
+
+FRAME_BITS = 16
+
+
+class Projector(wiring.Component):
+    """The simulated core of the projector.
+
+    Parameters
+    ----------
+    dmd : DmdType
+    mac, ip, port : int
+        Network addresses at reset.
+    sync_hz : float
+        ``sync`` frequency (status replies report it; the PHY management derives MDC from it).
+    slots : int
+        Frame slots in DDR2.
+    mdio_cycles : tuple(int, int), optional
+        PHY reset and settle waits in ``sync`` cycles (simulations shorten them).
+
+    Members
+    -------
+    gmii_rx : In(gmii.RxPins)
+        PHY receive pins (``gmii_rx``).
+    gmii_tx : Out(gmii.TxPins)
+        PHY transmit pins (``gmii_tx``).
+    phy_reset_n, mdc, mdio_o, mdio_oe : Out(1); mdio_i : In(1)
+        PHY reset and management (``sync``).
+    mcb_write : Out(mcb.PortSignature())
+        MCB port 0 (``sync``).
+    mcb_read : Out(mcb.PortSignature())
+        MCB port 1 (``dmd``).
+    dlpc : Out(dlpc410.interface.Signature)
+        The DLPC410 applications interface (``dmd``).
+    trigger_in, sync_in : In(1)
+        TTL trigger and sync inputs (asynchronous).
+    sync_out, camera_out : Out(1)
+        Frame shown; camera trigger (``dmd``).
+    regs : In(Registers)
+        The sequencer's run-time parameters (``dmd``; held steady while frames play).
+    """
+
+    def __init__(self, dmd, *, mac, ip, port, sync_hz=125e6, slots=4, mdio_cycles=None):
+        self._dmd = dmd
+        self._addresses = dict(mac=mac, ip=ip, port=port)
+        self._sync_hz = sync_hz
+        self._slots = slots
+        self._mdio_cycles = mdio_cycles or (None, None)
+        super().__init__({
+            "gmii_rx": In(gmii.RxPins),
+            "gmii_tx": Out(gmii.TxPins),
+            "phy_reset_n": Out(1),
+            "mdc": Out(1),
+            "mdio_o": Out(1),
+            "mdio_oe": Out(1),
+            "mdio_i": In(1),
+            "mcb_write": Out(mcb.PortSignature()),
+            "mcb_read": Out(mcb.PortSignature()),
+            "dlpc": Out(interface.Signature(dmd.buses)),
+            "trigger_in": In(1),
+            "sync_in": In(1),
+            "sync_out": Out(1),
+            "camera_out": Out(1),
+            "regs": In(Registers),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        dmd = self._dmd
+
+        # ---- MAC: GMII in and out, FIFOs into and out of sync ------------------------------------
+        m.submodules.mac_rx = mac_rx = ReceivePath()
+        m.submodules.mac_tx = mac_tx = TransmitPath()
+        m.d.comb += [mac_rx.gmii.eq(self.gmii_rx), self.gmii_tx.eq(mac_tx.gmii)]
+
+        m.submodules.phy = phy = StatusPoller(self._sync_hz, reset_cycles=self._mdio_cycles[0],
+                                              settle_cycles=self._mdio_cycles[1])
+        m.d.comb += [
+            self.phy_reset_n.eq(phy.phy_reset_n), self.mdc.eq(phy.mdc),
+            self.mdio_o.eq(phy.mdio_o), self.mdio_oe.eq(phy.mdio_oe), phy.mdio_i.eq(self.mdio_i),
+        ]
+
+        # ---- Network stack and application protocol (sync) --------------------------------------
+        m.submodules.ingest = ingest = Ingest(dmd, frame_bits=FRAME_BITS, **self._addresses)
+        wiring.connect(m, mac_rx.frames, ingest.rx)
+        wiring.connect(m, ingest.tx, mac_tx.frames)
+
+        # ---- Bit-plane serialiser and the store (sync, then dmd) -------------------------------
+        m.submodules.serialiser = serialiser = Serialiser(dmd, lanes=1, frame_bits=FRAME_BITS)
+        wiring.connect(m, ingest.pixels, serialiser.pixels)
+        m.submodules.store = store = Store(dmd, slots=self._slots, frame_bits=FRAME_BITS)
+        wiring.connect(m, serialiser.words, store.words)
+        wiring.connect(m, serialiser.rows, store.rows)
+        m.d.comb += [
+            store.bit_depth.eq(ingest.settings.bit_depth),
+            store.sequence_length.eq(ingest.settings.sequence_length),
+        ]
+        wiring.connect(m, store.mcb_write, wiring.flipped(self.mcb_write))
+        wiring.connect(m, store.mcb_read, wiring.flipped(self.mcb_read))
+
+        # ---- Frame hand-over and the DLPC410 sequencer (dmd) ------------------------------------
+        m.submodules.broker = broker = DomainRenamer("dmd")(FrameBroker(dmd, slots=self._slots))
+        wiring.connect(m, broker.ask, store.ask)
+        wiring.connect(m, store.frames, broker.offered)
+        wiring.connect(m, broker.store_occupancy, store.occupancy)
+
+        m.submodules.sequencer = seq = DomainRenamer("dmd")(Sequencer(dmd))
+        wiring.connect(m, broker.frames, seq.frames)
+        m.d.comb += [seq.occupancy.eq(broker.occupancy), broker.occ_slot.eq(seq.occ_slot)]
+        wiring.connect(m, seq.requests, store.requests)
+        wiring.connect(m, store.planes, seq.words)
+        wiring.connect(m, seq.release, store.release)
+        wiring.connect(m, seq.pins, wiring.flipped(self.dlpc))
+        m.d.comb += [
+            seq.regs.eq(self.regs),
+            seq.trigger_in.eq(self.trigger_in),
+            seq.sync_in.eq(self.sync_in),
+            self.sync_out.eq(seq.sync_out),
+            self.camera_out.eq(seq.camera_out),
+        ]
+        m.submodules.soft_trigger = soft = PulseSynchronizer(i_domain="sync", o_domain="dmd")
+        m.d.comb += [soft.i.eq(ingest.trigger), seq.soft_trigger.eq(soft.o)]
+
+        # ---- Status: what the status reply reports, carried into sync ---------------------------
+        uptime = Signal(48)
+        m.d.sync += uptime.eq(uptime + 1)
+        m.d.comb += [ingest.status.uptime_cycles.eq(uptime), ingest.status.clock_hz.eq(int(self._sync_hz))]
+        for name, source in (("triggers", seq.status.triggers), ("trigger_overruns", seq.status.overruns),
+                             ("frames_shown", seq.status.frames)):
+            sync = m.submodules[f"{name}_cdc"] = CountSynchronizer(len(source), i_domain="dmd", o_domain="sync")
+            m.d.comb += [sync.i.eq(source), getattr(ingest.status, name).eq(sync.o)]
+        # dlpc410_state: bit 0 INIT_ACTIVE, 1 RST_ACTIVE, 2 ECP2_FINISHED, 3 DDR2 calibrated,
+        # 4 Ethernet link up, 5-6 link speed (2 = 1000 Mb/s)
+        state = Signal(4)
+        m.submodules.state_cdc = FFSynchronizer(
+            Cat(self.dlpc.init_active, self.dlpc.rst_active, self.dlpc.ecp2_finished, self.mcb_read.calib_done),
+            state)
+        m.d.comb += ingest.status.dlpc410_state.eq(Cat(state, phy.status.up, phy.status.speed))
+        return m
