@@ -43,7 +43,11 @@ def platform_top():
 def emit_platform(outdir):
     from gateware.platform import Board
     name, top = platform_top()
-    plan = Board().build(top, name=name, do_build=False)
+    extra = {}
+    if name == "projector":
+        from gateware.top.platform import UCF_EXTRA
+        extra["add_constraints"] = UCF_EXTRA
+    plan = Board().build(top, name=name, do_build=False, **extra)
     plan.extract(str(outdir))
     return name
 

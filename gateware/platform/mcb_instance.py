@@ -92,8 +92,8 @@ class McbInstance(wiring.Component):
         calibration = platform.request("ddr2_calibration", 0, dir="-")
         return {name: find(ddr2, calibration) for name, (_width, find) in _PINS.items()}
 
-    def elaborate(self, platform):
-        m = Module()
+    def instance_ports(self, platform):
+        """``Instance`` keyword arguments: ``i_``/``o_``/``io_`` + the wrapper's port names."""
         ports = {
             "i_c3_sys_clk": self.sys_clk,
             "i_c3_sys_rst_i": self.sys_rst,
@@ -118,8 +118,26 @@ class McbInstance(wiring.Component):
             })
             calib_done.append(port.calib_done)
         ports["o_c3_calib_done"] = calib_done[0]
-        m.d.comb += calib_done[1].eq(calib_done[0])
         for name, io in self._pins(platform).items():
             ports[f"io_{name}"] = io
+        return ports, calib_done
+
+    def elaborate(self, platform):
+        m = Module()
+        ports, calib_done = self.instance_ports(platform)
+        m.d.comb += calib_done[1].eq(calib_done[0])
         m.submodules.mcb = Instance(MODULE, **ports)
         return m
+
+    @classmethod
+    def blackbox_verilog(cls):
+        """A Verilog declaration of the generated wrapper's ports, for tools that read our
+        Verilog without the vendor's sources (the resource report)."""
+        ports, _ = cls().instance_ports(None)
+        kinds = {"i": "input", "o": "output", "io": "inout"}
+        lines = []
+        for key, value in ports.items():
+            kind, name = key.split("_", 1)
+            width = len(value)
+            lines.append(f"  {kinds[kind]} {f'[{width - 1}:0] ' if width > 1 else ''}{name}")
+        return f"(* blackbox *)\nmodule {MODULE} (\n" + ",\n".join(lines) + "\n);\nendmodule\n"

@@ -7,7 +7,7 @@ vendor primitives, and these adapters are checked by building the Spartan-6 tree
 
 from amaranth import ClockSignal, Elaboratable, Instance, Module, Signal
 from amaranth.lib import io
-from amaranth.lib.cdc import FFSynchronizer
+from amaranth.lib.cdc import FFSynchronizer, ResetSynchronizer
 
 from gateware.dlpc410.interface import Signature as Dlpc410Signature
 from gateware.mac.gmii import RxPins, TxPins
@@ -23,6 +23,11 @@ class GmiiPins(Elaboratable):
     forwards ``gmii_tx``'s clock to GTX_CLK through an ODDR2 so that it leaves the FPGA with the
     same delay as the data.
 
+    Parameters
+    ----------
+    locked : Signal
+        The PLL's lock: ``gmii_rx`` is held in reset until it is set.
+
     Attributes
     ----------
     rx : Signal(RxPins), in ``gmii_rx``
@@ -31,7 +36,8 @@ class GmiiPins(Elaboratable):
     mdio_i : Signal, to the core
     """
 
-    def __init__(self):
+    def __init__(self, locked):
+        self._locked = locked
         self.rx = Signal(RxPins)
         self.tx = Signal(TxPins)
         self.phy_reset_n = Signal()
@@ -46,6 +52,8 @@ class GmiiPins(Elaboratable):
 
         m.submodules.rx_clk = rx_clk = io.Buffer("i", pins.rx_clk)
         m.submodules.rx_bufg = Instance("BUFG", i_I=rx_clk.i, o_O=ClockSignal("gmii_rx"))
+        platform.add_clock_constraint(rx_clk.i, 125e6)
+        m.submodules.rx_rst = ResetSynchronizer(~self._locked, domain="gmii_rx")
         for name, port, target in (("rx_data", pins.rx_data, self.rx.d), ("rx_dv", pins.rx_dv, self.rx.dv),
                                    ("rx_er", pins.rx_er, self.rx.er)):
             m.submodules[name] = buf = io.FFBuffer("i", port, i_domain="gmii_rx")
