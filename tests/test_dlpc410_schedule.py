@@ -104,17 +104,10 @@ def test_prng_patterns_follow_commands():
 
 @pytest.mark.parametrize("dmd", [TEST_DMD, XGA, DMDS["dlp9500"]])
 def test_pulse_encodings_decode_to_their_groups(dmd):
-    """The model's block commands and the decoder's reading of them agree for every group."""
-    from sim.models.dlpc410_commands import pulse_blocks
+    """The model's block commands and the DLPC410 model's reading of them agree for every group."""
+    from sim.models.dlpc410 import Dlpc410
+    controller = Dlpc410(dmd)
     for mode in ResetMode:
         for g, blocks in enumerate(schedule.groups(dmd, mode)):
-            assert pulse_blocks(dmd, *schedule.pulse_encoding(dmd, mode, g)) == tuple(blocks)
-
-
-def test_decoder_rejects_a_broken_row_cycle():
-    from sim.models.dlpc410_commands import CommandDecoder
-    lanes = {(b, e): 0 for b in "AB" for e in ("rise", "fall")}
-    dec = CommandDecoder(XGA)
-    dec.step(0, 1, 0b10, 5, 0, 0, 1, lanes)
-    with pytest.raises(AssertionError):
-        dec.step(1, 0, 0, 0, 0, 0, 1, lanes)
+            _kind, got = controller.block_command(*schedule.pulse_encoding(dmd, mode, g))
+            assert got == tuple(blocks)

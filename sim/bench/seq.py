@@ -36,7 +36,7 @@ def trigger_latencies():
             pin = ready + phase
             run = run_bench(TEST_DMD, p, frames, pins=[pin], cycles=pin + 40, name=f"bench_latency_{phase}",
                             )
-            pulse = next(t for t, kind, _a in run.decoder.commands if kind == "pulse")
+            pulse = next(t for t, kind, _a in run.commands if kind == "pulse")
             lat.append(pulse + 1 - pin)
         out[newer] = lat
     return out
@@ -51,7 +51,7 @@ def gateware_binary_period():
     ready = max(g.loaded_at for g in schedule.simulate(TEST_DMD, p, [schedule.Frame(0, 1)]).groups)
     run = run_bench(TEST_DMD, p, [], pins=[ready - PIN_TO_STROBE], cycles=ready + 8 * p.lsb,
                     name="bench_binary_period")
-    starts = [t for t, kind, blocks in run.decoder.commands if kind == "pulse" and 0 in blocks]
+    starts = [t for t, kind, blocks in run.commands if kind == "pulse" and 0 in blocks]
     return starts[-1] - starts[-2], plan.frame_cycles
 
 
