@@ -137,6 +137,7 @@ def write_gray_error(rows):
     for ax, what in zip(axes, ("max", "RMS"), strict=True):
         ax.set_xscale("log")
         ax.set_yscale("symlog", linthresh=0.01)
+        ax.set_ylim(bottom=0)
         ax.set_xlabel("frame period (ms, 200 MHz DCLK)")
         ax.set_ylabel(f"{what} grey error (LSB)")
         ax.grid(True, which="both", alpha=0.3)
