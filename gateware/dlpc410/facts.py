@@ -46,9 +46,10 @@ TIMING = {
                                   "first DVALID at least this many clocks after INIT_ACTIVE falls"),
     "global_overhead": Fact(13.5e-6, "s", "DLPU040C table 1-1, derived", "medium",
                             "per-frame overhead of global-reset binary patterns"),
-    "training_pattern": Fact(0xFFFF0000, "rise/fall bits", "DLP7000 8.3 (shape assumed)", "low",
-                             "during initialisation every data pin and DVALID toggle: 0 on the rising "
-                             "edge, 1 on the falling edge of each DCLK; confirm on hardware"),
+    "training_pattern": Fact(0b0100, "bits per 4 edges", "DLPC410 datasheet (training pattern)", "high",
+                             "during initialisation every data pin and DVALID repeat 0100 over four "
+                             "DDR edges (two DCLK cycles; the DLPC410 aligns to any phase): rising 0, "
+                             "falling 1, rising 0, falling 0. Written MSB first: edge 0 is bit 3"),
     "t_pwr_float": Fact(300e-6, "s", "DLPC410", "medium", "mirror parking after PWR_FLOAT"),
     "t_watchdog": Fact(10.0, "s", "DLPC410", "medium", "WDT_ENBLZ low: forced reset if none issued"),
     "dclk_min": Fact(200e6, "Hz", "DLP7000 table 8-2", "high"),

@@ -2,8 +2,9 @@
 
 After ARSTZ rises the DLPC410 configures itself (ECP2_FINISHED rises) and initialises the DMD
 (INIT_ACTIVE high, about 220 ms, DLP7000 8.3). INIT_ACTIVE is read only once ECP2_FINISHED is
-high (DLPC910). Until then the applications FPGA sends the training pattern on every data pin
-and DVALID and no command. ``running`` rises once ECP2_FINISHED is high and INIT_ACTIVE low,
+high (DLPC910). Until then the applications FPGA sends the training pattern (DLPC410 datasheet:
+``0100`` repeating over four DDR edges, that is two DCLK cycles) on every data pin and DVALID,
+and no command. ``running`` rises once ECP2_FINISHED is high and INIT_ACTIVE low,
 and stays high; the sequencer then keeps DVALID low for at least ``init_to_dvalid`` clocks
 (see :mod:`gateware.dlpc410.schedule`).
 """
@@ -15,12 +16,12 @@ from amaranth.lib.wiring import In, Out
 
 from .facts import TIMING
 
-__all__ = ["Init", "TRAINING_RISE", "TRAINING_FALL"]
+__all__ = ["Init", "TRAINING_EDGES"]
 
 _pattern = int(TIMING["training_pattern"].value)
-#: Training pattern bits of each pin on the rising and on the falling DCLK edge.
-TRAINING_RISE = _pattern & 0xffff
-TRAINING_FALL = _pattern >> 16
+#: The training pattern's bit on each of its four DDR edges (rising, falling, rising, falling:
+#: two DCLK cycles), the same on every data pin and on DVALID.
+TRAINING_EDGES = tuple((_pattern >> (3 - k)) & 1 for k in range(4))
 
 
 class Init(wiring.Component):

@@ -434,7 +434,9 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     lsb = even(lsb_min)
     for _ in range(100000):
         if G == 1 or _lattice_ok(lsb, stagger, G, sep):
-            dark_gap = lsb * math.ceil((t_rst + t_settle + load_g + slack) / lsb)
+            # phased: on the LSB lattice that keeps groups' pulses apart; global: no lattice
+            reload = t_rst + t_settle + load_g + slack
+            dark_gap = even(reload) if G == 1 else lsb * math.ceil(reload / lsb)
             p = Params(lsb=lsb, t_rst=t_rst, t_settle=t_settle, hide=hide, dark_gap=dark_gap,
                        reset_mode=reset_mode, order=order, order_table=order_table, chain=chain,
                        strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period)

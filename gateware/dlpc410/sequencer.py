@@ -25,7 +25,7 @@ from gateware.store.layouts import SLOT_BITS, FrameInfo, PlaneRequest
 from . import interface
 from .beat import LANES
 from .facts import BlockMode, RowMode
-from .init import TRAINING_FALL, TRAINING_RISE, Init
+from .init import TRAINING_EDGES, Init
 from .params import TIME_BITS, PlaneOrder, Registers, ResetMode, Source
 from .prng import Prng
 from .schedule import INIT_TO_DVALID
@@ -484,10 +484,14 @@ class Sequencer(wiring.Component):
         m.d.comb += [pins.arstz.eq(1), pins.wdt_enblz.eq(1), pins.comp_data.eq(0),
                      pins.ns_flip.eq(regs.ns_flip), pins.pwr_float.eq(regs.park)]
         with m.If(init.training):
+            # the four edges of the pattern over two cycles; DVALID (one bit per cycle in the
+            # core) carries the falling-edge bits, the platform layer's DDR output the rest
+            rise = Mux(toggle, TRAINING_EDGES[2], TRAINING_EDGES[0])
+            fall = Mux(toggle, TRAINING_EDGES[3], TRAINING_EDGES[1])
             for bus in "ab":
-                m.d.comb += [getattr(pins, f"din_{bus}").rise.eq(TRAINING_RISE),
-                             getattr(pins, f"din_{bus}").fall.eq(TRAINING_FALL)]
-            m.d.comb += [pins.dvalid.eq(toggle), pins.rst2blkz.eq(1)]
+                m.d.comb += [getattr(pins, f"din_{bus}").rise.eq(rise.replicate(16)),
+                             getattr(pins, f"din_{bus}").fall.eq(fall.replicate(16))]
+            m.d.comb += [pins.dvalid.eq(fall), pins.rst2blkz.eq(1)]
         with m.Else():
             for bus, edge, lsb in LANES:
                 m.d.comb += getattr(getattr(pins, f"din_{bus.lower()}"), edge).eq(word[lsb:lsb + 16])

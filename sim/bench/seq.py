@@ -7,12 +7,32 @@ the model's cycle for cycle (``tests/test_dlpc410_sequencer.py`` on the test DMD
 mode, ``tests/test_dlpc410_sequencer_verilog.py`` on full XGA, global and single-block), and
 :func:`gateware_binary_period` re-measures one rate on the gateware here.
 Each figure is given in cycles or Hz at 200 MHz DCLK, and again at 400 MHz (``_400mhz``).
+
+Grey error (:func:`gray_error_table`): the schedule model's global MSB-first 8-bit frame of the
+ramp image on the DLP7000 (the case the cocotb test proves equal to the gateware, command for
+command and pixel for pixel, on full XGA) is played through the rule-checking DLPC410 model
+with the facts' RST_ACTIVE and settle times (so every plan is also checked against every rule),
+and the camera model (4 us crossover ramp) integrates a window as long as the frame's light
+(first pulse to the end of the last mirror motion), shifted by a misalignment from the first
+pulse. LSB times from the shortest legal one up to 16 times it; ``build/seq_gray_error.csv``
+and ``build/seq_gray_error.png``. ``seq.gray_error_lsb_at_max_rate_phased``: the same at the
+fastest single-block plan (loose RST_ACTIVE reading, the phased mode the cocotb test runs on
+XGA), window holding the frame.
 """
+
+import csv
+
+import numpy as np
 
 from gateware.dlpc410 import schedule
 from gateware.dlpc410.facts import DMDS, TEST_DMD
 from gateware.dlpc410.params import ResetMode, Source
 from gateware.dlpc410.trigger import PIN_TO_STROBE
+from sim.harness.paths import build_dir
+from sim.models.camera import Camera, to_lsb
+from sim.models.dlpc410 import Dlpc410
+from sim.models.dlpc410_driver import Driver, play_schedule
+from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import run_bench
 
 XGA = DMDS["dlp7000"]
@@ -36,7 +56,7 @@ def trigger_latencies():
             pin = ready + phase
             run = run_bench(TEST_DMD, p, frames, pins=[pin], cycles=pin + 40, name=f"bench_latency_{phase}",
                             )
-            pulse = next(t for t, kind, _a in run.decoder.commands if kind == "pulse")
+            pulse = next(t for t, kind, _a in run.commands if kind == "pulse")
             lat.append(pulse + 1 - pin)
         out[newer] = lat
     return out
@@ -51,12 +71,110 @@ def gateware_binary_period():
     ready = max(g.loaded_at for g in schedule.simulate(TEST_DMD, p, [schedule.Frame(0, 1)]).groups)
     run = run_bench(TEST_DMD, p, [], pins=[ready - PIN_TO_STROBE], cycles=ready + 8 * p.lsb,
                     name="bench_binary_period")
-    starts = [t for t, kind, blocks in run.decoder.commands if kind == "pulse" and 0 in blocks]
+    starts = [t for t, kind, blocks in run.commands if kind == "pulse" and 0 in blocks]
     return starts[-1] - starts[-2], plan.frame_cycles
+
+
+#: LSB times of the grey-error sweep, as multiples of the shortest legal one.
+LSB_FACTORS = (1, 1.5, 2, 4, 8, 16)
+#: Camera window start minus the frame's first pulse, in microseconds.
+MISALIGN_US = (-5, -1, 0, 1, 5, 20)
+#: The misalignment of the ``seq.gray_error_rms_lsb_misaligned_<n>us`` figure.
+MISALIGN_FIGURE_US = 1
+
+
+def played_frame(plan, dclk=200e6):
+    """One triggered frame of ``plan`` (schedule model) played through the DLPC410 model: the
+    model, the frame's first and last pulse cycles, and the image shown."""
+    p = plan.params
+    frame = schedule.Frame(0, 8)
+    result = schedule.simulate(XGA, p, [frame], [schedule.ready_cycle(XGA, p, frame)])
+    model = Dlpc410(XGA, dclk=dclk, init_cycles=16, strict_rst_active=p.strict_rst)
+    driver = Driver(XGA)
+    driver.start(16)
+    image = ramp_image(XGA, 0)
+    play_schedule(driver, XGA, p, result, {0: image}, model.ecp2_cycles + 16)
+    model.run(driver.items)
+    pulses = [c.cycle for c in model.log if c.kind == "pulse"]
+    return model, pulses[0], pulses[-1], image
+
+
+def gray_error_table(dclk=200e6):
+    """Rows of (lsb cycles, frame cycles, rate Hz, misalignment us, max LSB, RMS LSB)."""
+    fastest = schedule.plan(XGA, dclk)
+    rows = []
+    for factor in LSB_FACTORS:
+        plan = fastest if factor == 1 else schedule.plan(
+            XGA, dclk, exposure_s=factor * fastest.params.lsb / dclk)
+        model, first, last, image = played_frame(plan, dclk)
+        camera = Camera(model)
+        span = last + camera.delay + camera.ramp - first
+        for us in MISALIGN_US:
+            t0 = first + round(us * 1e-6 * dclk)
+            seen = to_lsb(camera.image(t0, t0 + span), plan.params.lsb)
+            err = seen - image[:, :XGA.visible_columns]
+            rows.append((plan.params.lsb, plan.frame_cycles, plan.rate_hz, us,
+                         float(np.abs(err).max()), float(np.sqrt(np.mean(err ** 2)))))
+    return rows
+
+
+def write_gray_error(rows):
+    """``build/seq_gray_error.csv`` and the plot ``build/seq_gray_error.png``."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = build_dir()
+    with open(out / "seq_gray_error.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["lsb_cycles", "frame_cycles", "rate_hz", "misalign_us", "max_lsb", "rms_lsb"])
+        for r in rows:
+            w.writerow([r[0], r[1], f"{r[2]:.3f}", r[3], f"{r[4]:.4f}", f"{r[5]:.4f}"])
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharex=True)
+    for us in MISALIGN_US:
+        pts = [(r[1] / 200e3, r[4], r[5]) for r in rows if r[3] == us]
+        period = [x[0] for x in pts]
+        axes[0].plot(period, [x[1] for x in pts], "o-", label=f"{us:+g} us")
+        axes[1].plot(period, [x[2] for x in pts], "o-", label=f"{us:+g} us")
+    for ax, what in zip(axes, ("max", "RMS"), strict=True):
+        ax.set_xscale("log")
+        ax.set_yscale("symlog", linthresh=0.01)
+        ax.set_ylim(bottom=0)
+        ax.set_xlabel("frame period (ms, 200 MHz DCLK)")
+        ax.set_ylabel(f"{what} grey error (LSB)")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[1].legend(title="camera misalignment")
+    fig.suptitle("DLP7000 8-bit global PWM: camera grey error against frame period")
+    fig.tight_layout()
+    fig.savefig(out / "seq_gray_error.png", dpi=100)
+    plt.close(fig)
+
+
+def gray_error_figures():
+    rows = gray_error_table()
+    write_gray_error(rows)
+    lsb_min = min(r[0] for r in rows)
+    at_max = [r for r in rows if r[0] == lsb_min]
+    aligned = next(r for r in at_max if r[3] == 0)
+    off = next(r for r in at_max if r[3] == MISALIGN_FIGURE_US)
+    # phased (single-block pulses, loose RST_ACTIVE reading: the cocotb test's mode on XGA)
+    phased = schedule.plan(XGA, 200e6, reset_mode=ResetMode.SINGLE, strict_rst=False)
+    model, first, last, image = played_frame(phased)
+    camera = Camera(model)
+    seen = to_lsb(camera.image(first, last + camera.delay + camera.ramp), phased.params.lsb)
+    return {
+        "seq.gray_error_lsb_at_max_rate_phased": (float(np.abs(seen - image).max()), "LSB"),
+        "seq.gray_error_lsb_at_max_rate": (aligned[4], "LSB"),
+        "seq.gray_error_rms_lsb_at_max_rate": (aligned[5], "LSB"),
+        f"seq.gray_error_rms_lsb_misaligned_{MISALIGN_FIGURE_US}us": (off[5], "LSB"),
+        f"seq.gray_error_max_lsb_misaligned_{MISALIGN_FIGURE_US}us": (off[4], "LSB"),
+        "seq.gray_error_rate_hz_at_max_rate": (aligned[2], "Hz"),
+    }
 
 
 def run():
     figures = {}
+    figures.update(gray_error_figures())
     lat = trigger_latencies()
     typical = sorted(lat[False])[len(lat[False]) // 2]
     worst = max(lat[False] + lat[True])

@@ -549,6 +549,22 @@ class Dlpc410:
                 out[b * rpb:(b + 1) * rpb] = done[-1]
         return out
 
+    # --- the log as the schedule model speaks it -----------------------------------------------
+
+    def commands(self, shift=0):
+        """:attr:`log` as the command tuples of :mod:`gateware.dlpc410.schedule`:
+        ``(cycle + shift, "row", row)``, ``(.., "clear", block)`` and ``(.., "pulse", blocks)``,
+        in cycle order (``shift`` maps model cycles to the sequencer's time base)."""
+        out = []
+        for cmd in sorted(self.log, key=lambda cmd: cmd.cycle):
+            arg = {"row": cmd.row, "clear": cmd.blocks[0], "pulse": cmd.blocks}[cmd.kind]
+            out.append((cmd.cycle + shift, cmd.kind, arg))
+        return out
+
+    def block_command(self, blkmd, blkad, rst2blkz):
+        """``(kind, blocks)`` a block command with these pins addresses (RuleBreak if none)."""
+        return self._blocks(self.cycle, BlockMode(blkmd), blkad, rst2blkz)
+
     # --- helpers -------------------------------------------------------------------------------
 
     def _block_rows(self, block):

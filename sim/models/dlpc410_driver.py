@@ -142,3 +142,46 @@ class Driver:
             "global": (BlockMode.MULTI, 0b1000, 1),
         }[kind]
         return self.row(blkmd=blkmd, blkad=blkad, rst2blkz=rst2blkz)
+
+
+def play_schedule(driver, dmd, p, result, images, offset):
+    """Append the command stream of a :func:`gateware.dlpc410.schedule.simulate` ``result`` to
+    ``driver``: schedule cycle ``t`` becomes driver cycle ``t + offset`` (asserted, so a gap the
+    schedule leaves odd or too short shows here). Each row carries the plane its group's next
+    pulse shows (``images[frame index]``, 8-bit; zeros after the group's last pulse); dark pulses
+    show cleared blocks."""
+    from gateware.dlpc410.schedule import groups, pulse_encoding
+
+    grp = groups(dmd, p.reset_mode)
+    group_of = {b: g for g, blocks in enumerate(grp) for b in blocks}
+    pulses = {g: [(t, fi, e) for t, gg, _kind, fi, e in result.pulses if gg == g] for g in range(len(grp))}
+    seen = [0] * len(grp)                       # pulses of each group issued so far
+    planes = {}
+
+    def plane(fi, e):
+        if (fi, e) not in planes:
+            depth = result.shown[fi].depth
+            planes[fi, e] = (np.asarray(images[fi]) >> (8 - depth + e)) & 1
+        return planes[fi, e]
+
+    for t, kind, arg in result.commands:
+        driver.wait_until(t + offset)
+        if kind == "pulse":
+            g = group_of[arg[0]]
+            blkmd, blkad, rst2blkz = pulse_encoding(dmd, p.reset_mode, g)
+            start = driver.row(blkmd=blkmd, blkad=blkad, rst2blkz=rst2blkz)
+            seen[g] += 1
+        elif kind == "clear":
+            start = driver.clear(arg)
+        elif kind == "row":
+            g = group_of[dmd.block_of_row(arg)]
+            # rows loaded after the result's last pulse of the group are never shown: zeros
+            bits = None
+            if seen[g] < len(pulses[g]):
+                _t, fi, e = pulses[g][seen[g]]
+                assert e is not None, f"row {arg} loaded for a dark pulse"
+                bits = plane(fi, e)[arg]
+            start = driver.row(RowMode.ADDRESSED, rowad=arg, bits=bits)
+        else:
+            start = driver.row()
+        assert start == t + offset, f"{kind} at schedule cycle {t} lands on {start - offset}"

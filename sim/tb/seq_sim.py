@@ -1,104 +1,131 @@
-"""Run the sequencer bench in the Amaranth simulator: a DLPC410 stand-in, triggers, a decoder.
+"""Run the sequencer bench in the Amaranth simulator under the rule-checking DLPC410 model.
 
-The stand-in holds ECP2_FINISHED high, INIT_ACTIVE high for ``init_cycles`` and raises
-RST_ACTIVE for ``rst_high`` cycles after each clocking pulse (``rst_high`` must not exceed the
-``t_rst`` parameter less :data:`~gateware.dlpc410.schedule.RST_MARGIN`, as the plan
-assumes). Everything else is recorded by a
-:class:`sim.models.dlpc410_commands.CommandDecoder` in the sequencer's time base
-(``status.now``; a command's cycle is its decision cycle, one before the pins show it).
+:class:`sim.models.dlpc410.Dlpc410` plays the controller (:func:`dlpc410_for`): it drives
+ECP2_FINISHED, INIT_ACTIVE (checking the training pattern meanwhile) and RST_ACTIVE, decodes
+every row cycle, keeps the DMD's memory and mirrors, and raises
+:class:`~sim.models.dlpc410.RuleBreak` on the first broken rule. Its RST_ACTIVE time and settle
+time are the plan's ``t_rst_s`` and ``t_settle_s`` (the facts, or the scaled-down values of a
+test), so the sequencer's parameters are checked against the times they were planned for.
+
+The model's command log, moved to the sequencer's time base (``status.now``; a command's cycle
+is its decision cycle, one before the pins show it), is what the tests compare with the schedule
+model; the model's mirror history feeds the camera model (:func:`frame_lights`).
 """
 
 from dataclasses import dataclass, field
 
-from gateware.dlpc410.facts import BlockMode
 from gateware.dlpc410.params import Registers
 from gateware.dlpc410.schedule import RST_MARGIN
 from sim.harness.amaranth_sim import simulate
-from sim.models.dlpc410_commands import CommandDecoder
+from sim.models.camera import Camera
+from sim.models.dlpc410 import Dlpc410, amaranth_process
 from sim.tb.plane_source import SequencerBench
 
-__all__ = ["Run", "run_bench"]
+__all__ = ["Run", "run_bench", "dlpc410_for", "frame_lights", "INIT_CYCLES", "INIT_GRACE",
+           "CAMERA_RAMP", "CAMERA_DELAY"]
+
+#: INIT_ACTIVE high this long after ARSTZ rises (the 220 ms of the facts, shortened).
+INIT_CYCLES = 20
+#: The training pattern runs on while the sequencer's two-flip-flop synchroniser sees
+#: INIT_ACTIVE fall, and the cycle its ``running`` flag needs.
+INIT_GRACE = 4
+#: Camera mirror transition on the scaled-down test timing (the facts' 4 us crossover scaled as
+#: RST_ACTIVE is in the tests), and the delay from the pulse to the start of the motion.
+CAMERA_RAMP = 16
+CAMERA_DELAY = 4
 
 
 @dataclass
 class Run:
-    decoder: CommandDecoder
+    model: Dlpc410
+    shift: int = 0                                   # sequencer time base = model cycle + shift
+    commands: list = field(default_factory=list)     # the model's log in the sequencer's time base
     status: dict = field(default_factory=dict)
     sync_out: list = field(default_factory=list)     # (now, level) at each change
     camera_out: list = field(default_factory=list)
-    lights: list = field(default_factory=list)       # light taken at each sync_out fall
     releases: list = field(default_factory=list)     # (now, slot) handed back
+    lights: list = field(default_factory=list)       # camera images of the frames (frame_lights)
+
+    def frames(self):
+        """``(first, last)`` model cycles of each shown frame: sync out rising and falling."""
+        rises = [t + 1 - self.shift for t, level in self.sync_out if level]
+        falls = [t + 1 - self.shift for t, level in self.sync_out if not level]
+        return list(zip(rises, falls, strict=False))
 
 
-def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, name, init_cycles=20,
-              rst_high=None, early_pins=(), sync_pins=(), seed=None):
-    """``pins``: ``now`` values at which the trigger pin rises (high for 4 cycles);
-    ``early_pins``: testbench cycles (before initialisation ends) of extra rising edges."""
+def dlpc410_for(dmd, p, *, dclk=200e6, init_cycles=INIT_CYCLES, ecp2_cycles=4):
+    """The rule model with the RST_ACTIVE and settle times ``p`` (schedule Params) was planned
+    for: ``t_rst`` covers RST_ACTIVE plus :data:`~gateware.dlpc410.schedule.RST_MARGIN`."""
+    return Dlpc410(dmd, dclk=dclk, rst_active_cycles=p.t_rst - RST_MARGIN, settle_cycles=p.t_settle,
+                   init_cycles=init_cycles, init_grace_cycles=INIT_GRACE, ecp2_cycles=ecp2_cycles,
+                   strict_rst_active=p.strict_rst)
+
+
+def frame_lights(model, frames, *, ramp=CAMERA_RAMP, delay=CAMERA_DELAY):
+    """The camera's image of each frame (light in cycles, every column); ``frames``: ``(first,
+    last)`` model cycles of its first and last pulse. The window holds the frame: from its
+    first pulse to the end of the last pulse's mirror motion."""
+    camera = Camera(model, ramp_cycles=ramp, delay_cycles=delay, visible=False)
+    return [camera.image(first, last + delay + ramp) for first, last in frames]
+
+
+def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, name,
+              early_pins=(), sync_pins=(), seed=None, model=None):
+    """Run until the sequencer's time base reaches ``cycles``.
+
+    ``pins``: ``now`` values at which the trigger pin rises (high for 4 cycles); ``early_pins``:
+    testbench cycles (before initialisation ends) of extra rising edges. ``model``: the
+    controller (default :func:`dlpc410_for`)."""
     dut = SequencerBench(dmd, frames, images)
     regs = Registers.const(params.registers(dmd))
-    run = Run(CommandDecoder(dmd))
-    rst_high = params.t_rst - RST_MARGIN if rst_high is None else rst_high
+    model = dlpc410_for(dmd, params) if model is None else model
+    run = Run(model)
     pins, soft, sync_pins = set(pins), set(soft), set(sync_pins)
 
     async def bench(ctx):
         ctx.set(dut.regs, regs)
         ctx.set(dut.release.ready, 1)
-        ctx.set(dut.pins.ecp2_finished, 1)
-        ctx.set(dut.pins.init_active, 1)
+        tick = 0                      # the model's cycle of the sampled values
         if seed is not None:
             ctx.set(dut.seed, seed)
             ctx.set(dut.reseed, 1)
             await ctx.tick()
+            tick += 1
             ctx.set(dut.reseed, 0)
-        rst_left = 0
-        high_left = 0
-        sync_left = 0
+        high_left = sync_left = 0
         last_sync = last_cam = 0
-        p = dut.pins
-        sigs = (dut.status.now, p.dvalid, p.rowmd, p.rowad, p.blkmd, p.blkad, p.rst2blkz,
-                p.din_a.rise, p.din_b.rise, p.din_a.fall, p.din_b.fall,
-                dut.sync_out, dut.camera_out, dut.release.valid, dut.release.payload)
-        for i in range(init_cycles):
-            ctx.set(dut.trigger_in, i in early_pins)
-            await ctx.tick()
-        ctx.set(dut.trigger_in, 0)
-        ctx.set(dut.pins.init_active, 0)
-        running = False
-        for _ in range(cycles):
-            values = await ctx.tick().sample(*sigs)
-            now, dv, rowmd, rowad, blkmd, blkad, r2, ar, br, af, bf, so, co, rv, rs = values[2:]
-            if rv:
-                run.releases.append((now, rs))
-            running = running or now > 0
+        sigs = (dut.status.now, dut.sync_out, dut.camera_out, dut.release.valid, dut.release.payload)
+        now = 0
+        while now < cycles:
+            now, so, co, rv, rs = (await ctx.tick().sample(*sigs))[2:]
+            running = now > 0
             if running:
-                lanes = {("A", "rise"): ar, ("B", "rise"): br, ("A", "fall"): af, ("B", "fall"): bf}
-                run.decoder.step(now - 1, dv, rowmd, rowad, blkmd, blkad, r2, lanes)
-                if dv and blkmd in (BlockMode.RESET, BlockMode.MULTI) and run.decoder._beat == 1:
-                    rst_left = rst_high
+                run.shift = now - tick
+                if rv:
+                    run.releases.append((now, rs))
                 if so != last_sync:
                     run.sync_out.append((now - 1, so))
-                    if not so:
-                        run.lights.append(run.decoder.take_light())
                     last_sync = so
                 if co != last_cam:
                     run.camera_out.append((now, co))
                     last_cam = co
+            tick += 1
             # inputs for the next cycle, in the time base of the next cycle (now + 1)
-            nxt = now + 1 if running else 0
+            nxt = now + 1 if running else None
             if nxt in pins:
                 high_left = 4
             if nxt in sync_pins:
                 sync_left = 4
-            ctx.set(dut.trigger_in, high_left > 0)
+            ctx.set(dut.trigger_in, high_left > 0 or (not running and tick in early_pins))
             ctx.set(dut.sync_in, sync_left > 0)
             ctx.set(dut.soft_trigger, nxt in soft)
             high_left = max(0, high_left - 1)
             sync_left = max(0, sync_left - 1)
-            ctx.set(dut.pins.rst_active, rst_left > 0)
-            rst_left = max(0, rst_left - 1)
         st = ctx.get(dut.status)
         run.status = {k: int(getattr(st, k)) for k in
                       ("now", "frames", "triggers", "overruns", "early", "late", "underruns", "bad_frames")}
 
-    simulate(dut, [bench], name=name, clocks={"sync": 200e6})
+    process = amaranth_process(model, dut.pins)
+    simulate(dut, [bench], name=name, clocks={"sync": 200e6}, processes=[process])
+    run.commands = model.commands(run.shift - 1)
     return run
