@@ -16,7 +16,7 @@ def system_params(dmd, **overrides):
     p = {"dmd": dmd, "mac": "02:00:00:00:00:01", "ip": "10.0.0.2", "port": PORT,
          "memory_bytes": 4 * 2**20, "t_rst": 40, "t_settle": 60, "init_cycles": 200,
          "init_grace": 4, "mode": "GLOBAL", "order": "MSB_FIRST", "frames": 1, "seed": 1,
-         "settle_after_send": 3000, "check_training": False}
+         "settle_after_send": 3000}
     p.update(overrides)
     return p
 
