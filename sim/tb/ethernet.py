@@ -48,7 +48,9 @@ class Bench:
         for driver in (self.source, self.sink):
             if driver:
                 driver.log.setLevel(logging.WARNING)  # not every frame in the log
-        self.layout = pixel_layout(dmd)
+        # (offset, mask) of each pixel field: decoded by hand, every sync cycle counts
+        self._fields = [(f.offset, (1 << f.width) - 1) for name in ("frame", "row", "column", "pixels")
+                        for f in [pixel_layout(dmd)[name]]]
         self.pixels = []          # (frame, row, column, value)
         self.row_starts = []      # sim time (ps) of the transfer of each row's first pixel
         self.last_pixel = 0
@@ -79,10 +81,11 @@ class Bench:
             dut.pixels__ready.value = int(ready)
             await RisingEdge(dut.clk)
             if ready and dut.pixels__valid.value:
-                p = unpack(self.layout, dut.pixels__payload.value.to_unsigned())
-                self.pixels.append((p["frame"], p["row"], p["column"], p["pixels"][0]))
+                bits = dut.pixels__payload.value.to_unsigned()
+                pixel = tuple(bits >> offset & mask for offset, mask in self._fields)
+                self.pixels.append(pixel)
                 self.last_pixel = get_sim_time("ps")
-                if p["column"] == 0:
+                if pixel[2] == 0:
                     self.row_starts.append(self.last_pixel)
 
     async def send(self, gmii_frames, timeout_ms=20):
