@@ -44,8 +44,11 @@ async def line_rate(dut):
     intact = sum(1 for i in range(len(encoded))
                  if delivered[i * rows:(i + 1) * rows] == [(1, r, picture[r].tobytes())
                                                             for r in range(i * rows, (i + 1) * rows)])
-    starts = bench.row_starts[::rows]
-    latencies = [math.ceil((start - fcs) / sync_ps) for start, fcs in zip(starts, fcs_sampled, strict=False)]
+    # Pair each record's first pixel with its frame by row number, so a lost record shifts nothing.
+    row_start = {row: t for (_frame, row, _data), t in zip(delivered, bench.row_starts, strict=True)}
+    starts = [row_start[i * rows] for i in range(len(encoded)) if i * rows in row_start]
+    latencies = [math.ceil((row_start[i * rows] - fcs) / sync_ps) for i, fcs in enumerate(fcs_sampled)
+                 if i * rows in row_start]
     payload = (len(encoded) - 1) * rows * dmd.columns
     with open(p["out"], "w") as f:
         json.dump({
