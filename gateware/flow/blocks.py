@@ -8,6 +8,10 @@ parameters it ships with. ``make resources`` synthesises each for XC6SLX45 and r
 from gateware.dlpc410.facts import DMDS
 
 
+#: Build-time addresses of the Ethernet blocks; a control record may change them at run time.
+_ADDRESSES = {"mac": 0x02_00_00_00_00_01, "ip": 0xC0_A8_01_0A, "port": 5000}
+
+
 def _serialiser():
     from gateware.bitplane import Serialiser
     return Serialiser(DMDS["dlp7000"], lanes=8)
@@ -25,8 +29,13 @@ def _eth_tx():
 
 def _eth_stack():
     from gateware.net.ingest import Ingest
-    # Build-time addresses; a control record may change them at run time.
-    return Ingest(DMDS["dlp7000"], mac=0x02_00_00_00_00_01, ip=0xC0_A8_01_0A, port=5000)
+    return Ingest(DMDS["dlp7000"], **_ADDRESSES)
+
+
+def _eth_port():
+    from gateware.net.port import EthernetPort
+    # The whole Ethernet side: receive MAC, stack and protocol, transmit MAC.
+    return EthernetPort(DMDS["dlp7000"], **_ADDRESSES)
 
 
 def _store_slots():
@@ -54,6 +63,7 @@ BLOCKS = {
     "eth_rx": _eth_rx,
     "eth_tx": _eth_tx,
     "eth_stack": _eth_stack,
+    "eth_port": _eth_port,
     "store_slots": _store_slots,
     "store_writer": _store_writer,
     "store_reader": _store_reader,

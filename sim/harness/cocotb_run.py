@@ -9,6 +9,7 @@ records a VCD of the run in the build directory.
 
 import json
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -51,9 +52,15 @@ def emit_verilog(component, name, path=None):
     text = verilog.convert(component, name=name, emit_src=False, strip_internal_attrs=True)
     if path is not None:
         path = Path(path)
-        if not path.exists() or path.read_text() != text:
+        if not path.exists() or _tokens(path.read_text()) != _tokens(text):
             path.write_text(text)
     return text
+
+
+def _tokens(text):
+    """The Verilog's words in sorted order: with several clock domains, the order of module
+    ports follows Python's string hashing and changes from one process to the next."""
+    return sorted(re.split(r"[\s,();]+", text))
 
 
 def run(component, *, toplevel, module, key, params=None, testcase=None, waves=None,

@@ -1,0 +1,13 @@
+"""The whole Ethernet side (:class:`gateware.net.port.EthernetPort`) on its generated Verilog:
+GMII pins to image rows and counters, replies back to GMII pins, under cocotb and Verilator."""
+
+import pytest
+
+from sim.harness import cocotb_run
+from sim.tb.ethernet_pins import TOPLEVEL, build
+
+
+@pytest.mark.verilog
+def test_ethernet_verilog():
+    cocotb_run.run(build("dlp7000"), toplevel=TOPLEVEL, module="sim.tb.ethernet", key="dlp7000",
+                   params={"dmd": "dlp7000"})
