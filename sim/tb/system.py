@@ -8,6 +8,7 @@ rule; the frames are the host encoder's records inside scapy-built UDP datagrams
 """
 
 import json
+import time
 from pathlib import Path
 
 import cocotb
@@ -28,6 +29,7 @@ from sim.models import gmii
 from sim.models.camera import Camera, to_lsb
 from sim.models.dlpc410 import CocotbAdapter, Dlpc410
 from sim.models.mcb import CocotbPort, McbModel
+from sim.scene import default_scene
 
 SYNC_NS, GMII_NS, DMD_NS = 8.0, 8.0, 5.0
 HOST_MAC, HOST_IP = "02:00:00:00:00:99", "10.0.0.1"
@@ -50,6 +52,7 @@ class System:
                             settle_cycles=p["t_settle"], init_cycles=p["init_cycles"],
                             init_grace_cycles=p["init_grace"], check_training=p.get("check_training", True))
         self.dmd_cycle = 0
+        self.frames_sent = 0
 
     async def start(self):
         dut = self.dut
@@ -84,6 +87,7 @@ class System:
     async def send(self, frames, errors=None):
         """Drive GMII with ``frames`` (no FCS; the stream adds preamble, FCS and gaps)."""
         edge = RisingEdge(self.dut.gmii_rx_clk)
+        self.frames_sent += len(frames)
         for dv, er, byte in gmii.cycles(frames, errors=errors):
             await edge
             self.dut.gmii_rx.value = byte | (dv << 8) | (er << 9)
@@ -110,10 +114,15 @@ async def frame_over_gmii_is_shown_exactly(dut):
     system = System(dut, p)
     await system.start()
     dmd = system.dmd
-    rng = np.random.default_rng(p["seed"])
-    images = [rng.integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8) for _ in range(p["frames"])]
-    images[0][0, :] = np.arange(dmd.columns) % 256      # every grey level appears
-    report = {"frames": []}
+    if p.get("scene"):
+        images = default_scene(p["frames"], dmd.rows, dmd.columns)
+    else:
+        rng = np.random.default_rng(p["seed"])
+        images = [rng.integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8) for _ in range(p["frames"])]
+        images[0][0, :] = np.arange(dmd.columns) % 256      # every grey level appears
+    wall0 = time.monotonic()
+    report = {"frames": [], "period_cycles": system.plan.frame_cycles, "rate_hz": system.plan.rate_hz,
+              "lsb_cycles": system.plan.params.lsb}
 
     def encoded(index):
         payloads = records.image_records(images[index], frame=index)
@@ -145,4 +154,8 @@ async def frame_over_gmii_is_shown_exactly(dut):
         if sending is not None:
             await sending
             await ClockCycles(dut.dmd_clk, p["settle_after_send"])
+    report["wall_s"] = time.monotonic() - wall0
+    report["dmd_cycles"] = system.dmd_cycle
+    report["gmii_frames_sent"] = system.frames_sent
+    report["dlpc410_commands"] = len(system.dlpc.log)
     Path(p["report"]).write_text(json.dumps(report))
