@@ -13,6 +13,7 @@ stimulus is driven from Python here) and is still to come.
 import json
 import os
 import time
+from pathlib import Path
 
 from gateware.dlpc410.facts import DMDS
 from gateware.top.system import Projector
@@ -64,8 +65,33 @@ def main(frames=None):
     print(f"simulation speed: {r['dmd_cycles'] / r['wall_s']:.0f} dmd cycles per wall second "
           f"({r['dmd_cycles']} cycles in {r['wall_s']:.1f} s)")
     print(f"wall time: {time.monotonic() - t0:.1f} s including the Verilator build")
-    vcd = os.path.join(r["build"], "dump.vcd")
-    if os.path.exists(vcd):
-        print(f"waves: {vcd} (open with gtkwave; signals are named by block: ingest, serialiser, store, "
-              f"broker, sequencer)")
+    vcd = Path(r["build"]) / "dump.vcd"
+    if vcd.exists():
+        print(f"waves: {vcd}\n  GTKWave save file (ports grouped by block): {write_save_file(vcd)}")
     return 0 if all(f["max_error_lsb"] == 0 for f in frames_out) else 1
+
+
+#: The core's ports by the block they belong to, for the GTKWave save file.
+SAVE_GROUPS = {
+    "clocks and resets": ["clk", "rst", "gmii_rx_clk", "gmii_tx_clk", "dmd_clk", "dmd_rst"],
+    "MAC: GMII": ["gmii_rx[9:0]", "gmii_tx[9:0]"],
+    "store: MCB port 0 (write, sync)": ["mcb_write__cmd_en", "mcb_write__cmd_instr[2:0]", "mcb_write__cmd_bl[5:0]",
+                                        "mcb_write__cmd_byte_addr[29:0]", "mcb_write__wr_en",
+                                        "mcb_write__wr_data[63:0]", "mcb_write__wr_count[6:0]"],
+    "store: MCB port 1 (read, dmd)": ["mcb_read__cmd_en", "mcb_read__cmd_byte_addr[29:0]", "mcb_read__rd_en",
+                                      "mcb_read__rd_data[63:0]", "mcb_read__rd_count[6:0]"],
+    "sequencer: trigger and sync": ["trigger_in", "sync_out", "camera_out"],
+    "sequencer: DLPC410 pins": ["dlpc__dvalid", "dlpc__rowmd[1:0]", "dlpc__rowad[10:0]", "dlpc__blkmd[1:0]",
+                                "dlpc__blkad[3:0]", "dlpc__din_a[31:0]", "dlpc__din_b[31:0]",
+                                "dlpc__rst_active", "dlpc__init_active", "dlpc__arstz"],
+}
+
+
+def write_save_file(vcd):
+    lines = [f'[dumpfile] "{vcd}"', "[timestart] 0"]
+    for group, signals in SAVE_GROUPS.items():
+        lines += [f"-{group}", "@28"]
+        lines += [f"projector.{name}" for name in signals]
+    path = vcd.with_suffix(".gtkw")
+    path.write_text("\n".join(lines) + "\n")
+    return path
