@@ -12,4 +12,5 @@ MODULES = [
     "sim.bench.net",
     "sim.bench.store",
     "sim.bench.seq",
+    "sim.bench.system",
 ]
