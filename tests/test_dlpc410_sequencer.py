@@ -280,3 +280,61 @@ def test_too_short_lsb_is_counted_late(test_name):
     run = run_bench(DMD, p, frames, None, pins=[ready], cycles=model.commands[-1][0] + 50, name=test_name)
     same_commands(run, model)
     assert run.status["late"] == model.late > 0
+
+
+def waiting_after(p, frames, strobes):
+    """The cycle from which every group waits loaded again after the given strobes played out
+    (the frame shown repeated, nothing newer offered)."""
+    return next_ready(p, model_frames(frames, None), strobes)
+
+
+@pytest.mark.parametrize("mode", [ResetMode.GLOBAL, ResetMode.DUAL])
+def test_frame_offered_while_waiting_is_shown_next(mode, test_name):
+    """Frame 1 completes while the projector waits (frame 0 shown, its repeat preloaded): its
+    first plane is loaded at once and the next trigger shows it, not frame 0 again; with
+    nothing newer offered, the next trigger repeats frame 1."""
+    p = fast_plan(depth=3, reset_mode=mode).params
+    first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
+    idle = waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + 30
+    offered = [(0, 3, 0), (1, 3, idle)]
+    second = next_ready(p, model_frames(offered, None), [first + PIN_TO_STROBE]) - PIN_TO_STROBE
+    third = waiting_after(p, offered, [first + PIN_TO_STROBE, second + PIN_TO_STROBE]) - PIN_TO_STROBE
+    run, model = check(p, [(0, 3), (1, 3), (1, 3)], None, [first, second, third], test_name,
+                       offered=offered)
+    assert [f.slot for f in model.shown] == [0, 1] and len(run.lights) == 3
+    assert model.overruns == 0 and len(model.accepted) == 3
+    # the reload: every group's first plane again, from slot 1, after the frame was offered
+    reloads = [t for t, k, _a in model.commands if k != "pulse" and idle < t < second]
+    assert reloads and reloads[0] >= idle + schedule.RELOAD_LEAD
+    assert [s for _t, s in run.releases] == [0]
+
+
+def test_trigger_during_reload_is_an_overrun(test_name):
+    """A trigger while the newer frame's first plane is being loaded is ignored and counted:
+    nothing mixed is shown; the next trigger shows the newer frame whole."""
+    p = fast_plan(depth=3).params
+    first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
+    idle = waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + 30
+    offered = [(0, 3, 0), (1, 3, idle)]
+    early = [idle - PIN_TO_STROBE, idle + schedule.RELOAD_LEAD + 10 - PIN_TO_STROBE]
+    strobes = [first + PIN_TO_STROBE] + [t + PIN_TO_STROBE for t in early]
+    second = next_ready(p, model_frames(offered, None), strobes) - PIN_TO_STROBE
+    run, model = check(p, [(0, 3), (1, 3)], None, [first, *early, second], test_name, offered=offered)
+    assert model.overruns == 2 and run.status["triggers"] == 2
+    assert len(run.lights) == 2 and [f.slot for f in model.shown] == [0, 1]
+
+
+def test_frame_offered_late_in_a_frame_is_shown_next(test_name):
+    """Frame 1 completes one cycle after group 0's last pulse of frame 0 (too late to be taken
+    there): frame 0's repeat is preloaded whole, then frame 1's first plane replaces it, and
+    the next trigger shows frame 1 (phased: groups end their frame at different times)."""
+    p = fast_plan(depth=3, reset_mode=ResetMode.DUAL).params
+    first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
+    alone = schedule.simulate(DMD, p, model_frames([(0, 3)], None), [first + PIN_TO_STROBE])
+    last_pulse = max(t for t, g, _k, _f, _e in alone.pulses if g == 0)
+    offered = [(0, 3, 0), (1, 3, last_pulse + 1)]
+    second = next_ready(p, model_frames(offered, None), [first + PIN_TO_STROBE]) - PIN_TO_STROBE
+    run, model = check(p, [(0, 3), (1, 3)], None, [first, second], test_name, offered=offered)
+    assert [f.slot for f in model.shown] == [0, 1] and model.overruns == 0
+    # frame 0's repeat was loaded first (not cut), then frame 1's first plane
+    assert second + PIN_TO_STROBE > waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + schedule.RELOAD_LEAD
