@@ -118,3 +118,23 @@ def test_decoder_rejects_a_broken_row_cycle():
     dec.step(0, 1, 0b10, 5, 0, 0, 1, lanes)
     with pytest.raises(AssertionError):
         dec.step(1, 0, 0, 0, 0, 0, 1, lanes)
+
+
+@pytest.mark.parametrize("chain", [False, True])
+def test_newer_frame_taken_while_waiting_only_when_triggered(chain):
+    """Triggered: a frame offered while every group waits loaded is taken at once and its first
+    plane loaded again (a trigger meanwhile is an overrun). Chained: frames are taken only at
+    frame ends, as before."""
+    p = schedule.plan(TEST_DMD, 200e6, depth=1, chain=chain, t_rst_s=20 / 200e6, t_settle_s=30 / 200e6).params
+    start = schedule.ready_cycle(TEST_DMD, p, schedule.Frame(0, 1))
+    offered = start + 100
+    r = schedule.simulate(TEST_DMD, p, [schedule.Frame(0, 1), schedule.Frame(1, 1, ready=offered)],
+                          [offered + 2], until=offered + 400)
+    if chain:
+        assert r.overruns == 0 and r.accepted == [offered + 2]
+        assert [f.slot for f in r.shown] == [0, 1]      # taken at the end of a chained frame
+        assert r.pulses[0][3] == 0
+    else:
+        assert r.overruns == 1 and not r.accepted and [f.slot for f in r.shown] == [0, 1]
+        rows = [t for t, k, _a in r.commands if k == "row" and t > offered]
+        assert len(rows) == TEST_DMD.rows and rows[0] == offered + schedule.RELOAD_LEAD
