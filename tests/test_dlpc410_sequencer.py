@@ -23,12 +23,24 @@ def fast_plan(**kw):
 
 
 def model_frames(frames, images):
+    """Model frames of (slot, depth) or (slot, depth, ready) tuples."""
     out = []
-    for slot, depth in frames:
+    for slot, depth, *ready in frames:
         occ = None if images is None else \
             tuple(int(x) for x in bitplane.occupancy(images[slot], DMD.rows_per_block))
-        out.append(schedule.Frame(slot, depth, occ))
+        out.append(schedule.Frame(slot, depth, occ, *ready))
     return out
+
+
+def paced(p, frames, images):
+    """Each frame offered just after the trigger that starts the one before it (so it is taken
+    when that one ends), and the trigger pins as soon as each frame is ready."""
+    offered, pins = [], []
+    for slot, depth in frames:
+        offered.append((slot, depth, pins[-1] + PIN_TO_STROBE + 4 if pins else 0))
+        strobes = [t + PIN_TO_STROBE for t in pins]
+        pins.append(next_ready(p, model_frames(offered, images), strobes) - PIN_TO_STROBE)
+    return offered, pins
 
 
 def next_ready(p, frames, strobes):
@@ -69,7 +81,7 @@ def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), ea
     # the camera model on the rule model's mirror history, the window holding each frame
     run.lights = frame_lights(run.model, run.frames())
     for k, light in enumerate(run.lights):
-        slot, depth = frames[min(k, len(frames) - 1)]
+        slot, depth = frames[min(k, len(frames) - 1)][:2]
         image = ramp_image(DMD, slot) if images is None else images[slot]
         assert np.array_equal(light, (image.astype(np.int64) >> (8 - depth)) * p.lsb), f"frame {k}"
     return run, model
@@ -103,11 +115,8 @@ def test_random_images_every_depth_with_empty_blocks(test_name):
     images = {0: a, 1: b}
     frames = [(k % 2, depth) for k, depth in enumerate(range(1, 9))]
     p = fast_plan(reset_mode=ResetMode.DUAL).params
-    mframes = model_frames(frames, images)
-    pins = []
-    for _ in frames:
-        pins.append(next_ready(p, mframes, [t + PIN_TO_STROBE for t in pins]) - PIN_TO_STROBE)
-    run, model = check(p, frames, images, pins, test_name)
+    offered, pins = paced(p, frames, images)
+    run, model = check(p, frames, images, pins, test_name, offered=offered)
     assert len(run.lights) == len(frames)
     # each slot is handed back when every group has moved to the next frame's slot
     assert [s for _t, s in run.releases] == [k % 2 for k in range(len(frames) - 1)]
@@ -120,11 +129,8 @@ def test_extremes_all_dark_all_bright(test_name):
     images = {0: np.zeros(shape, np.uint8), 1: np.full(shape, 255, np.uint8)}
     frames = [(0, 8), (1, 8), (0, 1), (1, 1)]
     p = fast_plan().params
-    mframes = model_frames(frames, images)
-    pins = []
-    for _ in frames:
-        pins.append(next_ready(p, mframes, [t + PIN_TO_STROBE for t in pins]) - PIN_TO_STROBE)
-    run, model = check(p, frames, images, pins, test_name)
+    offered, pins = paced(p, frames, images)
+    run, model = check(p, frames, images, pins, test_name, offered=offered)
     assert len(run.lights) == 4
     first_rows = [k for _t, k, _a in model.commands[:DMD.blocks]]
     assert first_rows == ["clear"] * DMD.blocks
@@ -134,17 +140,20 @@ def test_triggers(test_name):
     """Before init ends, early, during a frame, a burst faster than frames, one cycle before the
     next frame is ready and exactly when it is: counted right, never half-obeyed."""
     p = fast_plan().params
-    frames = [(0, 4), (1, 0), (1, 4), (1, 9), (0, 4)]   # two frames with bad depths: dropped
+    first = next_ready(p, model_frames([(0, 4)], None), []) - PIN_TO_STROBE
+    after_first = first + PIN_TO_STROBE + 4
+    # two frames with bad depths, dropped; each good frame offered while the one before plays
+    frames = [(0, 4, 0), (1, 0, after_first), (1, 4, after_first), (1, 9, after_first)]
+    second = next_ready(p, model_frames(frames, None), [first + PIN_TO_STROBE]) - PIN_TO_STROBE
+    frames.append((0, 4, second + 7 + PIN_TO_STROBE + 4))
     mframes = model_frames(frames, None)
-    first = next_ready(p, mframes, []) - PIN_TO_STROBE
-    second = next_ready(p, mframes, [first + PIN_TO_STROBE]) - PIN_TO_STROBE
     third = next_ready(p, mframes, [first + PIN_TO_STROBE, second + 7 + PIN_TO_STROBE]) - PIN_TO_STROBE
     pins = [20,                                  # before the first plane is loaded: overrun
             first, first + 300, first + 310, first + 320,   # a frame plays: burst of overruns
             second - 1,                          # one cycle early: overrun
             second + 7,                          # accepted (edge after the early one's pulse)
             third]                               # exactly when ready: accepted
-    run, model = check(p, [f for f in frames if 1 <= f[1] <= 8], None, pins, test_name,
+    run, model = check(p, [f[:2] for f in frames if 1 <= f[1] <= 8], None, pins, test_name,
                        early_pins=(3, 9), offered=frames)
     assert model.overruns == 5 and len(model.accepted) == 3
     assert run.status["frames"] == 3 and run.status["bad_frames"] == model.bad_frames == 2
@@ -164,8 +173,8 @@ def test_sync_out_and_camera(test_name):
 def test_trigger_modes(mode, test_name):
     p = fast_plan().params
     p.trigger = mode
-    frames = [(0, 2), (1, 2)]
-    ready = next_ready(p, model_frames(frames, None), [])
+    ready = next_ready(p, model_frames([(0, 2)], None), [])
+    frames = [(0, 2), (1, 2, ready + 100)]
     if mode == TriggerMode.PERIODIC:
         p.period = ready + 1
         strobes = [k * p.period - 1 for k in range(1, 7)]
@@ -175,10 +184,10 @@ def test_trigger_modes(mode, test_name):
         assert run.status["triggers"] == len(model.accepted) >= 2
         assert run.status["overruns"] == model.overruns >= 1
     elif mode == TriggerMode.SOFTWARE:
-        run, model = check(p, frames, None, [], test_name, soft=[ready, ready + 40])
+        run, model = check(p, frames, None, [], test_name, soft=[ready, ready + 40], offered=frames)
         assert run.status["triggers"] == 1 and run.status["overruns"] == 1
     else:
-        run, model = check(p, frames, None, [ready], test_name, sync_pins=[ready + 50])
+        run, model = check(p, frames, None, [ready], test_name, sync_pins=[ready + 50], offered=frames)
         assert run.status["triggers"] == 1    # the TTL pin is ignored in sync mode
 
 
@@ -290,3 +299,61 @@ def test_too_short_lsb_is_counted_late(test_name):
     run = run_bench(DMD, p, frames, None, pins=[ready], cycles=model.commands[-1][0] + 50, name=test_name)
     same_commands(run, model)
     assert run.status["late"] == model.late > 0
+
+
+def waiting_after(p, frames, strobes):
+    """The cycle from which every group waits loaded again after the given strobes played out
+    (the frame shown repeated, nothing newer offered)."""
+    return next_ready(p, model_frames(frames, None), strobes)
+
+
+@pytest.mark.parametrize("mode", [ResetMode.GLOBAL, ResetMode.DUAL])
+def test_frame_offered_while_waiting_is_shown_next(mode, test_name):
+    """Frame 1 completes while the projector waits (frame 0 shown, its repeat preloaded): its
+    first plane is loaded at once and the next trigger shows it, not frame 0 again; with
+    nothing newer offered, the next trigger repeats frame 1."""
+    p = fast_plan(depth=3, reset_mode=mode).params
+    first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
+    idle = waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + 30
+    offered = [(0, 3, 0), (1, 3, idle)]
+    second = next_ready(p, model_frames(offered, None), [first + PIN_TO_STROBE]) - PIN_TO_STROBE
+    third = waiting_after(p, offered, [first + PIN_TO_STROBE, second + PIN_TO_STROBE]) - PIN_TO_STROBE
+    run, model = check(p, [(0, 3), (1, 3), (1, 3)], None, [first, second, third], test_name,
+                       offered=offered)
+    assert [f.slot for f in model.shown] == [0, 1] and len(run.lights) == 3
+    assert model.overruns == 0 and len(model.accepted) == 3
+    # the reload: every group's first plane again, from slot 1, after the frame was offered
+    reloads = [t for t, k, _a in model.commands if k != "pulse" and idle < t < second]
+    assert reloads and reloads[0] >= idle + schedule.RELOAD_LEAD
+    assert [s for _t, s in run.releases] == [0]
+
+
+def test_trigger_during_reload_is_an_overrun(test_name):
+    """A trigger while the newer frame's first plane is being loaded is ignored and counted:
+    nothing mixed is shown; the next trigger shows the newer frame whole."""
+    p = fast_plan(depth=3).params
+    first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
+    idle = waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + 30
+    offered = [(0, 3, 0), (1, 3, idle)]
+    early = [idle - PIN_TO_STROBE, idle + schedule.RELOAD_LEAD + 10 - PIN_TO_STROBE]
+    strobes = [first + PIN_TO_STROBE] + [t + PIN_TO_STROBE for t in early]
+    second = next_ready(p, model_frames(offered, None), strobes) - PIN_TO_STROBE
+    run, model = check(p, [(0, 3), (1, 3)], None, [first, *early, second], test_name, offered=offered)
+    assert model.overruns == 2 and run.status["triggers"] == 2
+    assert len(run.lights) == 2 and [f.slot for f in model.shown] == [0, 1]
+
+
+def test_frame_offered_late_in_a_frame_is_shown_next(test_name):
+    """Frame 1 completes one cycle after group 0's last pulse of frame 0 (too late to be taken
+    there): frame 0's repeat is preloaded whole, then frame 1's first plane replaces it, and
+    the next trigger shows frame 1 (phased: groups end their frame at different times)."""
+    p = fast_plan(depth=3, reset_mode=ResetMode.DUAL).params
+    first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
+    alone = schedule.simulate(DMD, p, model_frames([(0, 3)], None), [first + PIN_TO_STROBE])
+    last_pulse = max(t for t, g, _k, _f, _e in alone.pulses if g == 0)
+    offered = [(0, 3, 0), (1, 3, last_pulse + 1)]
+    second = next_ready(p, model_frames(offered, None), [first + PIN_TO_STROBE]) - PIN_TO_STROBE
+    run, model = check(p, [(0, 3), (1, 3)], None, [first, second], test_name, offered=offered)
+    assert [f.slot for f in model.shown] == [0, 1] and model.overruns == 0
+    # frame 0's repeat was loaded first (not cut), then frame 1's first plane
+    assert second + PIN_TO_STROBE > waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + schedule.RELOAD_LEAD

@@ -15,7 +15,7 @@ from sim.tb.plane_source import SequencerBench
 def test_sequencer_verilog_xga(mode, strict, order, depth):
     """One frame on full XGA, RST_ACTIVE and settle scaled down (run-time parameters)."""
     dmd = "dlp7000"
-    bench = SequencerBench(DMDS[dmd], [(0, depth), (1, depth)])
+    bench = SequencerBench(DMDS[dmd], [(0, depth)])
     cocotb_run.run(bench, toplevel="dlpc410_sequencer_bench", module="sim.tb.seq_cocotb",
                    key=f"{dmd}-{depth}",
                    params={"dmd": dmd, "mode": mode, "strict": strict, "order": order,

@@ -36,6 +36,12 @@ cannot be made on time is made late and counted (the plan below never lets that 
 A trigger strobe at cycle ``s`` is obeyed when every group is loaded and waiting: group ``g``'s
 first pulse is then at ``even(s + 1) + g * stagger``; otherwise it is counted as an overrun.
 
+Frames: group 0 takes the next offered frame when its last pulse of a frame is made (else the
+frame repeats). Triggered and not chained, a frame offered while every group is loaded and
+waiting is taken at once: every group's first plane is loaded again from it, no sooner than
+``RELOAD_LEAD`` cycles later (the store's first words); a trigger before that load ends is an
+overrun, so a trigger never shows an older frame than the newest complete one it could show.
+
 Time base: cycle 0 is the first cycle after initialisation (INIT_ACTIVE low); the first loads
 may start at ``init_to_dvalid`` (64 clocks, DLPC910). Command cycles are decision cycles; the
 pins show each command one cycle later.
@@ -50,10 +56,15 @@ from .facts import TIMING, BlockMode
 from .params import PlaneOrder, ResetMode, Source, TriggerMode, group_size
 
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate",
-           "plan", "bound", "level_light", "INIT_TO_DVALID", "RST_MARGIN", "even", "ready_cycle"]
+           "plan", "bound", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "RST_MARGIN", "even",
+           "ready_cycle"]
 
 #: First load this many cycles after INIT_ACTIVE falls (DLPC910: first DVALID >= 64 clocks).
 INIT_TO_DVALID = int(TIMING["init_to_dvalid_clocks"].value)
+
+#: A frame taken while waiting for a trigger has its first row loaded this many cycles later at
+#: the earliest: the requester's occupancy look-up and the store's first words of the row.
+RELOAD_LEAD = 16
 
 
 #: Cycles added to the RST_ACTIVE time: the command leaves one cycle after its decision, and the
@@ -175,8 +186,10 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
     dmd : DmdType
     p : Params
     frames : list of Frame
-        Offered in turn: each time group 0 needs a new frame it takes the next one whose
-        ``ready`` has passed, else shows the current one again.
+        Offered in turn from their ``ready`` cycle (one frame per cycle at most; a frame with a
+        bad bit depth is dropped the cycle it is offered): each time group 0 needs a new frame
+        it takes the offered one, else shows the current one again; triggered and not chained,
+        one offered while every group waits loaded for a trigger is taken at once.
     strobes : iterable of int
         Cycles at which the trigger block signals a trigger (see :mod:`.trigger`).
     until : int
@@ -194,17 +207,30 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
     offered = list(frames)
     shown = res.shown              # frames taken, by index
     strobes = sorted(strobes)
-    state = {"next_row": 0, "rst_any": 0, "next_frame": None}
+    state = {"next_row": 0, "rst_any": 0, "next_frame": None, "offer_from": 0, "queued_at": G + 1}
     if p.source == Source.PRNG:
         offered = [Frame(0, 1)]
 
-    def take_frame():
+    def offer():
+        """(bad frames before it, cycle it is offered from) of the next good frame, or None."""
+        at = state["offer_from"]
+        for k, f in enumerate(offered):
+            at = max(at, f.ready)
+            if 1 <= f.depth <= 8:
+                return k, at
+            at += 1
+        return None
+
+    def take_frame(repeat=True):
         # frames with a bit depth outside 1..8 are dropped (and counted) as soon as offered
-        while offered and offered[0].ready <= t_now[0] and not 1 <= offered[0].depth <= 8:
-            offered.pop(0)
-            res.bad_frames += 1
-        if offered and offered[0].ready <= t_now[0]:
+        nxt = offer()
+        if nxt is not None and nxt[1] <= t_now[0]:
+            del offered[:nxt[0]]
+            res.bad_frames += nxt[0]
             shown.append(offered.pop(0))
+            state["offer_from"] = t_now[0] + 1
+        elif not repeat:
+            return None
         assert shown, "no frame offered before it was needed"
         return len(shown) - 1
 
@@ -252,6 +278,20 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
                 s.pending = False
             enqueue(g, nfi, nj)
 
+    def waiting(t):
+        return all(not s.pending and s.loaded_at is not None and s.loaded_at <= t for s in st)
+
+    def take_while_waiting(t):
+        """A newer frame offered while every group waits loaded: load its first plane."""
+        fi = take_frame(repeat=False)
+        state["next_frame"] = fi
+        state["queued_at"] = t + G + 1
+        for g in range(G):
+            st[g].pos = ("plane", fi, 0)
+            st[g].writable = max(st[g].writable, t + RELOAD_LEAD)
+            enqueue(g, fi, 0)
+
+    idle_take = not p.chain and p.source != Source.PRNG
     t_now = [0]
     fi0 = take_frame()
     state["next_frame"] = fi0
@@ -264,6 +304,8 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
     si = 0
     while True:
         t_now[0] = t
+        nxt = offer()
+        take_now = idle_take and t >= state["queued_at"] and waiting(t) and nxt is not None and nxt[1] <= t
         # --- decision at t ---
         if t % 2 == 0 and t >= bus_free:
             rst_ok = [t - (state["rst_any"] if p.strict_rst else st[g].rst_free) >= 0 for g in range(G)]
@@ -303,12 +345,13 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
                     if queue[0][2] == len(ops):
                         queue.pop(0)
                         st[g].loaded_at = t + length
+        if take_now:
+            take_while_waiting(t)
         # --- trigger strobe at t (reads the state before this cycle's decision) ---
         while si < len(strobes) and strobes[si] <= t:
             s_t = strobes[si]
             si += 1
-            ready = all(not s.pending and s.loaded_at is not None and s.loaded_at <= s_t for s in st)
-            if ready:
+            if waiting(s_t):
                 res.accepted.append(s_t)
                 start = even(s_t + 1)
                 for g, s in enumerate(st):
@@ -326,10 +369,17 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
         if queue:
             g = queue[0][0]
             cands.append(max(st[g].writable, state["next_row"]))
+        nxt = offer()
+        take_at = None
+        if idle_take and nxt is not None and all(not s.pending and s.loaded_at is not None for s in st):
+            take_at = max(nxt[1], state["queued_at"], *(s.loaded_at for s in st))
+            cands.append(take_at)
         if not cands:
             break
         nt = max(t + 1, min(cands), bus_free)
-        if nt % 2 and not (si < len(strobes) and strobes[si] == nt):
+        if take_at is not None and t < take_at < nt:
+            nt = take_at
+        if nt % 2 and not (si < len(strobes) and strobes[si] == nt) and nt != take_at:
             nt += 1
         if until is not None and nt >= until:
             break
@@ -441,7 +491,8 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
                        reset_mode=reset_mode, order=order, order_table=order_table, chain=chain,
                        strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period)
             fr = frame or Frame(0, depth)
-            r = simulate(dmd, p, [replace(fr, ready=0)] * 3, [ready_cycle(dmd, p, fr)], max_frames=2)
+            r = simulate(dmd, p, [replace(fr, ready=0)] * (3 if chain else 1), [ready_cycle(dmd, p, fr)],
+                         max_frames=2)
             if r.late == 0:
                 break
         lsb += max(2, even(lsb // 128))
@@ -468,13 +519,13 @@ def _frame_cycles(dmd, p, fr):
     first = ready_cycle(dmd, p, fr)
     lo, hi = first + 1, first + 1
     while True:
-        r2 = simulate(dmd, p, [fr] * 3, [first, hi])
+        r2 = simulate(dmd, p, [fr], [first, hi])
         if len(r2.accepted) == 2:
             break
         lo, hi = hi, hi * 2
     while lo < hi:
         mid = (lo + hi) // 2
-        r2 = simulate(dmd, p, [fr] * 3, [first, mid])
+        r2 = simulate(dmd, p, [fr], [first, mid])
         if len(r2.accepted) == 2:
             hi = mid
         else:

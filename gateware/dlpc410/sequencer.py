@@ -28,7 +28,7 @@ from .facts import BlockMode, RowMode
 from .init import TRAINING_EDGES, Init
 from .params import TIME_BITS, PlaneOrder, Registers, ResetMode, Source
 from .prng import Prng
-from .schedule import INIT_TO_DVALID
+from .schedule import INIT_TO_DVALID, RELOAD_LEAD
 from .trigger import Trigger
 
 __all__ = ["Sequencer", "Status"]
@@ -98,7 +98,9 @@ class Sequencer(wiring.Component):
         Camera trigger: ``camera_width`` cycles, starting ``camera_offset`` cycles after the
         frame's first clocking pulse appears on the pins.
     frames : In(stream.Signature(FrameInfo))
-        The newest complete frame; taken when a new frame is due (else the last one repeats).
+        The newest complete frame; taken when a new frame is due (else the last one repeats),
+        or, triggered and not chained, as soon as every group waits loaded for a trigger: the
+        first plane is then loaded again from the new frame (a trigger meanwhile is an overrun).
     requests : Out(stream.Signature(PlaneRequest))
         Rows to read, one block of one plane per request, in load order.
     words : In(stream.Signature(64))
@@ -206,6 +208,7 @@ class Sequencer(wiring.Component):
 
         next_slot = Signal(SLOT_BITS)
         next_depth = Signal(4)
+        take_idle = Signal()                   # a frame offered while waiting for a trigger
 
         # ---- load queue (pulse order) -> requester -> loader queue ----
         queued = data.StructLayout({"group": grp_bits, "slot": SLOT_BITS, "depth": 4, "pos": 3, "clear": 1})
@@ -443,7 +446,7 @@ class Sequencer(wiring.Component):
 
         # ---- start: take the first frame, queue every group's first plane ----
         start_group = Signal(grp_bits + 1)
-        with m.FSM(name="start"):
+        with m.FSM(name="start") as start_fsm:
             with m.State("WAIT"):
                 with m.If(init.running & (self.frames.valid & frame_ok | use_prng)):
                     m.d.comb += self.frames.ready.eq(~use_prng)
@@ -454,21 +457,40 @@ class Sequencer(wiring.Component):
                         m.d.sync += [slot[g].eq(f_slot), depth[g].eq(f_depth),
                                      pos[g].eq(0), dark[g].eq(0)]
                     m.next = "QUEUE"
-            with m.State("QUEUE"):
+            def queue_first_planes():
                 m.d.comb += [queue.w_en.eq(1), enq.group.eq(start_group), enq.slot.eq(next_slot),
                              enq.depth.eq(next_depth), enq.pos.eq(0)]
                 m.d.sync += start_group.eq(start_group + 1)
                 with m.If(start_group == n_groups - 1):
                     m.next = "RUN"
+            with m.State("QUEUE"):
+                queue_first_planes()
             with m.State("RUN"):
                 m.d.comb += running.eq(1)
+                with m.If(take_idle):
+                    m.next = "RELOAD"
+            with m.State("RELOAD"):
+                m.d.comb += running.eq(1)
+                queue_first_planes()
 
         # ---- triggers ----
         all_ready = Cat(~active[g] | (~pending[g] & loaded[g]) for g in range(GMAX)).all()
+        # a newer frame than the one waiting: load its first plane instead (the loads wait for the
+        # requester's first words); nothing is in flight, since every group is loaded
+        m.d.comb += take_idle.eq(start_fsm.ongoing("RUN") & all_ready & ~regs.chain & ~use_prng
+                                 & self.frames.valid & frame_ok)
+        with m.If(take_idle):
+            m.d.comb += self.frames.ready.eq(1)
+            lead = now + RELOAD_LEAD
+            m.d.sync += [next_slot.eq(self.frames.payload.slot), next_depth.eq(self.frames.payload.bit_depth),
+                         start_group.eq(0)]
+            for g in range(GMAX):
+                m.d.sync += [slot[g].eq(self.frames.payload.slot), depth[g].eq(self.frames.payload.bit_depth),
+                             loaded[g].eq(0), writable[g].eq(Mux(_diff(writable[g], lead) < 0, lead, writable[g]))]
         with m.If(trig.strobe):
             with m.If(~running):
                 m.d.sync += self.status.early.eq(self.status.early + 1)
-            with m.Elif(all_ready):
+            with m.Elif(all_ready & ~take_idle):
                 start = (now + 2) & ~1
                 m.d.sync += self.status.triggers.eq(self.status.triggers + 1)
                 for g in range(GMAX):

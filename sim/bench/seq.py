@@ -43,23 +43,44 @@ FAST = {"t_rst_s": 20 / 200e6, "t_settle_s": 30 / 200e6}
 
 def trigger_latencies():
     """Pin edge to the first clocking pulse on the pins, in cycles, for pin edges on each
-    phase of the DCLK/2 command grid; ``newer``: a newer frame completed just before the
-    trigger. The frame preloaded when the previous one ended is the one a trigger shows (a
-    newer frame waits for the next trigger), so the latency does not depend on it."""
+    phase of the DCLK/2 command grid, the first plane loaded and waiting."""
     p = schedule.plan(TEST_DMD, 200e6, depth=1, **FAST).params
-    out = {}
-    for newer in (False, True):
-        frames = [(0, 1), (1, 1)] if newer else [(0, 1)]
-        ready = max(g.loaded_at for g in schedule.simulate(TEST_DMD, p, [schedule.Frame(0, 1)]).groups)
-        lat = []
-        for phase in range(4):
-            pin = ready + phase
-            run = run_bench(TEST_DMD, p, frames, pins=[pin], cycles=pin + 40, name=f"bench_latency_{phase}",
-                            )
-            pulse = next(t for t, kind, _a in run.commands if kind == "pulse")
-            lat.append(pulse + 1 - pin)
-        out[newer] = lat
-    return out
+    ready = max(g.loaded_at for g in schedule.simulate(TEST_DMD, p, [schedule.Frame(0, 1)]).groups)
+    lat = []
+    for phase in range(4):
+        pin = ready + phase
+        run = run_bench(TEST_DMD, p, [(0, 1)], pins=[pin], cycles=pin + 40, name=f"bench_latency_{phase}")
+        pulse = next(t for t, kind, _a in run.commands if kind == "pulse")
+        lat.append(pulse + 1 - pin)
+    return lat
+
+
+def newer_frame(dmd, p, *, late, gateware=False):
+    """A newer frame completed just before the trigger: a trigger before its first plane is
+    loaded again is an overrun, so the worst case is frame complete -> first clocking pulse of
+    it on the pins, triggered as early as it is obeyed. ``late``: the frame completes one cycle
+    after group 0's last pulse of the frame shown (its repeat is preloaded first, whole);
+    else while every group waits. Returns (reload cycles: complete -> a trigger is obeyed,
+    latency cycles, pin -> pulse cycles of that trigger); ``gateware``: measured on the
+    gateware in the Amaranth simulator, else the schedule model (equal cycle for cycle)."""
+    pin0 = max(g.loaded_at for g in schedule.simulate(dmd, p, [schedule.Frame(0, 1)]).groups)
+    alone = schedule.simulate(dmd, p, [schedule.Frame(0, 1)], [pin0 + PIN_TO_STROBE])
+    done = max(t for t, g, _k, _f, _e in alone.pulses if g == 0) + 1 if late \
+        else max(g.loaded_at for g in alone.groups) + 10
+    frames = [schedule.Frame(0, 1), schedule.Frame(1, 1, ready=done)]
+    strobes = [pin0 + PIN_TO_STROBE]
+    obeyed = max(g.loaded_at for g in schedule.simulate(dmd, p, frames, strobes).groups)
+    pin = obeyed - PIN_TO_STROBE
+    if gateware:
+        run = run_bench(dmd, p, [(0, 1), (1, 1, done)], pins=[pin0, pin], cycles=pin + 40,
+                        name=f"bench_newer_frame_{'late' if late else 'waiting'}")
+        assert run.status["overruns"] == 0 and run.status["triggers"] == 2
+        pulse = next(t for t, kind, _a in run.commands if kind == "pulse" and t >= pin)
+    else:
+        model = schedule.simulate(dmd, p, frames, strobes + [obeyed])
+        assert model.overruns == 0 and [f.slot for f in model.shown] == [0, 1]
+        pulse = next(t for t, _g, _k, fi, _e in model.pulses if fi == 1)
+    return obeyed - done, pulse + 1 - done, pulse + 1 - pin
 
 
 def gateware_binary_period():
@@ -176,13 +197,27 @@ def run():
     figures = {}
     figures.update(gray_error_figures())
     lat = trigger_latencies()
-    typical = sorted(lat[False])[len(lat[False]) // 2]
-    worst = max(lat[False] + lat[True])
+    typical = sorted(lat)[len(lat) // 2]
+    small = schedule.plan(TEST_DMD, 200e6, depth=1, **FAST).params
+    newer = {late: newer_frame(TEST_DMD, small, late=late, gateware=True) for late in (False, True)}
+    # the trigger that shows the newer frame; complete -> shown is the figure below
+    worst = max(lat + [n[2] for n in newer.values()])
     figures["seq.trigger_latency_cycles_typical"] = (typical, "cycle")
     figures["seq.trigger_latency_cycles_worst"] = (worst, "cycle")
     for mhz in (200, 400):
         figures[f"seq.trigger_latency_ns_typical_at_{mhz}mhz"] = (typical * 1e3 / mhz, "ns")
         figures[f"seq.trigger_latency_ns_worst_at_{mhz}mhz"] = (worst * 1e3 / mhz, "ns")
+    for late, (reload, shown, _pin) in newer.items():
+        when = "late" if late else "waiting"
+        figures[f"seq.newer_frame_reload_cycles_{when}_test_dmd"] = (reload, "cycle")
+        figures[f"seq.newer_frame_to_pulse_cycles_{when}_test_dmd"] = (shown, "cycle")
+    xga = schedule.plan(XGA, 200e6, depth=1).params
+    for late in (False, True):
+        when = "late" if late else "waiting"
+        reload, shown, _pin = newer_frame(XGA, xga, late=late)
+        figures[f"seq.newer_frame_reload_cycles_{when}_dlp7000"] = (reload, "cycle")
+        figures[f"seq.newer_frame_to_pulse_cycles_{when}_dlp7000"] = (shown, "cycle")
+        figures[f"seq.newer_frame_to_pulse_us_{when}_dlp7000_at_200mhz"] = (shown / 200, "us")
 
     for mhz in (200, 400):
         f = mhz * 1e6

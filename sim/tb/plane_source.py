@@ -12,7 +12,7 @@ from amaranth.lib import data, memory, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from gateware.dlpc410 import interface
-from gateware.dlpc410.params import Registers
+from gateware.dlpc410.params import TIME_BITS, Registers
 from gateware.dlpc410.sequencer import Sequencer, Status
 from gateware.store.layouts import FrameInfo, PlaneRequest
 from sim.models import bitplane
@@ -31,7 +31,9 @@ class PlaneSource(wiring.Component):
     """Answers :class:`PlaneRequest` with words, one per cycle; offers ``frames`` in turn.
 
     ``images``: {slot: 8-bit image} kept in a memory, or None for the ramp generator
-    (:func:`ramp_image`, every block occupied). ``frames``: list of (slot, bit depth).
+    (:func:`ramp_image`, every block occupied). ``frames``: list of (slot, bit depth) or
+    (slot, bit depth, ready): a frame is offered once ``now`` (the sequencer's time base) has
+    reached its ``ready`` (default 0), after the frames before it were taken or dropped.
     """
 
     def __init__(self, dmd, frames, images=None, slots=2):
@@ -42,6 +44,7 @@ class PlaneSource(wiring.Component):
             "frames": Out(stream.Signature(FrameInfo)),
             "occ_slot": In(4),
             "occupancy": Out(data.ArrayLayout(8, dmd.blocks)),
+            "now": In(TIME_BITS),
         })
 
     def elaborate(self, platform):
@@ -89,9 +92,10 @@ class PlaneSource(wiring.Component):
         m.d.sync += self.occupancy.as_value().eq(occ[self.occ_slot])
 
         index = Signal(range(len(self._frames) + 1))
-        frames = Array(Const(FrameInfo.const({"slot": s, "frame_id": i, "bit_depth": d}).as_value().value,
-                             FrameInfo.as_shape().size) for i, (s, d) in enumerate(self._frames))
-        m.d.comb += [self.frames.valid.eq(index < len(self._frames)),
+        frames = Array(Const(FrameInfo.const({"slot": f[0], "frame_id": i, "bit_depth": f[1]}).as_value().value,
+                             FrameInfo.as_shape().size) for i, f in enumerate(self._frames))
+        ready = Array(Const(f[2] if len(f) > 2 else 0, TIME_BITS) for f in self._frames + [(0, 0)])
+        m.d.comb += [self.frames.valid.eq((index < len(self._frames)) & (self.now >= ready[index])),
                      self.frames.payload.as_value().eq(frames[index])]
         with m.If(self.frames.valid & self.frames.ready):
             m.d.sync += index.eq(index + 1)
@@ -125,7 +129,8 @@ class SequencerBench(wiring.Component):
         wiring.connect(m, src.words, seq.words)
         wiring.connect(m, src.frames, seq.frames)
         wiring.connect(m, seq.release, wiring.flipped(self.release))
-        m.d.comb += [src.occ_slot.eq(seq.occ_slot), seq.occupancy.eq(src.occupancy)]
+        m.d.comb += [src.occ_slot.eq(seq.occ_slot), seq.occupancy.eq(src.occupancy),
+                     src.now.eq(seq.status.now)]
         wiring.connect(m, wiring.flipped(self.pins), seq.pins)
         for name in ("regs", "trigger_in", "sync_in", "soft_trigger", "seed", "reseed"):
             m.d.comb += getattr(seq, name).eq(getattr(self, name))

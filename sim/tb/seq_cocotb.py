@@ -35,7 +35,7 @@ async def ramp_frame_matches_model(dut):
     prm = params()
     dmd, p = plan_from(prm)
     depth = prm["depth"]
-    frames = [schedule.Frame(0, depth), schedule.Frame(1, depth)]
+    frames = [schedule.Frame(0, depth)]   # repeated: a newer frame offered while waiting would be reloaded
     ready = max(g.loaded_at for g in schedule.simulate(dmd, p, frames[:1]).groups)
     pin = ready + 6
     model_run = schedule.simulate(dmd, p, frames, [pin + PIN_TO_STROBE])
