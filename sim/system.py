@@ -28,7 +28,7 @@ DMD_NS = 5.0
 #: The system run's parameters (the testbench's ``params()``).
 PARAMS = {"dmd": "test", "mac": "02:00:00:00:00:01", "ip": "10.0.0.2", "port": PORT,
           "memory_bytes": 4 * 2**20, "t_rst": 40, "t_settle": 60, "init_cycles": 200,
-          "init_grace": 4, "mode": "GLOBAL", "order": "MSB_FIRST", "frames": 1, "seed": 1,
+          "init_grace": 4, "mode": "GLOBAL", "order": "MSB_FIRST", "frames": 3, "seed": 1,
           "settle_after_send": 3000}
 
 

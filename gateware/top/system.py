@@ -13,7 +13,7 @@ The top that instantiates this defines the four clock domains and connects the M
 memory controller (platform) or the MCB model (simulation).
 """
 
-from amaranth import Cat, DomainRenamer, Module, Signal
+from amaranth import Cat, DomainRenamer, Module, Mux, Signal
 from amaranth.lib import wiring
 from amaranth.lib.cdc import FFSynchronizer, PulseSynchronizer
 from amaranth.lib.wiring import In, Out
@@ -125,9 +125,12 @@ class Projector(wiring.Component):
         m.submodules.store = store = Store(dmd, slots=self._slots, frame_bits=FRAME_BITS)
         wiring.connect(m, serialiser.words, store.words)
         wiring.connect(m, serialiser.rows, store.rows)
+        # The protocol counts a single streamed frame as a sequence of 1; the store calls streaming
+        # a sequence of 0 and plays sequences of 2 slots or more.
+        seq_len = ingest.settings.sequence_length
         m.d.comb += [
             store.bit_depth.eq(ingest.settings.bit_depth),
-            store.sequence_length.eq(ingest.settings.sequence_length),
+            store.sequence_length.eq(Mux(seq_len > 1, seq_len, 0)),
         ]
         wiring.connect(m, store.mcb_write, wiring.flipped(self.mcb_write))
         wiring.connect(m, store.mcb_read, wiring.flipped(self.mcb_read))

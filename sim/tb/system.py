@@ -22,9 +22,10 @@ from scapy.packet import Raw
 from gateware.dlpc410 import schedule
 from gateware.dlpc410.facts import DMDS
 from gateware.dlpc410.params import PlaneOrder, Registers, ResetMode
+from gateware.store.slots import SlotCounters
 from host import records
 from sim.harness.cocotb_run import params
-from sim.harness.layout import pack
+from sim.harness.layout import pack, unpack
 from sim.models import gmii
 from sim.models.camera import Camera, to_lsb
 from sim.models.dlpc410 import CocotbAdapter, Dlpc410
@@ -148,6 +149,8 @@ async def frame_over_gmii_is_shown_exactly(dut):
                       index, first - pin, error.max())
         matches = [j for j, other in enumerate(images)
                    if np.abs(to_lsb(light, system.plan.params.lsb) - other).max() < 1e-9]
+        if error.max() >= 1e-9:     # what the store made of the rows, to say why
+            dut._log.info("store counters %s", unpack(SlotCounters, int(dut.store.counters.value)))
         assert error.max() < 1e-9, (f"frame {index}: {int((error > 1e-9).sum())} pixels wrong; the image shown "
                                     f"equals sent frame(s) {matches}; period {period}, send ended at dmd cycle "
                                     f"{system.sent_at}, pulses {[(c.cycle, c.kind) for c in pulses[:3]]}")
