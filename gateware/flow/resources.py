@@ -66,10 +66,10 @@ def report(outdir="build/spartan6"):
     top = emit_platform(outdir)
     # the memory controller is the vendor's (generated, not ours to count): a black box here
     from gateware.platform.mcb_instance import McbInstance
-    stub = outdir / "mcb_blackbox.v"
-    stub.write_text(McbInstance.blackbox_verilog())
+    blackbox = outdir / "mcb_blackbox.v"
+    blackbox.write_text(McbInstance.blackbox_verilog())
     # flattened: the WebAssembly ABC fails on the whole hierarchy of the projector's top
-    results["total"] = count(synthesise(outdir / f"{top}.v", top, iopads=True, blackboxes=[stub], flatten=True))
+    results["total"] = count(synthesise(outdir / f"{top}.v", top, iopads=True, blackboxes=[blackbox], flatten=True))
     results["total"]["top"] = top
     return results
 

@@ -133,7 +133,9 @@ class McbInstance(wiring.Component):
     def blackbox_verilog(cls):
         """A Verilog declaration of the generated wrapper's ports, for tools that read our
         Verilog without the vendor's sources (the resource report)."""
-        ports, _ = cls().instance_ports(None)
+        declaration = cls()
+        declaration._MustUse__silence = True     # read for its ports, never elaborated
+        ports, _ = declaration.instance_ports(None)
         kinds = {"i": "input", "o": "output", "io": "inout"}
         lines = []
         for key, value in ports.items():
