@@ -2,8 +2,8 @@
 
 Layers, as data flows through them (one banner each below):
 
-* MAC (``gmii_rx`` / ``gmii_tx``), crossed into ``sync`` by its FIFOs;
-* network stack and application protocol (``sync``);
+* Ethernet (:class:`gateware.net.port.EthernetPort`): the MAC in ``gmii_rx`` / ``gmii_tx``, its
+  FIFOs into ``sync``, the network stack and the application protocol;
 * bit-plane serialiser and the store's writer (``sync``), DDR2 through MCB port 0;
 * the store's slots and plane reader (``dmd``), MCB port 1;
 * the frame broker and the DLPC410 sequencer (``dmd``);
@@ -25,8 +25,7 @@ from gateware.dlpc410.sequencer import Sequencer
 from gateware.mac import gmii
 from gateware.mac.cdc import CountSynchronizer
 from gateware.mac.mdio import StatusPoller
-from gateware.mac.path import ReceivePath, TransmitPath
-from gateware.net.ingest import Ingest
+from gateware.net.port import EthernetPort
 from gateware.store import mcb
 from gateware.store.store import Store
 
@@ -102,10 +101,9 @@ class Projector(wiring.Component):
         m = Module()
         dmd = self._dmd
 
-        # ---- MAC: GMII in and out, FIFOs into and out of sync ------------------------------------
-        m.submodules.mac_rx = mac_rx = ReceivePath()
-        m.submodules.mac_tx = mac_tx = TransmitPath()
-        m.d.comb += [mac_rx.gmii.eq(self.gmii_rx), self.gmii_tx.eq(mac_tx.gmii)]
+        # ---- Ethernet: GMII MAC, stack and application protocol (gmii_rx / gmii_tx -> sync) ------
+        m.submodules.ethernet = ethernet = EthernetPort(dmd, frame_bits=FRAME_BITS, **self._addresses)
+        m.d.comb += [ethernet.gmii_rx.eq(self.gmii_rx), self.gmii_tx.eq(ethernet.gmii_tx)]
 
         m.submodules.phy = phy = StatusPoller(self._sync_hz, reset_cycles=self._mdio_cycles[0],
                                               settle_cycles=self._mdio_cycles[1])
@@ -114,22 +112,17 @@ class Projector(wiring.Component):
             self.mdio_o.eq(phy.mdio_o), self.mdio_oe.eq(phy.mdio_oe), phy.mdio_i.eq(self.mdio_i),
         ]
 
-        # ---- Network stack and application protocol (sync) --------------------------------------
-        m.submodules.ingest = ingest = Ingest(dmd, frame_bits=FRAME_BITS, **self._addresses)
-        wiring.connect(m, mac_rx.frames, ingest.rx)
-        wiring.connect(m, ingest.tx, mac_tx.frames)
-
         # ---- Bit-plane serialiser and the store (sync, then dmd) -------------------------------
         m.submodules.serialiser = serialiser = Serialiser(dmd, lanes=1, frame_bits=FRAME_BITS)
-        wiring.connect(m, ingest.pixels, serialiser.pixels)
+        wiring.connect(m, ethernet.pixels, serialiser.pixels)
         m.submodules.store = store = Store(dmd, slots=self._slots, frame_bits=FRAME_BITS)
         wiring.connect(m, serialiser.words, store.words)
         wiring.connect(m, serialiser.rows, store.rows)
         # The protocol counts a single streamed frame as a sequence of 1; the store calls streaming
         # a sequence of 0 and plays sequences of 2 slots or more.
-        seq_len = ingest.settings.sequence_length
+        seq_len = ethernet.settings.sequence_length
         m.d.comb += [
-            store.bit_depth.eq(ingest.settings.bit_depth),
+            store.bit_depth.eq(ethernet.settings.bit_depth),
             store.sequence_length.eq(Mux(seq_len > 1, seq_len, 0)),
         ]
         wiring.connect(m, store.mcb_write, wiring.flipped(self.mcb_write))
@@ -156,21 +149,21 @@ class Projector(wiring.Component):
             self.camera_out.eq(seq.camera_out),
         ]
         m.submodules.soft_trigger = soft = PulseSynchronizer(i_domain="sync", o_domain="dmd")
-        m.d.comb += [soft.i.eq(ingest.trigger), seq.soft_trigger.eq(soft.o)]
+        m.d.comb += [soft.i.eq(ethernet.trigger), seq.soft_trigger.eq(soft.o)]
 
         # ---- Status: what the status reply reports, carried into sync ---------------------------
         uptime = Signal(48)
         m.d.sync += uptime.eq(uptime + 1)
-        m.d.comb += [ingest.status.uptime_cycles.eq(uptime), ingest.status.clock_hz.eq(int(self._sync_hz))]
+        m.d.comb += [ethernet.status.uptime_cycles.eq(uptime), ethernet.status.clock_hz.eq(int(self._sync_hz))]
         for name, source in (("triggers", seq.status.triggers), ("trigger_overruns", seq.status.overruns),
                              ("frames_shown", seq.status.frames)):
             sync = m.submodules[f"{name}_cdc"] = CountSynchronizer(len(source), i_domain="dmd", o_domain="sync")
-            m.d.comb += [sync.i.eq(source), getattr(ingest.status, name).eq(sync.o)]
+            m.d.comb += [sync.i.eq(source), getattr(ethernet.status, name).eq(sync.o)]
         # dlpc410_state: bit 0 INIT_ACTIVE, 1 RST_ACTIVE, 2 ECP2_FINISHED, 3 DDR2 calibrated,
         # 4 Ethernet link up, 5-6 link speed (2 = 1000 Mb/s)
         state = Signal(4)
         m.submodules.state_cdc = FFSynchronizer(
             Cat(self.dlpc.init_active, self.dlpc.rst_active, self.dlpc.ecp2_finished, self.mcb_read.calib_done),
             state)
-        m.d.comb += ingest.status.dlpc410_state.eq(Cat(state, phy.status.up, phy.status.speed))
+        m.d.comb += ethernet.status.dlpc410_state.eq(Cat(state, phy.status.up, phy.status.speed))
         return m
