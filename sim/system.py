@@ -1,31 +1,34 @@
 """``make sim``: the projector's core end to end on the default scene.
 
-The core's generated Verilog (MAC, network stack, protocol, serialiser, store, sequencer) runs
-under Verilator with the MCB model on both memory ports and the rule-checking DLPC410 model on
-the DMD pins. The default scene is encoded by the host encoder, sent over GMII, triggered, and
-the camera model's image is compared with what was sent.
+:func:`main` is the full-XGA run (:mod:`sim.xga`): the core's generated Verilog (MAC, network
+stack, protocol, serialiser, store, sequencer) on the DLP7000 at TI timing under Verilator, the
+frames played into GMII from a replay file, the Verilog MCB model on both memory ports, and the
+DLPC410 pins recorded and checked after the run by the rule-checking DLPC410 model and the camera
+model. Nothing in Python runs per cycle.
 
-Geometry: the small test DMD (128x96, 4 blocks), with RST_ACTIVE and settle scaled down so that
-a run takes a few minutes; the full-XGA system run needs the GMII replay path wired in (the
-stimulus is driven from Python here) and is still to come.
+:func:`run` is the small-geometry run (128x96, RST_ACTIVE and settle scaled down) with every model
+in Python per cycle and cocotbext-style GMII from Python: the end-to-end test of the suite.
 """
 
 import json
-import os
 import time
 from pathlib import Path
 
 from gateware.dlpc410.facts import DMDS
 from gateware.top.system import Projector
+from sim import xga
 from sim.harness import cocotb_run
 from sim.harness.paths import build_dir
 
-__all__ = ["main", "run", "PARAMS"]
+__all__ = ["main", "run", "PARAMS", "XGA_FRAMES"]
 
 MAC, IP, PORT = 0x02_00_00_00_00_01, 0x0A_00_00_02, 5000
 DMD_NS = 5.0
 
-#: The system run's parameters (the testbench's ``params()``).
+#: Frames ``make sim`` streams.
+XGA_FRAMES = 3
+
+#: The small-geometry system run's parameters (the testbench's ``params()``).
 PARAMS = {"dmd": "test", "mac": "02:00:00:00:00:01", "ip": "10.0.0.2", "port": PORT,
           "memory_bytes": 4 * 2**20, "t_rst": 40, "t_settle": 60, "init_cycles": 200,
           "init_grace": 4, "mode": "GLOBAL", "order": "MSB_FIRST", "frames": 3, "seed": 1,
@@ -44,31 +47,49 @@ def run(key="test", **overrides):
 
 
 def main(frames=None):
-    dmd = DMDS[PARAMS["dmd"]]
+    """``make sim``: the full-XGA run of :mod:`sim.xga` on the default scene; prints the figures."""
+    frames = frames or XGA_FRAMES
+    dmd = xga.DMD
     print(f"make sim: the projector's core (generated Verilog, Verilator) on the default scene, "
-          f"{dmd.columns}x{dmd.rows} 8-bit ({dmd.name}); MCB model on both memory ports; "
-          f"rule-checking DLPC410 model and camera model on the DMD side")
-    os.environ.setdefault("WAVES", "1")
+          f"{dmd.columns}x{dmd.rows} 8-bit ({dmd.name}), {frames} frames streamed over GMII from a replay "
+          f"file; Verilog MCB model on both memory ports; DLPC410 pins recorded and checked afterwards by "
+          f"the rule-checking DLPC410 model and the camera model; TI timing (only INIT_ACTIVE shortened)")
     t0 = time.monotonic()
-    r = run("scene", scene=True, frames=frames or PARAMS["frames"])
-    frames_out = r["frames"]
-    latencies = [f["latency_cycles"] for f in frames_out]
+    r = xga.run("scene", frames=frames)
+    shown, status = r["frames"], r["status"]
+    ns = 1e9 / xga.DMD_HZ
+    latencies = sorted(f["latency_cycles"] for f in shown)
+    typical, worst = latencies[len(latencies) // 2], latencies[-1]
+    optical = r["pulse_to_mirror_cycles"]
     print()
-    print(f"frames shown: {len(frames_out)}; GMII frames sent: {r['gmii_frames_sent']} "
-          f"(one per frame addressed to another UDP port, which the stack drops)")
-    print(f"trigger to first clocking pulse: typical {sorted(latencies)[len(latencies) // 2]} cycles, "
-          f"worst {max(latencies)} cycles ({max(latencies) * DMD_NS:.0f} ns at DCLK = 200 MHz); "
-          f"to the optical change add RST_ACTIVE ({PARAMS['t_rst']} cycles here, 908 at TI timing)")
-    print(f"frame period: {r['period_cycles']} cycles = {r['rate_hz']:.0f} Hz with the scaled timing "
-          f"(schedule model's bound; the gateware equals it cycle for cycle)")
-    print(f"grey error of the reconstructed image: max {max(f['max_error_lsb'] for f in frames_out):g} LSB")
-    print(f"simulation speed: {r['dmd_cycles'] / r['wall_s']:.0f} dmd cycles per wall second "
-          f"({r['dmd_cycles']} cycles in {r['wall_s']:.1f} s)")
-    print(f"wall time: {time.monotonic() - t0:.1f} s including the Verilator build")
-    vcd = Path(r["build"]) / "dump.vcd"
-    if vcd.exists():
-        print(f"waves: {vcd}\n  GTKWave save file (ports grouped by block): {write_save_file(vcd)}")
-    return 0 if all(f["max_error_lsb"] == 0 for f in frames_out) else 1
+    print(f"frames triggered and shown: {len(shown)}")
+    print(f"trigger pin to first clocking pulse: typical {typical} cycles ({typical * ns:.0f} ns), "
+          f"worst {worst} cycles ({worst * ns:.0f} ns)")
+    print(f"trigger pin to the optical change (+ {optical} cycles, pulse to mirror motion, facts "
+          f"t_pulse_to_mirror): typical {typical + optical} cycles ({(typical + optical) * ns / 1e3:.2f} us), "
+          f"worst {worst + optical} cycles ({(worst + optical) * ns / 1e3:.2f} us)")
+    spans = sorted({f["span_cycles"] for f in shown})
+    print(f"frame period (schedule model, global reset, MSB first, LSB {r['lsb_cycles']} cycles, rows every "
+          f"{r['row_period']} cycles): {r['period_cycles']} cycles = {r['rate_hz']:.1f} Hz; first to last "
+          f"pulse of each frame: {spans} cycles, model {r['model_span_cycles']}")
+    drops = {k: v for k, v in status.items() if k.startswith("drop") and v}
+    print(f"status reply: {status['frames']} Ethernet frames received, {status['accepted']} accepted, "
+          f"drops {drops or 'none'}; {status['records_image']} image records, {status['rows']} rows; "
+          f"triggers {status['triggers']}, overruns {status['trigger_overruns']}, frames shown "
+          f"{status['frames_shown']}")
+    print(f"grey error of the reconstructed images: max {max(f['max_error_lsb'] for f in shown):g} LSB "
+          f"({sum(f['wrong_pixels'] for f in shown)} pixels wrong)")
+    print(f"simulation speed: {r['dmd_cycles'] / r['sim_wall_s']:.0f} dmd cycles per wall second "
+          f"({r['dmd_cycles']:.0f} cycles = {r['dmd_cycles'] * ns / 1e6:.1f} ms in {r['sim_wall_s']:.0f} s); "
+          f"one frame from first packet to shown: {r['xga_frame_sim_wall_s']:.0f} s wall")
+    print(f"pin check and camera: {r['check_wall_s']:.0f} s over {r['trace_records']} trace records; "
+          f"wall time {time.monotonic() - t0:.0f} s including the Verilator build")
+    vcd = Path(r["waves"])
+    print(f"waves: {vcd} (DLPC410 pins, trigger, sync and camera outputs from the first trigger "
+          f"through the first planes, written from the pin trace; the full design is not dumped at XGA)\n"
+          f"  GTKWave save file: {write_save_file(vcd, PIN_GROUPS, 'dlpc410')}")
+    exact = all(f["max_error_lsb"] == 0 for f in shown) and len(shown) == frames
+    return 0 if exact else 1
 
 
 #: The core's ports by the block they belong to, for the GTKWave save file.
@@ -87,11 +108,20 @@ SAVE_GROUPS = {
 }
 
 
-def write_save_file(vcd):
+#: The pin trace's fields by what they are, for the XGA run's save file.
+PIN_GROUPS = {
+    "trigger, sync and camera": ["trigger_in", "sync_out", "camera_out"],
+    "DLPC410 commands": ["dvalid", "rowmd[1:0]", "rowad[10:0]", "blkmd[1:0]", "blkad[3:0]", "rst2blkz"],
+    "DLPC410 data": ["din_a[31:0]", "din_b[31:0]"],
+    "DLPC410 state": ["arstz", "init_active", "rst_active", "ecp2_finished"],
+}
+
+
+def write_save_file(vcd, groups=None, scope="projector"):
     lines = [f'[dumpfile] "{vcd}"', "[timestart] 0"]
-    for group, signals in SAVE_GROUPS.items():
+    for group, signals in (groups or SAVE_GROUPS).items():
         lines += [f"-{group}", "@28"]
-        lines += [f"projector.{name}" for name in signals]
+        lines += [f"{scope}.{name}" for name in signals]
     path = vcd.with_suffix(".gtkw")
     path.write_text("\n".join(lines) + "\n")
     return path

@@ -13,7 +13,7 @@ DLPU040C    DLPC410 user guide, table 1-1 (binary pattern rates)
 DLP7000     DLP7000 datasheet (timing 7.12, initialisation 8.3)
 DLPC910     sister part's datasheet (same interface family)
 refHDL      TI's applications-FPGA reference HDL as quoted in public repositories
-forum       TI E2E forum answer quoting the datasheet; Mathews et al., IEEE QCE 2022 (measured)
+forum       TI E2E forum answers (quoting the datasheet); Mathews et al., IEEE QCE 2022 (measured)
 """
 
 from dataclasses import dataclass
@@ -39,6 +39,9 @@ TIMING = {
                          "RST_ACTIVE high after a mirror clocking pulse; no new pulse before it falls"),
     "t_settle": Fact(8e-6, "s", "forum; DLPA008B 4.1", "medium",
                      "after RST_ACTIVE falls, a pulsed block's memory must not change for this long"),
+    "t_pulse_to_mirror": Fact(4.5e-6, "s", "forum (TI E2E DLP9500 thread 1075252)", "medium",
+                              "from the start of a mirror clocking pulse (reset) to the start of the "
+                              "mirrors' motion; fixed by the physics, whatever the number of blocks"),
     "t_crossover": Fact(4e-6, "s", "DLP7000 7.12", "high", "mirror crossover time"),
     "t_switch": Fact(12.5e-6, "s", "DLP7000 7.12", "high", "typical mirror switching time"),
     "t_init": Fact(220e-3, "s", "DLP7000 8.3", "medium", "INIT_ACTIVE high after ARSTZ"),

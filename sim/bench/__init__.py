@@ -13,4 +13,5 @@ MODULES = [
     "sim.bench.store",
     "sim.bench.seq",
     "sim.bench.system",
+    "sim.bench.system_xga",
 ]

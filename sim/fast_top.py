@@ -1,0 +1,218 @@
+"""The system simulation's fast top: the projector's core with its surroundings in Verilog.
+
+Simulation only. Around :class:`gateware.top.system.Projector` it places the Verilog models of
+``sim/hdl/`` so that nothing in Python runs per cycle:
+
+* ``gmii_replay.v`` plays a GMII receive file written by :mod:`sim.models.gmii` (the host
+  encoder's records in scapy-built datagrams) into ``gmii_rx``;
+* ``mcb_model.v`` is the memory behind both MCB ports, with the timing of
+  :class:`sim.models.mcb.McbTiming` in each port's cycles;
+* ``dlpc410_responder.v`` drives INIT_ACTIVE, RST_ACTIVE and ECP2_FINISHED as the DLPC410 model
+  does (the offline replay cross-checks them);
+* two ``trace_recorder.v`` write the DLPC410 pins (with the trigger, sync and camera pins) and the
+  GMII transmit pins to files, only on cycles where something happens, for the rule-checking
+  model and the camera model (:mod:`sim.models.trace`) after the run.
+
+Clocks come from the testbench: ``clk`` (125 MHz) and ``dmd_clk`` (200 MHz); resets are made
+inside. The GMII receive and transmit domains run on ``clk`` here: every edge costs the simulator
+an evaluation, and three 125 MHz clocks apart would cost three (the small-geometry run,
+:mod:`sim.tb.system`, keeps all four clocks apart). The trigger comes from the testbench too.
+"""
+
+import math
+
+from amaranth import Cat, ClockDomain, ClockSignal, Const, Instance, Module, ResetSignal, Signal
+from amaranth.lib import data, wiring
+from amaranth.lib.wiring import In, Out
+
+from gateware.dlpc410.params import Registers
+from gateware.mac import gmii
+from gateware.store import mcb
+from gateware.top.system import Projector
+from sim.harness.layout import pack
+from sim.harness.paths import ROOT
+from sim.models.dlpc410 import timing_cycles
+from sim.models.mcb import McbTiming
+
+__all__ = ["FastSystem", "pin_layout", "SOURCES", "PLUSARGS", "read_rate"]
+
+#: The Verilog models the top instantiates.
+SOURCES = [ROOT / "sim" / "hdl" / name for name in
+           ("gmii_replay.v", "mcb_model.v", "dlpc410_responder.v", "trace_recorder.v")]
+#: Plusargs naming the files: GMII replay in, DLPC410 pin trace and GMII transmit trace out.
+PLUSARGS = {"replay": "GMII_REPLAY", "pins": "DLPC_TRACE", "tx": "GMII_TX_TRACE"}
+
+#: Cycles each domain stays in reset after its clock starts.
+RESET_CYCLES = 4
+
+#: GMII line rate in 64-bit words per second (the store's write traffic at most).
+_INGEST_WORDS_PER_S = 125e6 / 8
+
+
+def pin_layout(buses):
+    """One record of the DLPC410 pin trace: the pins the model reads, the controller's outputs
+    the responder drove, and the trigger, sync and camera pins."""
+    return data.StructLayout({
+        **{f"din_{b}": 32 for b in "abcd"[:buses]},
+        "dvalid": 1, "rowmd": 2, "rowad": 11, "blkmd": 2, "blkad": 4, "rst2blkz": 1, "comp_data": 1,
+        "ns_flip": 1, "wdt_enblz": 1, "pwr_float": 1, "arstz": 1,
+        "init_active": 1, "rst_active": 1, "ecp2_finished": 1,
+        "trigger_in": 1, "sync_out": 1, "camera_out": 1,
+    })
+
+
+def read_rate(timing, dmd_hz):
+    """(numerator, denominator): words per ``dmd`` cycle the read port gets. The store's writes
+    (at most the GMII line rate) take their share of the DDR2 bandwidth first; refresh is
+    modelled separately (``mcb_model.v`` stalls)."""
+    words_per_s = timing.peak_bytes_per_s * timing.efficiency / 8 - _INGEST_WORDS_PER_S
+    den = 1000
+    return min(den, math.floor(words_per_s / dmd_hz * den)), den
+
+
+class FastSystem(wiring.Component):
+    """The projector's core with GMII replay, memory, DLPC410 responder and pin recorders.
+
+    Parameters
+    ----------
+    dmd : DmdType
+    registers : dict
+        The sequencer's registers (:class:`gateware.dlpc410.params.Registers` fields), fixed for
+        the run.
+    mac, ip, port : int
+        The core's addresses.
+    clocks : dict
+        ``{"sync": Hz, "dmd": Hz}`` (the memory timing is converted to each port's cycles).
+    init_cycles, init_grace_cycles : int
+        The responder's initialisation time and grace (as the DLPC410 model's).
+    memory_words : int
+        64-bit words of memory.
+
+    Members
+    -------
+    clk, dmd_clk : In(1)
+        125 MHz (``sync`` and both GMII domains) and 200 MHz (``dmd``); each domain leaves reset
+        ``RESET_CYCLES`` cycles after its clock starts.
+    trigger_in : In(1)
+        The trigger pin.
+    replay_start : In(1); replay_busy : Out(1)
+        A pulse plays the GMII replay file (the file is opened at the pulse); busy while playing.
+    flush : In(1)
+        Writes the recorders' buffered lines to their files.
+    mcb_fault : Out(8)
+        The memory ports' rule-break codes (``mcb_model.v``), 4 bits per port; 0 = none.
+    """
+
+    def __init__(self, dmd, registers, *, mac, ip, port, clocks, init_cycles=200, init_grace_cycles=4,
+                 memory_words=1 << 21, timing=None):
+        self._dmd = dmd
+        self._registers = registers
+        self._addresses = dict(mac=mac, ip=ip, port=port)
+        self._clocks = clocks
+        self._init = (init_cycles, init_grace_cycles)
+        self._memory_words = memory_words
+        self._timing = timing or McbTiming()
+        super().__init__({
+            "clk": In(1),
+            "dmd_clk": In(1),
+            "trigger_in": In(1),
+            "replay_start": In(1),
+            "replay_busy": Out(1),
+            "flush": In(1),
+            "mcb_fault": Out(8),
+        })
+
+    def _memory(self, m, core):
+        t = self._timing
+        hz = [self._clocks["sync"], self._clocks["dmd"]]
+
+        def per_port(values):
+            return Const(sum(int(v) << (32 * i) for i, v in enumerate(values)), 64)
+
+        def cycles(seconds):
+            return per_port(max(1, math.ceil(seconds * f)) for f in hz)
+
+        num, den = read_rate(t, self._clocks["dmd"])
+        ports = [core.mcb_write, core.mcb_read]
+        connections = {}
+        for name, member in mcb.PortSignature().members.items():
+            both = Cat(*(getattr(p, name) for p in ports))
+            # Out members are driven by the core: inputs of the model
+            connections[("i_" if member.flow == wiring.Out else "o_") + name] = both
+        m.submodules.memory = Instance(
+            "mcb_model",
+            p_PORTS=2, p_WORDS=self._memory_words,
+            p_CALIB_CYCLES=cycles(t.calib_delay_s),
+            p_RATE_NUM=per_port([1, num]), p_RATE_DEN=per_port([1, den]),
+            p_CMD_LATENCY=cycles(t.command_latency_s), p_READ_LATENCY=cycles(t.read_latency_s),
+            p_REFRESH_INTERVAL=cycles(t.refresh_interval_s), p_REFRESH_CYCLES=cycles(t.refresh_s),
+            i_clk=Cat(ClockSignal("sync"), ClockSignal("dmd")),
+            o_fault=self.mcb_fault,
+            **connections)
+
+    def _clocks_and_resets(self, m):
+        """Domains from the two clock ports; resets from a counter in each domain. A reset
+        port would make Verilator re-evaluate, on every clock edge, all the logic that depends
+        on it (that is, nearly all): an internal reset is evaluated with its registers."""
+        domains = {"sync": self.clk, "gmii_rx": self.clk, "gmii_tx": self.clk, "dmd": self.dmd_clk}
+        for name, clock in domains.items():
+            m.domains += ClockDomain(name)
+            m.d.comb += ClockSignal(name).eq(clock)
+        for name, clock in (("sync", self.clk), ("dmd", self.dmd_clk)):
+            m.domains += ClockDomain(f"{name}_por", reset_less=True)
+            m.d.comb += ClockSignal(f"{name}_por").eq(clock)
+            count = Signal(range(RESET_CYCLES + 1), name=f"{name}_por_count")
+            with m.If(count != RESET_CYCLES):
+                m.d[f"{name}_por"] += count.eq(count + 1)
+            m.d.comb += ResetSignal(name).eq(count != RESET_CYCLES)
+        for name in ("gmii_rx", "gmii_tx"):
+            m.d.comb += ResetSignal(name).eq(ResetSignal("sync"))
+
+    def elaborate(self, platform):
+        m = Module()
+        dmd = self._dmd
+        self._clocks_and_resets(m)
+        m.submodules.core = core = Projector(dmd, **self._addresses, sync_hz=self._clocks["sync"],
+                                             mdio_cycles=(40, 10))
+        # The sequencer's registers for the run (one place: the core's power-up registers later).
+        m.d.comb += core.regs.eq(pack(Registers, self._registers))
+        m.d.comb += [core.trigger_in.eq(self.trigger_in), core.sync_in.eq(0), core.mdio_i.eq(1)]
+
+        rx = Signal(gmii.RxPins)
+        m.submodules.replay = Instance(
+            "gmii_replay",
+            i_clk=ClockSignal("gmii_rx"), i_start=self.replay_start,
+            o_rx_d=rx.d, o_rx_dv=rx.dv, o_rx_er=rx.er, o_busy=self.replay_busy)
+        m.d.comb += core.gmii_rx.eq(rx)
+
+        self._memory(m, core)
+
+        rst_active, init_active, ecp2 = Signal(), Signal(), Signal()
+        cycles = timing_cycles(self._clocks["dmd"])
+        m.submodules.responder = Instance(
+            "dlpc410_responder",
+            p_DCLK_PER_ROW=dmd.dclk_per_row, p_RST_ACTIVE_CYCLES=cycles["rst_active_cycles"],
+            p_INIT_CYCLES=self._init[0], p_INIT_GRACE_CYCLES=self._init[1], p_ECP2_CYCLES=4,
+            i_clk=ClockSignal("dmd"), i_rst=ResetSignal("dmd"), i_arstz=core.dlpc.arstz, i_dvalid=core.dlpc.dvalid,
+            i_blkmd=core.dlpc.blkmd,
+            o_init_active=init_active, o_rst_active=rst_active, o_ecp2_finished=ecp2)
+        m.d.comb += [core.dlpc.rst_active.eq(rst_active), core.dlpc.init_active.eq(init_active),
+                     core.dlpc.ecp2_finished.eq(ecp2), core.dlpc.dmd_type.eq(dmd.dmd_type_code or 0)]
+
+        pins = Signal(pin_layout(dmd.buses))
+        for name, _ in pin_layout(dmd.buses):
+            if hasattr(core.dlpc, name):
+                m.d.comb += getattr(pins, name).eq(getattr(core.dlpc, name))
+        m.d.comb += [pins.trigger_in.eq(self.trigger_in), pins.sync_out.eq(core.sync_out),
+                     pins.camera_out.eq(core.camera_out)]
+        m.submodules.pin_trace = Instance(
+            "trace_recorder", p_WIDTH=len(pins.as_value()), p_PLUSARG=PLUSARGS["pins"],
+            i_clk=ClockSignal("dmd"), i_rst=ResetSignal("dmd"), i_value=pins.as_value(),
+            i_always_record=core.dlpc.dvalid, i_flush=self.flush)
+        tx = Signal(gmii.TxPins)
+        m.d.comb += tx.eq(core.gmii_tx)
+        m.submodules.tx_trace = Instance(
+            "trace_recorder", p_WIDTH=len(tx.as_value()), p_PLUSARG=PLUSARGS["tx"],
+            i_clk=ClockSignal("gmii_tx"), i_rst=ResetSignal("gmii_tx"), i_value=tx.as_value(), i_always_record=tx.en,
+            i_flush=self.flush)
+        return m

@@ -1,0 +1,238 @@
+// Spartan-6 MCB native user ports with one shared memory: the fast memory of the system run.
+//
+// Simulation only. The same port protocol and rules as the Python model sim/models/mcb.py (which
+// stays the reference and the checker of the store's tests), at nanoseconds per cycle instead of
+// a Python call per cycle. PORTS 64-bit ports, each in its own clock, share one memory of WORDS
+// words. Signals of port p are bits [p*W +: W] of the vectors below.
+//
+// Per port (in its clock's cycles; every timing parameter holds one 32-bit value per port, port
+// 0 in the low bits): 4 commands, 64 write words and 64 read words (first-word-fall-
+// through); flags registered as the Python model's outputs. A command starts CMD_LATENCY cycles
+// after it was pushed at the earliest, then moves one word whenever the port's rate accumulator
+// (RATE_NUM / RATE_DEN words per cycle) allows; read words reach the read FIFO READ_LATENCY
+// cycles later. Every REFRESH_INTERVAL cycles the port pauses REFRESH_CYCLES. calib_done rises
+// after CALIB_CYCLES. Not modelled: arbitration between the ports (each port has its own rate;
+// give each the share of the DDR2 bandwidth it may count on) and random stalls.
+//
+// Rule breaks (the Python model's McbError kinds) print a message and set the port's sticky
+// `fault` code: 1 before_calib, 2 cmd_full, 3 misaligned, 4 out_of_range, 5 data_missing,
+// 6 wr_full, 7 rd_empty, 8 underrun, 9 overflow, 10 bad_instruction.
+module mcb_model #(
+    parameter PORTS = 2,
+    parameter WORDS = 1 << 21,
+    parameter [32*PORTS-1:0] CALIB_CYCLES = {32'd200, 32'd125},
+    parameter [32*PORTS-1:0] RATE_NUM = {32'd7, 32'd1},
+    parameter [32*PORTS-1:0] RATE_DEN = {32'd8, 32'd1},
+    parameter [32*PORTS-1:0] CMD_LATENCY = {32'd2, 32'd2},
+    parameter [32*PORTS-1:0] READ_LATENCY = {32'd12, 32'd8},
+    parameter [32*PORTS-1:0] REFRESH_INTERVAL = {32'd1560, 32'd975},
+    parameter [32*PORTS-1:0] REFRESH_CYCLES = {32'd32, 32'd20}
+) (
+    input  wire [PORTS-1:0]     clk,
+    input  wire [PORTS-1:0]     cmd_en,
+    input  wire [3*PORTS-1:0]   cmd_instr,
+    input  wire [6*PORTS-1:0]   cmd_bl,
+    input  wire [30*PORTS-1:0]  cmd_byte_addr,
+    output wire [PORTS-1:0]     cmd_full,
+    output wire [PORTS-1:0]     cmd_empty,
+    input  wire [PORTS-1:0]     wr_en,
+    input  wire [64*PORTS-1:0]  wr_data,
+    input  wire [8*PORTS-1:0]   wr_mask,
+    output wire [PORTS-1:0]     wr_full,
+    output wire [PORTS-1:0]     wr_empty,
+    output wire [7*PORTS-1:0]   wr_count,
+    output wire [PORTS-1:0]     wr_underrun,
+    output wire [PORTS-1:0]     wr_error,
+    input  wire [PORTS-1:0]     rd_en,
+    output wire [64*PORTS-1:0]  rd_data,
+    output wire [PORTS-1:0]     rd_full,
+    output wire [PORTS-1:0]     rd_empty,
+    output wire [7*PORTS-1:0]   rd_count,
+    output wire [PORTS-1:0]     rd_overflow,
+    output wire [PORTS-1:0]     rd_error,
+    output wire [PORTS-1:0]     calib_done,
+    output wire [4*PORTS-1:0]   fault
+);
+    // the ports write the one memory from their own clocks (behavioural, simulation only)
+    /* verilator lint_off MULTIDRIVEN */
+    reg [63:0] mem [0:WORDS-1];
+    /* verilator lint_on MULTIDRIVEN */
+
+    integer i;
+    initial for (i = 0; i < WORDS; i = i + 1) mem[i] = 64'd0;
+
+    genvar p;
+    generate for (p = 0; p < PORTS; p = p + 1) begin : port
+        localparam [31:0] CALIB = CALIB_CYCLES[32*p +: 32];
+        localparam [31:0] NUM = RATE_NUM[32*p +: 32];
+        localparam [31:0] DEN = RATE_DEN[32*p +: 32];
+        localparam [31:0] CMD_WAIT = CMD_LATENCY[32*p +: 32];
+        localparam [31:0] READ_WAIT = READ_LATENCY[32*p +: 32];
+        localparam [31:0] REFRESH_EVERY = REFRESH_INTERVAL[32*p +: 32];
+        localparam [31:0] REFRESH_TIME = REFRESH_CYCLES[32*p +: 32];
+
+        // command FIFO: instr, words, word address, cycle pushed
+        reg [2:0]  c_instr [0:3];
+        reg [6:0]  c_words [0:3];
+        reg [31:0] c_addr  [0:3];
+        reg [31:0] c_time  [0:3];
+        integer c_head, c_n;
+        // write FIFO: data, mask; read FIFO
+        reg [63:0] w_data [0:63];
+        reg [7:0]  w_mask [0:63];
+        integer w_head, w_n;
+        reg [63:0] r_data [0:63];
+        integer r_head, r_n;
+        // read words on their way: arrival cycle and data, in order
+        reg [63:0] f_data [0:63];
+        reg [31:0] f_time [0:63];
+        integer f_head, f_n;
+        // the command being executed
+        reg busy, writing;
+        integer words_left, addr, owed, acc, refresh_left;
+        reg [31:0] cycle;
+        reg calib, bad_write;
+        reg [63:0] word, keep;
+        integer b, k;
+        // registered outputs
+        reg o_cmd_full, o_cmd_empty, o_wr_full, o_wr_empty, o_underrun;
+        reg o_rd_full, o_rd_empty, o_overflow, o_calib_done;
+        reg [6:0] o_wr_count, o_rd_count;
+        reg [63:0] o_rd_data;
+        reg [3:0] o_fault;
+        assign cmd_full[p] = o_cmd_full;
+        assign cmd_empty[p] = o_cmd_empty;
+        assign wr_full[p] = o_wr_full;
+        assign wr_empty[p] = o_wr_empty;
+        assign wr_count[7*p +: 7] = o_wr_count;
+        assign wr_underrun[p] = o_underrun;
+        assign wr_error[p] = o_underrun;
+        assign rd_data[64*p +: 64] = o_rd_data;
+        assign rd_full[p] = o_rd_full;
+        assign rd_empty[p] = o_rd_empty;
+        assign rd_count[7*p +: 7] = o_rd_count;
+        assign rd_overflow[p] = o_overflow;
+        assign rd_error[p] = o_overflow;
+        assign calib_done[p] = o_calib_done;
+        assign fault[4*p +: 4] = o_fault;
+
+        initial begin
+            c_head = 0; c_n = 0; w_head = 0; w_n = 0; r_head = 0; r_n = 0; f_head = 0; f_n = 0;
+            busy = 0; writing = 0; words_left = 0; addr = 0; owed = 0; acc = 0; refresh_left = 0;
+            cycle = 0; calib = 0;
+            o_cmd_full = 0; o_cmd_empty = 1; o_wr_full = 0; o_wr_empty = 1; o_underrun = 0;
+            o_rd_full = 0; o_rd_empty = 1; o_overflow = 0; o_calib_done = 0;
+            o_wr_count = 0; o_rd_count = 0; o_rd_data = 0; o_fault = 0;
+        end
+
+        task automatic break_rule(input [3:0] code, input [8*40-1:0] what);
+            begin
+                $display("mcb_model: port %0d: %0s (cycle %0d)", p, what, cycle);
+                if (o_fault == 0) o_fault <= code;
+            end
+        endtask
+
+        always @(posedge clk[p]) begin
+            cycle = cycle + 1;
+            // -- the fabric side, in the Python model's order: read, command, write word
+            if ((cmd_en[p] || wr_en[p] || rd_en[p]) && !calib)
+                break_rule(1, "traffic before calib_done");
+            if (rd_en[p]) begin
+                if (r_n == 0) break_rule(7, "rd_en while rd_empty");
+                else begin r_head = (r_head + 1) % 64; r_n = r_n - 1; end
+            end
+            if (cmd_en[p]) begin
+                if (c_n >= 4) break_rule(2, "cmd_en while cmd_full");
+                else if (cmd_instr[3*p +: 3] > 3'd4) break_rule(10, "bad instruction");
+                else if (cmd_instr[3*p +: 3] != 3'd4 && cmd_byte_addr[30*p +: 3] != 0)
+                    break_rule(3, "misaligned byte address");
+                else if (cmd_instr[3*p +: 3] != 3'd4
+                         && (cmd_byte_addr[30*p+3 +: 27] + cmd_bl[6*p +: 6] + 1) > WORDS)
+                    break_rule(4, "burst ends past the memory");
+                else begin
+                    bad_write = !cmd_instr[3*p] && !cmd_instr[3*p+2]
+                                && (w_n - owed < cmd_bl[6*p +: 6] + 1);
+                    if (bad_write) break_rule(5, "write command before its data");
+                    k = (c_head + c_n) % 4;
+                    c_instr[k] = cmd_instr[3*p +: 3];
+                    c_words[k] = cmd_bl[6*p +: 6] + 1;
+                    c_addr[k] = cmd_byte_addr[30*p+3 +: 27];
+                    c_time[k] = cycle;
+                    c_n = c_n + 1;
+                    if (!cmd_instr[3*p] && !cmd_instr[3*p+2]) owed = owed + cmd_bl[6*p +: 6] + 1;
+                end
+            end
+            if (wr_en[p]) begin
+                if (w_n >= 64) break_rule(6, "wr_en while wr_full");
+                else begin
+                    k = (w_head + w_n) % 64;
+                    w_data[k] = wr_data[64*p +: 64];
+                    w_mask[k] = wr_mask[8*p +: 8];
+                    w_n = w_n + 1;
+                end
+            end
+            // -- the controller side
+            if (cycle % REFRESH_EVERY == 0) refresh_left = REFRESH_TIME;
+            if (!busy && c_n != 0 && cycle >= c_time[c_head] + CMD_WAIT && refresh_left == 0) begin
+                busy = c_instr[c_head] != 3'd4;
+                writing = !c_instr[c_head][0];
+                words_left = c_words[c_head];
+                addr = c_addr[c_head];
+                c_head = (c_head + 1) % 4;
+                c_n = c_n - 1;
+            end
+            if (refresh_left != 0) refresh_left = refresh_left - 1;
+            else if (busy) begin
+                acc = acc + NUM;
+                if (acc >= DEN) begin
+                    acc = acc - DEN;
+                    if (writing) begin
+                        if (w_n == 0) begin
+                            break_rule(8, "write FIFO empty during a write");
+                            o_underrun <= 1'b1;
+                        end else begin
+                            keep = 64'd0;
+                            for (b = 0; b < 8; b = b + 1)
+                                if (w_mask[w_head][b]) keep[8*b +: 8] = 8'hFF;
+                            mem[addr] = (mem[addr] & keep) | (w_data[w_head] & ~keep);
+                            w_head = (w_head + 1) % 64;
+                            w_n = w_n - 1;
+                            owed = owed - 1;
+                        end
+                    end else begin
+                        k = (f_head + f_n) % 64;
+                        f_data[k] = mem[addr];
+                        f_time[k] = cycle + READ_WAIT;
+                        f_n = f_n + 1;
+                    end
+                    addr = addr + 1;
+                    words_left = words_left - 1;
+                    if (words_left == 0) begin busy = 0; acc = 0; end
+                end
+            end
+            while (f_n != 0 && f_time[f_head] <= cycle) begin
+                if (r_n >= 64) begin
+                    break_rule(9, "read data arrived at a full read FIFO");
+                    o_overflow <= 1'b1;
+                end else begin
+                    r_data[(r_head + r_n) % 64] = f_data[f_head];
+                    r_n = r_n + 1;
+                end
+                f_head = (f_head + 1) % 64;
+                f_n = f_n - 1;
+            end
+            if (cycle >= CALIB) calib = 1;
+            // -- registered outputs for the next cycle
+            o_cmd_full <= c_n >= 4;
+            o_cmd_empty <= c_n == 0;
+            o_wr_full <= w_n >= 64;
+            o_wr_empty <= w_n == 0;
+            o_wr_count <= w_n;
+            o_rd_data <= r_n != 0 ? r_data[r_head] : 64'd0;
+            o_rd_full <= r_n >= 64;
+            o_rd_empty <= r_n == 0;
+            o_rd_count <= r_n;
+            o_calib_done <= calib;
+        end
+    end endgenerate
+endmodule

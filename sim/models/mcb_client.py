@@ -1,0 +1,145 @@
+"""A well-behaved MCB port client and scripted rule breaks, to hold the Verilog memory model
+(``sim/hdl/mcb_model.v``) against the Python one (:mod:`sim.models.mcb`).
+
+:class:`Client` is a cycle-by-cycle user of one port: ``step(outputs) -> inputs``, the same
+function on both models. It follows the port's rules (write data before its command, no push
+while full, read commands only when the read FIFO has room for every word in flight) and keeps
+the words it read. :data:`CASES` are scripts that each break one rule, named by the Python
+model's :class:`~sim.models.mcb.McbError` kind.
+"""
+
+import random
+
+from sim.models.mcb import FIFO_DEPTH, READ, WRITE, McbError, McbModel
+
+__all__ = ["Client", "traffic", "writes", "reads", "python_reads", "python_fault", "CASES", "FAULTS",
+           "PERIODS_S"]
+
+#: ``mcb_model.v`` fault codes -> the Python model's error kinds.
+FAULTS = {1: "before_calib", 2: "cmd_full", 3: "misaligned", 4: "out_of_range", 5: "data_missing",
+          6: "wr_full", 7: "rd_empty", 8: "underrun", 9: "overflow", 10: "bad_instruction"}
+#: The port clock periods the Verilog model's default parameters stand for.
+PERIODS_S = (8e-9, 5e-9)
+WORDS = 1 << 21     # mcb_model.v's default
+
+
+class Client:
+    """Runs ``ops``: ``("write", byte address, [(data, mask), ...])`` or ``("read", byte address,
+    words)``, one command each (at most 64 words), in order."""
+
+    def __init__(self, ops):
+        self.ops = list(ops)
+        self.read = []
+        self._pushed = 0          # data words of the current write already pushed
+        self._in_flight = 0       # read words asked for and not yet taken
+
+    def done(self):
+        return not self.ops and self._in_flight == 0
+
+    def step(self, out):
+        inputs = {}
+        if not out["calib_done"]:
+            return inputs
+        if not out["rd_empty"] and self._in_flight:
+            self.read.append(out["rd_data"])
+            self._in_flight -= 1
+            inputs["rd_en"] = 1
+        if not self.ops:
+            return inputs
+        kind, address, payload = self.ops[0]
+        if kind == "write":
+            if self._pushed < len(payload):
+                if not out["wr_full"]:
+                    data, mask = payload[self._pushed]
+                    inputs.update(wr_en=1, wr_data=data, wr_mask=mask)
+                    self._pushed += 1
+            elif not out["cmd_full"]:
+                inputs.update(cmd_en=1, cmd_instr=WRITE, cmd_bl=len(payload) - 1, cmd_byte_addr=address)
+                self.ops.pop(0)
+                self._pushed = 0
+        elif not out["cmd_full"] and self._in_flight + payload <= FIFO_DEPTH - out["rd_count"]:
+            inputs.update(cmd_en=1, cmd_instr=READ, cmd_bl=payload - 1, cmd_byte_addr=address)
+            self._in_flight += payload
+            self.ops.pop(0)
+        return inputs
+
+
+def traffic(seed=0, bursts=24):
+    """Write bursts of 1..64 words (some bytes masked) at scattered addresses, each then read
+    back in two halves."""
+    rng = random.Random(seed)
+    ops = []
+    for i in range(bursts):
+        words = rng.randint(1, 64)
+        address = (i * 4096 + rng.randrange(0, 2048)) * 8
+        payload = [(rng.getrandbits(64), rng.choice([0, 0, 0, 0x0F, 0x81])) for _ in range(words)]
+        ops.append(("write", address, payload))
+    return ops
+
+
+def writes(ops):
+    return [op for op in ops if op[0] == "write"]
+
+
+def reads(ops):
+    """Each write's words read back, in two commands where it has more than one word."""
+    out = []
+    for _kind, address, payload in writes(ops):
+        half = max(1, len(payload) // 2)
+        out.append(("read", address, half))
+        if len(payload) > half:
+            out.append(("read", address + 8 * half, len(payload) - half))
+    return out
+
+
+def _run(model, port, client, period, cycles=100000):
+    outputs = model.ports[port].outputs
+    for cycle in range(1, cycles + 1):
+        outputs = model.ports[port].clock(cycle * period, **client.step(outputs))
+        if client.done():
+            return cycle
+    raise AssertionError("the client did not finish on the Python model")
+
+
+def python_reads(ops):
+    """What :func:`reads` of ``ops`` returns on the Python model after the writes on port 0."""
+    model = McbModel(WORDS * 8)
+    _run(model, 0, Client(writes(ops)), PERIODS_S[0])
+    reader = Client(reads(ops))
+    _run(model, 1, reader, PERIODS_S[1])
+    return reader.read
+
+
+def python_fault(script, port):
+    """The error kind the Python model raises on ``script`` (per-cycle inputs) on ``port``."""
+    model = McbModel(WORDS * 8)
+    try:
+        for cycle, inputs in enumerate(script, start=1):
+            model.ports[port].clock(cycle * PERIODS_S[port], **inputs)
+        for cycle in range(len(script) + 1, len(script) + 400):
+            model.ports[port].clock(cycle * PERIODS_S[port])
+    except McbError as error:
+        return error.kind
+    return None
+
+
+def _after_calib(*cycles):
+    return [{}] * 210 + list(cycles)
+
+
+def _read(address, words=1):
+    return {"cmd_en": 1, "cmd_instr": READ, "cmd_bl": words - 1, "cmd_byte_addr": address}
+
+
+#: Scripts (per-cycle inputs of one port) that break one rule each.
+CASES = {
+    "before_calib": lambda: [_read(0)],
+    "rd_empty": lambda: _after_calib({"rd_en": 1}),
+    "misaligned": lambda: _after_calib(_read(4)),
+    "out_of_range": lambda: _after_calib(_read(WORDS * 8 - 8, 2)),
+    "data_missing": lambda: _after_calib({"wr_en": 1, "wr_data": 1}, {"wr_en": 1, "wr_data": 2},
+                                         {"cmd_en": 1, "cmd_instr": WRITE, "cmd_bl": 2, "cmd_byte_addr": 0}),
+    "wr_full": lambda: _after_calib(*[{"wr_en": 1, "wr_data": i} for i in range(FIFO_DEPTH + 1)]),
+    "cmd_full": lambda: _after_calib(*[_read(64 * 8 * i, 64) for i in range(8)]),
+    "overflow": lambda: _after_calib(_read(0, 64), _read(512, 64)),
+}

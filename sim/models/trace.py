@@ -1,0 +1,134 @@
+"""Reading the pin traces of the fast system run (``sim/hdl/trace_recorder.v``) after the run.
+
+A trace has a line ``<cycle> <hex value>`` for cycle 0 and every cycle on which the recorded
+bus changed or was marked (DVALID high; TX_EN high); on the cycles between two lines the bus
+held the earlier line's value.
+
+:func:`replay_dlpc410` feeds a DLPC410 pin trace to the rule-checking
+:class:`sim.models.dlpc410.Dlpc410` (``step`` on recorded cycles, ``idle`` over the gaps, which
+have DVALID low) and checks on every recorded cycle that the controller outputs the Verilog
+responder drove equal the model's; :func:`gmii_frames` cuts a GMII transmit trace into frames;
+:func:`write_vcd` turns a window of a trace into waves.
+"""
+
+from amaranth.lib import data
+
+from gateware.mac import gmii as gmii_pins
+from sim.models.dlpc410 import INPUTS, OUTPUTS
+
+__all__ = ["read", "fields", "Mismatch", "replay_dlpc410", "rising_edges", "gmii_frames", "write_vcd"]
+
+#: Controller outputs the responder drives and the replay compares.
+COMPARED = ("init_active", "rst_active", "ecp2_finished")
+
+
+class Mismatch(AssertionError):
+    """The responder's outputs differ from the DLPC410 model's."""
+
+
+def read(path):
+    """``[(cycle, value)]`` of a trace file."""
+    out = []
+    with open(path) as f:
+        for line in f:
+            cycle, value = line.split()
+            out.append((int(cycle), int(value, 16)))
+    return out
+
+
+def fields(layout):
+    """``[(name, offset, mask)]`` of a flat struct layout, for fast unpacking."""
+    layout = data.Layout.cast(layout)
+    return [(name, field.offset, (1 << field.width) - 1) for name, field in layout]
+
+
+def rising_edges(trace, layout, name):
+    """Cycles on which field ``name`` rose."""
+    _, offset, mask = next(f for f in fields(layout) if f[0] == name)
+    edges, last = [], 0
+    for cycle, value in trace:
+        level = value >> offset & mask
+        if level and not last:
+            edges.append(cycle)
+        last = level
+    return edges
+
+
+def replay_dlpc410(model, trace, layout, *, until=None):
+    """Feed ``trace`` (from :func:`read`) of pins with ``layout`` to ``model`` up to cycle
+    ``until`` (default: the last record). Raises the model's RuleBreak on a broken rule and
+    :class:`Mismatch` when the recorded controller outputs differ from the model's."""
+    unpack = fields(layout)
+    inputs = [f for f in unpack if f[0] in INPUTS]
+    outputs = [f for f in unpack if f[0] in OUTPUTS and f[0] in COMPARED]
+    held = None
+    for cycle, value in trace:
+        if until is not None and cycle > until:
+            break
+        if cycle > model.cycle:
+            model.idle(cycle - model.cycle, held)
+        assert cycle == model.cycle, f"trace cycle {cycle} behind the model's {model.cycle}"
+        want = model.outputs()
+        for name, offset, mask in outputs:
+            if value >> offset & mask != want[name]:
+                raise Mismatch(f"cycle {cycle}: the responder drove {name.upper()}={value >> offset & mask}, "
+                               f"the DLPC410 model says {want[name]}")
+        held = {name: value >> offset & mask for name, offset, mask in inputs}
+        model.step(held)
+    if until is not None and held is not None and until > model.cycle:
+        model.idle(until - model.cycle, held)
+    return model
+
+
+def gmii_frames(trace):
+    """The frames (bytes after the SFD, FCS included) on a GMII transmit trace."""
+    unpack = {name: (offset, mask) for name, offset, mask in fields(gmii_pins.TxPins)}
+    (d_off, d_mask), (en_off, _) = unpack["d"], unpack["en"]
+    frames, current, last_cycle = [], None, None
+    for cycle, value in trace:
+        en = value >> en_off & 1
+        if en and current is not None and cycle == last_cycle + 1:
+            current.append(value >> d_off & d_mask)
+        elif en:
+            if current:
+                frames.append(current)
+            current = [value >> d_off & d_mask]
+        elif current:
+            frames.append(current)
+            current = None
+        last_cycle = cycle
+    if current:
+        frames.append(current)
+    out = []
+    for frame in frames:
+        raw = bytes(frame)
+        sfd = raw.find(bytes([gmii_pins.SFD_BYTE]))
+        out.append(raw[sfd + 1:] if sfd >= 0 else raw)
+    return out
+
+
+def write_vcd(path, trace, layout, *, start, end, ns_per_cycle, scope="dlpc410"):
+    """A VCD of the records of ``trace`` in cycles ``[start, end)`` (the value held at ``start``
+    included), one wire per field of ``layout``; time in ns."""
+    unpack = fields(layout)
+    codes = {name: chr(33 + i) for i, (name, _, _) in enumerate(unpack)}
+    widths = {name: mask.bit_length() for name, _, mask in unpack}
+    lines = ["$timescale 1ps $end", f"$scope module {scope} $end"]
+    lines += [f"$var wire {widths[n]} {codes[n]} {n} $end" for n, _, _ in unpack]
+    lines += ["$upscope $end", "$enddefinitions $end"]
+    last = {}
+    held = next((v for c, v in reversed(trace) if c <= start), 0)
+    window = [(start, held)] + [(c, v) for c, v in trace if start < c < end]
+    for cycle, value in window:
+        changes = []
+        for name, offset, mask in unpack:
+            field = value >> offset & mask
+            if last.get(name) != field:
+                last[name] = field
+                changes.append(f"b{field:b} {codes[name]}" if widths[name] > 1 else f"{field}{codes[name]}")
+        if changes:
+            lines.append(f"#{round((cycle - start) * ns_per_cycle * 1000)}")
+            lines += changes
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    return path

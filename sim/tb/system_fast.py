@@ -1,0 +1,122 @@
+"""cocotb stimulus of the fast system run (:class:`sim.fast_top.FastSystem`).
+
+Python does not run per cycle here: the clocks are cocotb's C clocks, GMII comes from the replay
+file, the memory and the DLPC410 responder are Verilog, the pins go to trace files. This
+testbench only starts each replay, raises the trigger at chosen instants and waits on edges of
+``replay_busy`` or on timers; the checks are made after the run on the traces
+(:mod:`sim.xga`).
+
+Sequence: frame 0 is sent; each frame is then triggered while the next one is sent (as a
+renderer streams), the next trigger coming once the frame has been shown and the next one has
+arrived; at the end a status query is sent and the reply is recorded on the transmit pins.
+"""
+
+import json
+import shutil
+import time
+from pathlib import Path
+
+import cocotb
+from cocotb.clock import Clock
+from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
+
+from sim.harness.cocotb_run import params
+
+SYNC_NS, DMD_NS = 8.0, 5.0
+
+
+class Run:
+    def __init__(self, dut, p):
+        self.dut, self.p = dut, p
+        self.wall0 = time.monotonic()
+        self.events = {"sends": [], "triggers_ns": [], "wall": {}}
+
+    def now_ns(self):
+        return cocotb.utils.get_sim_time("ns")
+
+    def log(self, text):
+        sim_us = self.now_ns() / 1e3
+        self.dut._log.info("%s  [%.0f us simulated, %.0f s wall]", text, sim_us, time.monotonic() - self.wall0)
+
+    async def start(self):
+        dut = self.dut
+        dut.trigger_in.value = 0
+        dut.replay_start.value = 0
+        dut.flush.value = 0
+        # the edges of the two clocks never coincide (the GMII domains run on clk); the top
+        # holds each domain in reset for its first cycles
+        Clock(dut.clk, SYNC_NS, unit="ns").start()
+        await Timer(750, "ps")
+        Clock(dut.dmd_clk, DMD_NS, unit="ns").start()
+
+    async def send(self, path, what):
+        """Play one replay file; returns when its last byte is on the pins."""
+        dut = self.dut
+        shutil.copyfile(path, self.p["replay"])
+        await RisingEdge(dut.clk)
+        t0, w0 = self.now_ns(), time.monotonic()
+        dut.replay_start.value = 1
+        await RisingEdge(dut.clk)
+        dut.replay_start.value = 0
+        await FallingEdge(dut.replay_busy)
+        self.events["sends"].append({"what": what, "start_ns": t0, "end_ns": self.now_ns(),
+                                     "wall_start": w0 - self.wall0, "wall_end": time.monotonic() - self.wall0})
+        self.log(f"{what} sent over GMII")
+
+    async def trigger(self, phase_ps):
+        """A trigger pulse, ``phase_ps`` after a ``dmd`` rising edge (the pin is asynchronous)."""
+        dut = self.dut
+        await RisingEdge(dut.dmd_clk)
+        if phase_ps:
+            await Timer(phase_ps, "ps")
+        self.events["triggers_ns"].append(self.now_ns())
+        dut.trigger_in.value = 1
+        await Timer(40, "ns")
+        dut.trigger_in.value = 0
+
+    async def progress(self, every_us):
+        while True:
+            await Timer(every_us, "us")
+            self.log("running")
+
+    def check_memory(self):
+        fault = int(self.dut.mcb_fault.value)
+        assert fault == 0, f"memory model: rule broken on a port (codes {fault:#04x}, see the log)"
+
+
+@cocotb.test()
+async def stream_frames(dut):
+    p = params()
+    run = Run(dut, p)
+    await run.start()
+    cocotb.start_soon(run.progress(p["progress_us"]))
+    period_ns = p["period_cycles"] * DMD_NS
+    frames = p["frames"]
+    await run.send(p["replays"][0], f"frame 1/{frames}")
+    await Timer(p["settle_us"], "us")
+    for index in range(frames):
+        # a different phase of the trigger against DCLK each time: latency has a spread
+        phase = (index * 1300) % int(DMD_NS * 1000)
+        await run.trigger(phase)
+        shown_at = run.events["triggers_ns"][-1] + period_ns + p["margin_us"] * 1e3
+        run.log(f"frame {index + 1}/{frames} triggered")
+        if index + 1 < frames:
+            await run.send(p["replays"][index + 1], f"frame {index + 2}/{frames}")
+            await Timer(p["settle_us"], "us")
+        wait = shown_at - run.now_ns()
+        if wait > 0:
+            await Timer(round(wait), "ns")
+        if index == 0:
+            run.events["wall"]["first_frame_shown"] = time.monotonic() - run.wall0
+        run.log(f"frame {index + 1}/{frames} shown")
+        run.check_memory()
+    await run.send(p["status_query"], "status query")
+    await Timer(p["reply_us"], "us")
+    dut.flush.value = 1
+    await ClockCycles(dut.clk, 2)
+    await ClockCycles(dut.dmd_clk, 2)
+    dut.flush.value = 0
+    run.check_memory()
+    run.events["sim_ns"] = run.now_ns()
+    run.events["wall_s"] = time.monotonic() - run.wall0
+    Path(p["report"]).write_text(json.dumps(run.events))

@@ -1,0 +1,183 @@
+"""The full-XGA system run: the projector's core on the DLP7000 at TI timing, end to end.
+
+:func:`run` encodes the default scene (1024x768, 8 bits) with the host encoder into scapy-built
+datagrams, writes one GMII replay file per frame, builds :class:`sim.fast_top.FastSystem` with
+Verilator and runs :mod:`sim.tb.system_fast` (no Python per cycle). After the run it replays the
+DLPC410 pin trace through the rule-checking model (every rule, and the Verilog responder's
+outputs against the model's), reconstructs each triggered frame with the camera model, decodes
+the status reply from the transmit trace, and returns the figures.
+
+Timing: DCLK 200 MHz, RST_ACTIVE and settle from the facts table (no scaling); only the
+DLPC410's initialisation (220 ms) is shortened, to ``INIT_CYCLES``. The schedule comes from
+:func:`gateware.dlpc410.schedule.plan` with the read bandwidth the memory model gives the plane
+reader.
+"""
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+from scapy.layers.inet import IP, UDP
+from scapy.layers.l2 import Ether
+from scapy.packet import Raw
+
+from gateware.dlpc410 import schedule
+from gateware.dlpc410.facts import DMDS, TIMING
+from host import records
+from sim.fast_top import PLUSARGS, SOURCES, FastSystem, pin_layout, read_rate
+from sim.harness import cocotb_run
+from sim.harness.paths import build_dir
+from sim.models import gmii, trace
+from sim.models.camera import Camera, to_lsb
+from sim.models.dlpc410 import Dlpc410
+from sim.models.mcb import McbTiming
+from sim.scene import default_scene
+
+__all__ = ["run", "plan", "DMD", "DMD_HZ"]
+
+DMD = DMDS["dlp7000"]
+DMD_HZ, SYNC_HZ = 200e6, 125e6
+MAC, IP_ADDR, PORT = 0x02_00_00_00_00_01, 0x0A_00_00_02, 5000
+HOST_MAC, HOST_IP = "02:00:00:00:00:99", "10.0.0.1"
+INIT_CYCLES, INIT_GRACE = 200, 4
+TOPLEVEL = "fast_system"
+#: Cycles before and after the first trigger that the VCD of the pins covers.
+WAVE_WINDOW = (1000, 40000)
+
+
+def plan():
+    """The schedule for the run: global reset, MSB first, rows paced to the memory's read rate
+    (with refresh stalls taken off)."""
+    t = McbTiming()
+    num, den = read_rate(t, DMD_HZ)
+    words_per_cycle = num / den * (1 - t.refresh_s / t.refresh_interval_s)
+    return schedule.plan(DMD, DMD_HZ, depth=8, words_per_cycle=words_per_cycle)
+
+
+def top(the_plan):
+    return FastSystem(DMD, the_plan.params.registers(DMD), mac=MAC, ip=IP_ADDR, port=PORT,
+                      clocks={"sync": SYNC_HZ, "dmd": DMD_HZ}, init_cycles=INIT_CYCLES,
+                      init_grace_cycles=INIT_GRACE)
+
+
+def _datagrams(payloads):
+    dst = ":".join(f"{MAC >> (8 * i) & 0xFF:02x}" for i in reversed(range(6)))
+    ip = ".".join(str(IP_ADDR >> (8 * i) & 0xFF) for i in reversed(range(4)))
+    return [bytes(Ether(src=HOST_MAC, dst=dst) / IP(src=HOST_IP, dst=ip) / UDP(sport=40000, dport=PORT)
+                  / Raw(payload)) for payload in payloads]
+
+
+def _replay_files(directory, images):
+    """One GMII replay file per frame (its image records) and one with a status query."""
+    files, sequence, datagrams = [], 0, 0
+    for index, image in enumerate(images):
+        payloads = records.image_records(image, frame=index, sequence=sequence)
+        sequence += len(payloads)
+        datagrams += len(payloads)
+        path = directory / f"frame{index}.bin"
+        gmii.replay_file(path, _datagrams(payloads))
+        files.append(str(path))
+    query = directory / "status_query.bin"
+    gmii.replay_file(query, _datagrams([records.status_query(sequence)]))
+    return files, str(query), datagrams + 1
+
+
+def _status(tx_trace):
+    """The status reply's fields, from the GMII transmit trace."""
+    for frame in trace.gmii_frames(tx_trace):
+        packet = Ether(frame[:-4])
+        if UDP in packet and packet[UDP].sport == PORT:
+            head, body, _ = records.decode(bytes(packet[UDP].payload))
+            if head["type"] == records.RecordType.STATUS_REPLY:
+                return body
+    raise AssertionError("no status reply on the transmit pins")
+
+
+def run(key="xga", frames=3, *, log=print):
+    """Build and run the XGA system simulation on ``frames`` frames of the default scene;
+    returns the report (dict). Raises on a broken DLPC410 or memory rule, a responder mismatch
+    or a missing status reply; the images' errors are in the report."""
+    the_plan = plan()
+    directory = build_dir("system", key)
+    t0 = time.monotonic()
+    images = default_scene(frames, DMD.rows, DMD.columns)
+    replays, query, datagrams = _replay_files(directory, images)
+    log(f"scene encoded: {frames} frames, {datagrams} datagrams ({time.monotonic() - t0:.1f} s)")
+    files = {name: directory / f"{name}.txt" for name in ("pins", "tx")}
+    report_path = directory / "stimulus.json"
+    p = {"frames": frames, "replays": replays, "status_query": query, "replay": str(directory / "replay.bin"),
+         "period_cycles": the_plan.frame_cycles, "settle_us": 250, "margin_us": 20, "reply_us": 30,
+         "progress_us": 2000, "report": str(report_path)}
+    plusargs = [f"+{PLUSARGS['replay']}={p['replay']}", f"+{PLUSARGS['pins']}={files['pins']}",
+                f"+{PLUSARGS['tx']}={files['tx']}"]
+    t_build = time.monotonic()
+    build = cocotb_run.run(top(the_plan), toplevel=TOPLEVEL, module="sim.tb.system_fast", key="dlp7000",
+                           params=p, extra_sources=SOURCES, plusargs=plusargs, waves=False)
+    stimulus = json.loads(report_path.read_text())
+    sim_wall = stimulus["wall_s"]
+    log(f"simulation done: build and run {time.monotonic() - t_build:.0f} s, of which the run {sim_wall:.0f} s; "
+        f"checking the pins")
+    return analyse(the_plan, images, stimulus, files, build=build)
+
+
+def analyse(the_plan, images, stimulus, files, *, build=None):
+    t0 = time.monotonic()
+    layout = pin_layout(DMD.buses)
+    pins = trace.read(files["pins"])
+    model = Dlpc410(DMD, dclk=DMD_HZ, init_cycles=INIT_CYCLES, init_grace_cycles=INIT_GRACE)
+    trace.replay_dlpc410(model, pins, layout)
+    triggers = trace.rising_edges(pins, layout, "trigger_in")
+    pulses = [c.cycle for c in model.log if c.kind == "pulse"]
+    period, lsb = the_plan.frame_cycles, the_plan.params.lsb
+    camera = Camera(model, ramp_cycles=0)
+    shown = []
+    for index, pin in enumerate(triggers):
+        end = triggers[index + 1] if index + 1 < len(triggers) else model.cycle
+        mine = [c for c in pulses if pin <= c < end]
+        assert mine, f"trigger {index} produced no clocking pulse"
+        first = mine[0]
+        light = to_lsb(camera.image(first, first + period), lsb)
+        error = np.abs(light - images[index].astype(np.float64))
+        shown.append({"trigger_cycle": pin, "latency_cycles": first - pin, "pulses": len(mine),
+                      "span_cycles": mine[-1] - first, "max_error_lsb": float(error.max()),
+                      "wrong_pixels": int((error > 1e-9).sum())})
+    status = _status(trace.read(files["tx"]))
+    waves = None
+    if triggers:
+        waves = trace.write_vcd(Path(files["pins"]).with_suffix(".vcd"), pins, layout,
+                                start=triggers[0] - WAVE_WINDOW[0], end=triggers[0] + WAVE_WINDOW[1],
+                                ns_per_cycle=1e9 / DMD_HZ)
+    sends = stimulus["sends"]
+    first_frame = sends[0]
+    return {
+        "frames": shown,
+        "period_cycles": period,
+        "rate_hz": the_plan.rate_hz,
+        "model_span_cycles": _model_span(the_plan),
+        "lsb_cycles": lsb,
+        "row_period": the_plan.params.row_period,
+        "pulse_to_mirror_cycles": round(TIMING["t_pulse_to_mirror"].value * DMD_HZ),
+        "status": status,
+        "sends": sends,
+        "dmd_cycles": stimulus["sim_ns"] / (1e9 / DMD_HZ),
+        "sim_wall_s": stimulus["wall_s"],
+        "xga_frame_sim_wall_s": stimulus["wall"]["first_frame_shown"] - first_frame["wall_start"],
+        "trace_records": len(pins),
+        "waves": str(waves),
+        "check_wall_s": time.monotonic() - t0,
+        "build": str(build) if build else None,
+    }
+
+
+def _model_span(the_plan):
+    """First to last clocking pulse of one frame in the schedule model."""
+    p = the_plan.params
+    fr = schedule.Frame(0, 8)
+    r = schedule.simulate(DMD, p, [fr], [schedule.ready_cycle(DMD, p, fr)], max_frames=1)
+    cycles = [c for c, *_ in r.pulses]
+    return cycles[-1] - cycles[0]
+
+
+if __name__ == "__main__":
+    print(json.dumps(run(frames=1), indent=1, default=str))

@@ -1,0 +1,26 @@
+"""The system run's Verilog memory model against the Python MCB model: same data, same rules."""
+
+import pytest
+
+from sim.harness import cocotb_run
+from sim.harness.paths import ROOT
+
+SOURCE = ROOT / "sim" / "hdl" / "mcb_model.v"
+
+
+def run(testcase, **params):
+    cocotb_run.run(None, toplevel="mcb_model", module="sim.tb.mcb_model", key="default", testcase=testcase,
+                   extra_sources=[SOURCE], params=params)
+
+
+@pytest.mark.verilog
+def test_traffic_agrees_with_python_model():
+    run("client_traffic_agrees")
+
+
+@pytest.mark.verilog
+@pytest.mark.parametrize("case", [("before_calib", "rd_empty"), ("misaligned", "out_of_range"),
+                                  ("data_missing", "wr_full"), ("cmd_full", "overflow")],
+                         ids="-".join)
+def test_rule_breaks_agree_with_python_model(case):
+    run("scripted_rule_breaks", case=list(case))
