@@ -113,7 +113,8 @@ def run(key="xga", frames=3, *, log=print):
                 f"+{PLUSARGS['tx']}={files['tx']}"]
     t_build = time.monotonic()
     build = cocotb_run.run(top(the_plan), toplevel=TOPLEVEL, module="sim.tb.system_fast", key="dlp7000",
-                           params=p, extra_sources=SOURCES, plusargs=plusargs, waves=False)
+                           params=p, extra_sources=SOURCES, plusargs=plusargs, waves=False,
+                           top_signals_only=True)
     stimulus = json.loads(report_path.read_text())
     sim_wall = stimulus["wall_s"]
     log(f"simulation done: build and run {time.monotonic() - t_build:.0f} s, of which the run {sim_wall:.0f} s; "

@@ -64,7 +64,7 @@ def _tokens(text):
 
 
 def run(component, *, toplevel, module, key, params=None, testcase=None, waves=None,
-        extra_sources=(), plusargs=(), timeout_s=None):
+        extra_sources=(), plusargs=(), timeout_s=None, top_signals_only=False):
     """Build ``component`` and run the cocotb tests in ``module`` against it.
 
     Parameters
@@ -79,6 +79,11 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
         Names the parameter set; one build directory per key.
     params : dict
         JSON-able parameters handed to the testbench.
+    top_signals_only : bool
+        Make only the top module's signals visible to the testbench, not every signal of the
+        design (cocotb's default). Verilator must then re-evaluate only the logic that depends on
+        the top's inputs when the testbench drives one (a clock edge included), not all of it:
+        several times faster on a large design.
     """
     from cocotb_tools.check_results import get_results
     from cocotb_tools.runner import get_runner
@@ -94,6 +99,13 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
         sources.insert(0, source)
 
     runner = get_runner("verilator")
+    if top_signals_only:
+        control = build / "public.vlt"
+        text = f'`verilator_config\npublic_flat_rw -module "{toplevel}" -var "*"\n'
+        if not control.exists() or control.read_text() != text:
+            control.write_text(text)
+        sources.append(control)
+        _drop_public_flat_rw(runner)
     runner.build(
         sources=sources,
         hdl_toplevel=toplevel,
@@ -131,6 +143,18 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
     assert tests > 0, f"cocotb ran no test from {module}"
     assert failed == 0, f"{failed} of {tests} cocotb tests failed in {module} (see {build})"
     return build
+
+
+def _drop_public_flat_rw(runner):
+    """The cocotb runner always passes ``--public-flat-rw``; take it out of its build command."""
+    build_command = runner._build_command
+
+    def without():
+        commands = build_command()
+        commands[0] = [arg for arg in commands[0] if arg != "--public-flat-rw"]
+        return commands
+
+    runner._build_command = without
 
 
 def params():
