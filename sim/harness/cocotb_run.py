@@ -104,7 +104,7 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
         text = f'`verilator_config\npublic_flat_rw -module "{toplevel}" -var "*"\n'
         if not control.exists() or control.read_text() != text:
             control.write_text(text)
-        sources.append(control)
+        sources.insert(0, control)      # the runner takes the last source for the top's language
         _drop_public_flat_rw(runner)
     runner.build(
         sources=sources,
