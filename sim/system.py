@@ -81,7 +81,7 @@ def main(frames=None):
           f"({sum(f['wrong_pixels'] for f in shown)} pixels wrong)")
     print(f"simulation speed: {r['dmd_cycles'] / r['sim_wall_s']:.0f} dmd cycles per wall second "
           f"({r['dmd_cycles']:.0f} cycles = {r['dmd_cycles'] * ns / 1e6:.1f} ms in {r['sim_wall_s']:.0f} s); "
-          f"one frame from first packet to shown: {r['xga_frame_sim_wall_s']:.0f} s wall")
+          f"one frame from its first packet to its last clocking pulse: {r['xga_frame_sim_wall_s']:.1f} s wall")
     print(f"pin check and camera: {r['check_wall_s']:.0f} s over {r['trace_records']} trace records; "
           f"wall time {time.monotonic() - t0:.0f} s including the Verilator build")
     vcd = Path(r["waves"])

@@ -74,6 +74,11 @@ class Run:
         await Timer(40, "ns")
         dut.trigger_in.value = 0
 
+    async def mark(self, at_ns, name):
+        """Note the wall time when simulated time reaches ``at_ns``."""
+        await Timer(round(at_ns - self.now_ns()), "ns")
+        self.events["wall"][name] = time.monotonic() - self.wall0
+
     async def progress(self, every_us):
         while True:
             await Timer(every_us, "us")
@@ -100,14 +105,15 @@ async def stream_frames(dut):
         await run.trigger(phase)
         shown_at = run.events["triggers_ns"][-1] + period_ns + p["margin_us"] * 1e3
         run.log(f"frame {index + 1}/{frames} triggered")
+        if index == 0:
+            last_pulse = run.events["triggers_ns"][0] + p["last_pulse_cycles"] * DMD_NS
+            cocotb.start_soon(run.mark(last_pulse, "first_frame_last_pulse"))
         if index + 1 < frames:
             await run.send(p["replays"][index + 1], f"frame {index + 2}/{frames}")
             await Timer(p["settle_us"], "us")
         wait = shown_at - run.now_ns()
         if wait > 0:
             await Timer(round(wait), "ns")
-        if index == 0:
-            run.events["wall"]["first_frame_shown"] = time.monotonic() - run.wall0
         run.log(f"frame {index + 1}/{frames} shown")
         run.check_memory()
     await run.send(p["status_query"], "status query")
