@@ -74,7 +74,8 @@ def main(frames=None):
           f"pulse of each frame: {spans} cycles, model {r['model_span_cycles']}")
     drops = {k: v for k, v in status.items() if k.startswith("drop") and v}
     print(f"status reply: {status['frames']} Ethernet frames received, {status['accepted']} accepted, "
-          f"drops {drops or 'none'}; {status['records_image']} image records, {status['rows']} rows; "
+          f"drops {drops or 'none'} (one datagram per frame goes to another UDP port on purpose); "
+          f"{status['records_image']} image records, {status['rows']} rows; "
           f"triggers {status['triggers']}, overruns {status['trigger_overruns']}, frames shown "
           f"{status['frames_shown']}")
     print(f"grey error of the reconstructed images: max {max(f['max_error_lsb'] for f in shown):g} LSB "

@@ -61,22 +61,24 @@ def top(the_plan):
                       init_grace_cycles=INIT_GRACE)
 
 
-def _datagrams(payloads):
+def _datagrams(payloads, port=PORT):
     dst = ":".join(f"{MAC >> (8 * i) & 0xFF:02x}" for i in reversed(range(6)))
     ip = ".".join(str(IP_ADDR >> (8 * i) & 0xFF) for i in reversed(range(4)))
-    return [bytes(Ether(src=HOST_MAC, dst=dst) / IP(src=HOST_IP, dst=ip) / UDP(sport=40000, dport=PORT)
+    return [bytes(Ether(src=HOST_MAC, dst=dst) / IP(src=HOST_IP, dst=ip) / UDP(sport=40000, dport=port)
                   / Raw(payload)) for payload in payloads]
 
 
 def _replay_files(directory, images):
-    """One GMII replay file per frame (its image records) and one with a status query."""
+    """One GMII replay file per frame (its image records, then the first record again addressed
+    to another UDP port, which the stack must drop and count) and one with a status query."""
     files, sequence, datagrams = [], 0, 0
     for index, image in enumerate(images):
         payloads = records.image_records(image, frame=index, sequence=sequence)
         sequence += len(payloads)
-        datagrams += len(payloads)
+        stray = _datagrams(payloads[:1], port=PORT + 1)
+        datagrams += len(payloads) + len(stray)
         path = directory / f"frame{index}.bin"
-        gmii.replay_file(path, _datagrams(payloads))
+        gmii.replay_file(path, _datagrams(payloads) + stray)
         files.append(str(path))
     query = directory / "status_query.bin"
     gmii.replay_file(query, _datagrams([records.status_query(sequence)]))
