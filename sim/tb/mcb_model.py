@@ -1,22 +1,28 @@
 """cocotb: the Verilog MCB model (``sim/hdl/mcb_model.v``) against the Python one.
 
-The same client (:class:`sim.models.mcb_client.Client`) runs on both: the words it reads back and
-the memory it leaves must agree. Scripted rule breaks, one per port and run (the Verilog fault
+The same client (:class:`sim.models.mcb_client.Client`) runs on both: the words it reads back
+must agree. Scripted rule breaks, one per port and run (the Verilog fault
 code is sticky), must give the rule the Python model names.
 """
 
 import cocotb
+from amaranth import Shape
+from amaranth.lib import wiring
 from cocotb.triggers import Timer
+
+from gateware.store import mcb
 
 from sim.harness.cocotb_run import params
 from sim.models import mcb_client
 
-OUTPUTS = ("cmd_full", "cmd_empty", "wr_full", "wr_empty", "wr_count", "rd_data", "rd_full", "rd_empty",
-           "rd_count", "calib_done")
-WIDTHS = {"cmd_en": 1, "cmd_instr": 3, "cmd_bl": 6, "cmd_byte_addr": 30, "wr_en": 1, "wr_data": 64,
-          "wr_mask": 8, "rd_en": 1}
-OUT_WIDTHS = {"cmd_full": 1, "cmd_empty": 1, "wr_full": 1, "wr_empty": 1, "wr_count": 7, "rd_data": 64,
-              "rd_full": 1, "rd_empty": 1, "rd_count": 7, "calib_done": 1}
+
+def _widths(flow):
+    return {name: Shape.cast(member.shape).width for name, member in mcb.PortSignature().members.items()
+            if member.flow == flow}
+
+
+#: The port's members by width: driven by the user (the model's inputs) and by the model.
+WIDTHS, OUT_WIDTHS = _widths(wiring.Out), _widths(wiring.In)
 
 
 class Ports:
