@@ -87,6 +87,9 @@ class FastSystem(wiring.Component):
         The responder's initialisation time and grace (as the DLPC410 model's).
     memory_words : int
         64-bit words of memory.
+    timing : McbTiming, optional
+        DDR2 timing (default :class:`sim.models.mcb.McbTiming`, the Python model's), converted to
+        each port's cycles; the read port gets :func:`read_rate` of it.
 
     Members
     -------
