@@ -32,15 +32,19 @@ from gateware.top.system import Projector
 from sim.harness.layout import pack
 from sim.harness.paths import ROOT
 from sim.models.dlpc410 import timing_cycles
+from sim.models.dlpc410_replay import Replay
 from sim.models.mcb import McbTiming
 
-__all__ = ["FastSystem", "pin_layout", "SOURCES", "PLUSARGS", "read_rate"]
+__all__ = ["FastSystem", "ResponderBench", "dlpc410_side", "pin_layout", "SOURCES", "PLUSARGS", "read_rate"]
 
 #: The Verilog models the top instantiates.
 SOURCES = [ROOT / "sim" / "hdl" / name for name in
            ("gmii_replay.v", "mcb_model.v", "dlpc410_responder.v", "trace_recorder.v")]
 #: Plusargs naming the files: GMII replay in, DLPC410 pin trace and GMII transmit trace out.
 PLUSARGS = {"replay": "GMII_REPLAY", "pins": "DLPC_TRACE", "tx": "GMII_TX_TRACE"}
+
+#: ECP2_FINISHED rises on this cycle (the DLPC410 model's default).
+ECP2_CYCLES = 4
 
 #: Cycles each domain stays in reset after its clock starts.
 RESET_CYCLES = 4
@@ -68,6 +72,61 @@ def read_rate(timing, dmd_hz):
     words_per_s = timing.peak_bytes_per_s * timing.efficiency / 8 - _INGEST_WORDS_PER_S
     den = 1000
     return min(den, math.floor(words_per_s / dmd_hz * den)), den
+
+
+def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cycles, flush, extra=None,
+                 domain="dmd"):
+    """The DLPC410's side of the pins ``dlpc`` (an interface of
+    :class:`gateware.dlpc410.interface.Signature`, seen from its driver): the responder drives the
+    controller's outputs, the recorder writes the pins and ``extra`` (``{field: signal}`` of
+    :func:`pin_layout`'s other fields) to the file of plusarg ``PLUSARGS["pins"]``."""
+    rst_active, init_active, ecp2 = Signal(), Signal(), Signal()
+    m.submodules.responder = Instance(
+        "dlpc410_responder",
+        p_DCLK_PER_ROW=dmd.dclk_per_row, p_RST_ACTIVE_CYCLES=rst_active_cycles,
+        p_INIT_CYCLES=init_cycles, p_INIT_GRACE_CYCLES=init_grace_cycles, p_ECP2_CYCLES=ECP2_CYCLES,
+        i_clk=ClockSignal(domain), i_rst=ResetSignal(domain), i_arstz=dlpc.arstz, i_dvalid=dlpc.dvalid,
+        i_blkmd=dlpc.blkmd,
+        o_init_active=init_active, o_rst_active=rst_active, o_ecp2_finished=ecp2)
+    m.d.comb += [dlpc.rst_active.eq(rst_active), dlpc.init_active.eq(init_active),
+                 dlpc.ecp2_finished.eq(ecp2), dlpc.dmd_type.eq(dmd.dmd_type_code or 0)]
+    pins = Signal(pin_layout(dmd.buses))
+    for name, _ in pin_layout(dmd.buses):
+        if hasattr(dlpc, name):
+            m.d.comb += getattr(pins, name).eq(getattr(dlpc, name))
+    for name, signal in (extra or {}).items():
+        m.d.comb += getattr(pins, name).eq(signal)
+    m.submodules.pin_trace = Instance(
+        "trace_recorder", p_WIDTH=len(pins.as_value()), p_PLUSARG=PLUSARGS["pins"],
+        i_clk=ClockSignal(domain), i_rst=ResetSignal(domain), i_value=pins.as_value(),
+        i_always_record=dlpc.dvalid, i_flush=flush)
+
+
+class ResponderBench(wiring.Component):
+    """:func:`dlpc410_side` behind :class:`sim.models.dlpc410_replay.Replay`: the responder and the
+    pin recorder on driver-built cycle sequences, in ``sync``.
+
+    Members
+    -------
+    select : In; done : Out(1)
+        As :class:`~sim.models.dlpc410_replay.Replay`'s.
+    flush : In(1)
+        Writes the recorder's buffered lines to its file.
+    """
+
+    def __init__(self, dmd, sequences, *, rst_active_cycles, init_cycles, init_grace_cycles=0):
+        self._replay = Replay(dmd, sequences)
+        self._dmd = dmd
+        self._timing = dict(rst_active_cycles=rst_active_cycles, init_cycles=init_cycles,
+                            init_grace_cycles=init_grace_cycles)
+        super().__init__({"select": In(len(self._replay.select)), "done": Out(1), "flush": In(1)})
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.replay = replay = self._replay
+        m.d.comb += [replay.select.eq(self.select), self.done.eq(replay.done)]
+        dlpc410_side(m, self._dmd, replay.dlpc, flush=self.flush, domain="sync", **self._timing)
+        return m
 
 
 class FastSystem(wiring.Component):
@@ -190,28 +249,11 @@ class FastSystem(wiring.Component):
 
         self._memory(m, core)
 
-        rst_active, init_active, ecp2 = Signal(), Signal(), Signal()
         cycles = timing_cycles(self._clocks["dmd"])
-        m.submodules.responder = Instance(
-            "dlpc410_responder",
-            p_DCLK_PER_ROW=dmd.dclk_per_row, p_RST_ACTIVE_CYCLES=cycles["rst_active_cycles"],
-            p_INIT_CYCLES=self._init[0], p_INIT_GRACE_CYCLES=self._init[1], p_ECP2_CYCLES=4,
-            i_clk=ClockSignal("dmd"), i_rst=ResetSignal("dmd"), i_arstz=core.dlpc.arstz, i_dvalid=core.dlpc.dvalid,
-            i_blkmd=core.dlpc.blkmd,
-            o_init_active=init_active, o_rst_active=rst_active, o_ecp2_finished=ecp2)
-        m.d.comb += [core.dlpc.rst_active.eq(rst_active), core.dlpc.init_active.eq(init_active),
-                     core.dlpc.ecp2_finished.eq(ecp2), core.dlpc.dmd_type.eq(dmd.dmd_type_code or 0)]
-
-        pins = Signal(pin_layout(dmd.buses))
-        for name, _ in pin_layout(dmd.buses):
-            if hasattr(core.dlpc, name):
-                m.d.comb += getattr(pins, name).eq(getattr(core.dlpc, name))
-        m.d.comb += [pins.trigger_in.eq(self.trigger_in), pins.sync_out.eq(core.sync_out),
-                     pins.camera_out.eq(core.camera_out)]
-        m.submodules.pin_trace = Instance(
-            "trace_recorder", p_WIDTH=len(pins.as_value()), p_PLUSARG=PLUSARGS["pins"],
-            i_clk=ClockSignal("dmd"), i_rst=ResetSignal("dmd"), i_value=pins.as_value(),
-            i_always_record=core.dlpc.dvalid, i_flush=self.flush)
+        dlpc410_side(m, dmd, core.dlpc, rst_active_cycles=cycles["rst_active_cycles"], init_cycles=self._init[0],
+                     init_grace_cycles=self._init[1], flush=self.flush,
+                     extra={"trigger_in": self.trigger_in, "sync_out": core.sync_out,
+                            "camera_out": core.camera_out})
         tx = Signal(gmii.TxPins)
         m.d.comb += tx.eq(core.gmii_tx)
         m.submodules.tx_trace = Instance(

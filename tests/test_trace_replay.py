@@ -1,26 +1,31 @@
 """Pin traces of the fast system run, read back: the DLPC410 replay gives what stepping the model
 every cycle gives, catches a responder that disagrees with the model, and keeps rule breaks;
-GMII transmit traces give back their frames; a window of a trace becomes a VCD."""
+GMII transmit traces give back their frames; a window of a trace becomes a VCD. The Verilog
+responder and recorder, on replayed sequences, agree with the model."""
 
 import numpy as np
 import pytest
 
 from gateware.dlpc410.facts import TEST_DMD
-from sim.fast_top import pin_layout
+from sim.fast_top import PLUSARGS, SOURCES, ResponderBench, pin_layout
+from sim.harness import cocotb_run
 from sim.harness.layout import pack
+from sim.harness.paths import build_dir
 from sim.models import gmii, trace
 from sim.models.dlpc410 import RULES, Dlpc410, RuleBreak
 from sim.models.dlpc410_replay import MODEL_PARAMS, sequences
+from sim.models.dlpc410_replay import NAMES as NAMES_OF_SEQUENCES
 
 LAYOUT = pin_layout(TEST_DMD.buses)
 NAMES = [name for name, _ in LAYOUT]
+RESPONDER_TIMING = {"rst_active_cycles": MODEL_PARAMS["rst_active_cycles"], "init_cycles": MODEL_PARAMS["init_cycles"]}
 
 
-def record(cycles, *, tamper_at=None):
+def record(cycles, *, tamper_at=None, responder=None):
     """What trace_recorder.v writes for ``cycles`` (per-cycle pin dicts), with the controller
-    outputs a faithful responder drives (a reference model's), one of them flipped at
+    outputs ``responder`` (default: a faithful one, the model's) drives, one of them flipped at
     ``tamper_at``."""
-    reference = Dlpc410(TEST_DMD, **MODEL_PARAMS)
+    reference = responder or Dlpc410(TEST_DMD, **MODEL_PARAMS)
     out, last = [], None
     for c, pins in enumerate(cycles):
         levels = reference.outputs()
@@ -54,6 +59,12 @@ def test_responder_disagreeing_with_the_model_is_caught():
         trace.replay_dlpc410(Dlpc410(TEST_DMD, **MODEL_PARAMS), records, LAYOUT)
 
 
+def test_responder_late_inside_an_unrecorded_gap_is_caught():
+    late = Dlpc410(TEST_DMD, **{**MODEL_PARAMS, "rst_active_cycles": MODEL_PARAMS["rst_active_cycles"] + 1})
+    with pytest.raises(trace.Mismatch, match="RST_ACTIVE=1"):
+        trace.replay_dlpc410(Dlpc410(TEST_DMD, **MODEL_PARAMS), record(sequences()["legal"], responder=late), LAYOUT)
+
+
 def test_rule_break_on_the_trace_is_raised():
     with pytest.raises(RuleBreak) as caught:
         trace.replay_dlpc410(Dlpc410(TEST_DMD, **MODEL_PARAMS), record(sequences()["illegal"]), LAYOUT)
@@ -78,3 +89,28 @@ def test_gmii_frames_from_a_transmit_trace():
         cycle += 1
     records.append((cycle, 0))
     assert trace.gmii_frames(records) == [gmii.wire_bytes(f) for f in frames]
+
+
+@pytest.mark.verilog
+@pytest.mark.parametrize("name", NAMES_OF_SEQUENCES)
+def test_responder_and_recorder_verilog(name):
+    """The Verilog responder and recorder on the legal and the illegal sequence: the recorded
+    trace, replayed, gives the command log of stepping the model every cycle (the responder's
+    outputs equal to the model's on every recorded cycle), or the same rule break."""
+    seqs = sequences()
+    path = build_dir("cocotb", "responder_bench-test") / f"{name}.txt"
+    path.unlink(missing_ok=True)
+    bench = ResponderBench(TEST_DMD, [seqs[n] for n in NAMES_OF_SEQUENCES], **RESPONDER_TIMING)
+    cocotb_run.run(bench, toplevel="responder_bench", module="sim.tb.dlpc410_responder", key="test",
+                   extra_sources=SOURCES, plusargs=[f"+{PLUSARGS['pins']}={path}"],
+                   params={"select": NAMES_OF_SEQUENCES.index(name)}, top_signals_only=True)
+    reference, replayed = Dlpc410(TEST_DMD, **MODEL_PARAMS), Dlpc410(TEST_DMD, **MODEL_PARAMS)
+    try:
+        reference.run(seqs[name])
+    except RuleBreak as error:
+        with pytest.raises(RuleBreak) as caught:
+            trace.replay_dlpc410(replayed, trace.read(path), LAYOUT)
+        assert (caught.value.rule, caught.value.cycle) == (error.rule, error.cycle)
+        return
+    trace.replay_dlpc410(replayed, trace.read(path), LAYOUT)
+    assert replayed.log == reference.log and replayed.log

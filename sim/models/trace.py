@@ -61,19 +61,30 @@ def replay_dlpc410(model, trace, layout, *, until=None):
     unpack = fields(layout)
     inputs = [f for f in unpack if f[0] in INPUTS]
     outputs = [f for f in unpack if f[0] in OUTPUTS and f[0] in COMPARED]
-    held = None
+
+    def check(value):
+        want = model.outputs()
+        for name, offset, mask in outputs:
+            if value >> offset & mask != want[name]:
+                raise Mismatch(f"cycle {model.cycle}: the responder drove {name.upper()}="
+                               f"{value >> offset & mask}, the DLPC410 model says {want[name]}")
+
+    held = last = None
     for cycle, value in trace:
         if until is not None and cycle > until:
             break
         if cycle > model.cycle:
-            model.idle(cycle - model.cycle, held)
+            # a gap: the last record's pins and the responder's outputs held throughout. The
+            # model's outputs can only step once each in a gap (no pulse without DVALID), so
+            # they held too if they match at its first and its last cycle.
+            check(last)
+            model.idle(cycle - 1 - model.cycle, held)
+            check(last)
+            model.idle(1, held)
         assert cycle == model.cycle, f"trace cycle {cycle} behind the model's {model.cycle}"
-        want = model.outputs()
-        for name, offset, mask in outputs:
-            if value >> offset & mask != want[name]:
-                raise Mismatch(f"cycle {cycle}: the responder drove {name.upper()}={value >> offset & mask}, "
-                               f"the DLPC410 model says {want[name]}")
+        check(value)
         held = {name: value >> offset & mask for name, offset, mask in inputs}
+        last = value
         model.step(held)
     if until is not None and held is not None and until > model.cycle:
         model.idle(until - model.cycle, held)
