@@ -6,7 +6,7 @@ Simulation only. Around :class:`gateware.top.system.Projector` it places the Ver
 * ``gmii_replay.v`` plays a GMII receive file written by :mod:`sim.models.gmii` (the host
   encoder's records in scapy-built datagrams) into ``gmii_rx``;
 * ``mcb_model.v`` is the memory behind both MCB ports, with the timing of
-  :class:`sim.models.mcb.McbTiming` in each port's cycles;
+  :class:`sim.models.mcb.McbTiming` (bandwidth shared by the ports, refresh);
 * ``dlpc410_responder.v`` drives INIT_ACTIVE, RST_ACTIVE and ECP2_FINISHED as the DLPC410 model
   does (the offline replay cross-checks them);
 * two ``trace_recorder.v`` write the DLPC410 pins (with the trigger, sync and camera pins) and the
@@ -66,12 +66,9 @@ def pin_layout(buses):
 
 
 def read_rate(timing, dmd_hz):
-    """(numerator, denominator): words per ``dmd`` cycle the read port gets. The store's writes
-    (at most the GMII line rate) take their share of the DDR2 bandwidth first; refresh is
-    modelled separately (``mcb_model.v`` stalls)."""
-    words_per_s = timing.peak_bytes_per_s * timing.efficiency / 8 - _INGEST_WORDS_PER_S
-    den = 1000
-    return min(den, math.floor(words_per_s / dmd_hz * den)), den
+    """Words per ``dmd`` cycle the plane reader can count on: the DDR2's sustained bandwidth
+    (refresh taken off) less the store's writes (at most the GMII line rate)."""
+    return (timing.sustained_bytes_per_s / 8 - _INGEST_WORDS_PER_S) / dmd_hz
 
 
 def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cycles, flush, extra=None,
@@ -147,8 +144,7 @@ class FastSystem(wiring.Component):
     memory_words : int
         64-bit words of memory.
     timing : McbTiming, optional
-        DDR2 timing (default :class:`sim.models.mcb.McbTiming`, the Python model's), converted to
-        each port's cycles; the read port gets :func:`read_rate` of it.
+        DDR2 timing (default :class:`sim.models.mcb.McbTiming`, the Python model's).
 
     Members
     -------
@@ -188,13 +184,9 @@ class FastSystem(wiring.Component):
         t = self._timing
         hz = [self._clocks["sync"], self._clocks["dmd"]]
 
-        def per_port(values):
-            return Const(sum(int(v) << (32 * i) for i, v in enumerate(values)), 64)
-
         def cycles(seconds):
-            return per_port(max(1, math.ceil(seconds * f)) for f in hz)
+            return Const(sum(max(1, math.ceil(seconds * f)) << (32 * i) for i, f in enumerate(hz)), 64)
 
-        num, den = read_rate(t, self._clocks["dmd"])
         ports = [core.mcb_write, core.mcb_read]
         connections = {}
         for name, member in mcb.PortSignature().members.items():
@@ -204,10 +196,9 @@ class FastSystem(wiring.Component):
         m.submodules.memory = Instance(
             "mcb_model",
             p_PORTS=2, p_WORDS=self._memory_words,
-            p_CALIB_CYCLES=cycles(t.calib_delay_s),
-            p_RATE_NUM=per_port([1, num]), p_RATE_DEN=per_port([1, den]),
-            p_CMD_LATENCY=cycles(t.command_latency_s), p_READ_LATENCY=cycles(t.read_latency_s),
-            p_REFRESH_INTERVAL=cycles(t.refresh_interval_s), p_REFRESH_CYCLES=cycles(t.refresh_s),
+            p_CALIB_CYCLES=cycles(t.calib_delay_s), p_CMD_LATENCY=cycles(t.command_latency_s),
+            p_WORD_NS=t.word_s * 1e9, p_READ_LATENCY_NS=t.read_latency_s * 1e9,
+            p_REFRESH_INTERVAL_NS=t.refresh_interval_s * 1e9, p_REFRESH_NS=t.refresh_s * 1e9,
             i_clk=Cat(ClockSignal("sync"), ClockSignal("dmd")),
             o_fault=self.mcb_fault,
             **connections)

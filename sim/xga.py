@@ -47,12 +47,9 @@ WAVE_WINDOW = (1000, 40000)
 
 
 def plan():
-    """The schedule for the run: global reset, MSB first, rows paced to the memory's read rate
-    (with refresh stalls taken off)."""
-    t = McbTiming()
-    num, den = read_rate(t, DMD_HZ)
-    words_per_cycle = num / den * (1 - t.refresh_s / t.refresh_interval_s)
-    return schedule.plan(DMD, DMD_HZ, depth=8, words_per_cycle=words_per_cycle)
+    """The schedule for the run: global reset, MSB first, rows paced to the read bandwidth the
+    memory leaves the plane reader."""
+    return schedule.plan(DMD, DMD_HZ, depth=8, words_per_cycle=read_rate(McbTiming(), DMD_HZ))
 
 
 def top(the_plan):

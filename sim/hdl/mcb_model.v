@@ -5,14 +5,16 @@
 // a Python call per cycle. PORTS 64-bit ports, each in its own clock, share one memory of WORDS
 // words. Signals of port p are bits [p*W +: W] of the vectors below.
 //
-// Per port (in its clock's cycles; every timing parameter holds one 32-bit value per port, port
-// 0 in the low bits): 4 commands, 64 write words and 64 read words (first-word-fall-
-// through); flags registered as the Python model's outputs. A command starts CMD_LATENCY cycles
-// after it was pushed at the earliest, then moves one word whenever the port's rate accumulator
-// (RATE_NUM / RATE_DEN words per cycle) allows; read words reach the read FIFO READ_LATENCY
-// cycles later. Every REFRESH_INTERVAL cycles the port pauses REFRESH_CYCLES. calib_done rises
-// after CALIB_CYCLES. Not modelled: arbitration between the ports (each port has its own rate;
-// give each the share of the DDR2 bandwidth it may count on) and random stalls.
+// Per port: 4 commands, 64 write words and 64 read words (first-word-fall-through); flags
+// registered as the Python model's outputs; calib_done rises after CALIB_CYCLES of the port's
+// clock; a command is taken CMD_LATENCY port cycles after it was pushed at the earliest (both
+// hold one 32-bit value per port, port 0 in the low bits). As in the Python model, the memory is
+// shared in time (ns): a command taken by a port occupies it from when it is free for its words
+// times WORD_NS; its words move at their times (writes leave the write FIFO, reads reach the read
+// FIFO READ_LATENCY_NS later), seen at the port's next clock edge. Every REFRESH_INTERVAL_NS the
+// memory is busy for REFRESH_NS after the command in progress. Commands are granted in the order
+// the ports' edges see them (the Python model: round robin). Not modelled: random stalls. Times
+// are $realtime, in ns with the 1 ns time unit the system build gives modules.
 //
 // Rule breaks (the Python model's McbError kinds) print a message and set the port's sticky
 // `fault` code: 1 before_calib, 2 cmd_full, 3 misaligned, 4 out_of_range, 5 data_missing,
@@ -21,12 +23,11 @@ module mcb_model #(
     parameter PORTS = 2,
     parameter WORDS = 1 << 21,
     parameter [32*PORTS-1:0] CALIB_CYCLES = {32'd200, 32'd125},
-    parameter [32*PORTS-1:0] RATE_NUM = {32'd7, 32'd1},
-    parameter [32*PORTS-1:0] RATE_DEN = {32'd8, 32'd1},
     parameter [32*PORTS-1:0] CMD_LATENCY = {32'd2, 32'd2},
-    parameter [32*PORTS-1:0] READ_LATENCY = {32'd12, 32'd8},
-    parameter [32*PORTS-1:0] REFRESH_INTERVAL = {32'd1560, 32'd975},
-    parameter [32*PORTS-1:0] REFRESH_CYCLES = {32'd32, 32'd20}
+    parameter real WORD_NS = 5.714,
+    parameter real READ_LATENCY_NS = 60.0,
+    parameter real REFRESH_INTERVAL_NS = 7800.0,
+    parameter real REFRESH_NS = 160.0
 ) (
     input  wire [PORTS-1:0]     clk,
     input  wire [PORTS-1:0]     cmd_en,
@@ -58,18 +59,22 @@ module mcb_model #(
     reg [63:0] mem [0:WORDS-1];
     /* verilator lint_on MULTIDRIVEN */
 
+    // when the memory is free, and when the next refresh is due (ns); shared by the ports
+    /* verilator lint_off MULTIDRIVEN */
+    real free_at, refresh_at;
+    /* verilator lint_on MULTIDRIVEN */
+
     integer i;
-    initial for (i = 0; i < WORDS; i = i + 1) mem[i] = 64'd0;
+    initial begin
+        for (i = 0; i < WORDS; i = i + 1) mem[i] = 64'd0;
+        free_at = 0.0;
+        refresh_at = REFRESH_INTERVAL_NS;
+    end
 
     genvar p;
     generate for (p = 0; p < PORTS; p = p + 1) begin : port
         localparam [31:0] CALIB = CALIB_CYCLES[32*p +: 32];
-        localparam [31:0] NUM = RATE_NUM[32*p +: 32];
-        localparam [31:0] DEN = RATE_DEN[32*p +: 32];
         localparam [31:0] CMD_WAIT = CMD_LATENCY[32*p +: 32];
-        localparam [31:0] READ_WAIT = READ_LATENCY[32*p +: 32];
-        localparam [31:0] REFRESH_EVERY = REFRESH_INTERVAL[32*p +: 32];
-        localparam [31:0] REFRESH_TIME = REFRESH_CYCLES[32*p +: 32];
 
         // command FIFO: instr, words, word address, cycle pushed
         reg [2:0]  c_instr [0:3];
@@ -85,11 +90,12 @@ module mcb_model #(
         integer r_head, r_n;
         // read words on their way: arrival cycle and data, in order
         reg [63:0] f_data [0:63];
-        reg [31:0] f_time [0:63];
+        real       f_time [0:63];
         integer f_head, f_n;
         // the command being executed
         reg busy, writing;
-        integer words_left, addr, owed, acc, refresh_left;
+        integer words_left, addr, owed;
+        real now, next_word_at;
         reg [31:0] cycle;
         reg calib, bad_write;
         reg [63:0] word, keep;
@@ -118,7 +124,7 @@ module mcb_model #(
 
         initial begin
             c_head = 0; c_n = 0; w_head = 0; w_n = 0; r_head = 0; r_n = 0; f_head = 0; f_n = 0;
-            busy = 0; writing = 0; words_left = 0; addr = 0; owed = 0; acc = 0; refresh_left = 0;
+            busy = 0; writing = 0; words_left = 0; addr = 0; owed = 0; next_word_at = 0.0;
             cycle = 0; calib = 0;
             o_cmd_full = 0; o_cmd_empty = 1; o_wr_full = 0; o_wr_empty = 1; o_underrun = 0;
             o_rd_full = 0; o_rd_empty = 1; o_overflow = 0; o_calib_done = 0;
@@ -172,45 +178,48 @@ module mcb_model #(
                 end
             end
             // -- the controller side
-            if (cycle % REFRESH_EVERY == 0) refresh_left = REFRESH_TIME;
-            if (!busy && c_n != 0 && cycle >= c_time[c_head] + CMD_WAIT && refresh_left == 0) begin
+            now = $realtime;
+            if (!busy && c_n != 0 && cycle >= c_time[c_head] + CMD_WAIT) begin
+                next_word_at = free_at > now ? free_at : now;
+                while (refresh_at <= next_word_at) begin
+                    next_word_at = next_word_at + REFRESH_NS;
+                    refresh_at = refresh_at + REFRESH_INTERVAL_NS;
+                end
                 busy = c_instr[c_head] != 3'd4;
                 writing = !c_instr[c_head][0];
                 words_left = c_words[c_head];
                 addr = c_addr[c_head];
+                free_at = next_word_at + (busy ? words_left * WORD_NS : REFRESH_NS);
+                next_word_at = next_word_at + WORD_NS;
                 c_head = (c_head + 1) % 4;
                 c_n = c_n - 1;
             end
-            if (refresh_left != 0) refresh_left = refresh_left - 1;
-            else if (busy) begin
-                acc = acc + NUM;
-                if (acc >= DEN) begin
-                    acc = acc - DEN;
-                    if (writing) begin
-                        if (w_n == 0) begin
-                            break_rule(8, "write FIFO empty during a write");
-                            o_underrun <= 1'b1;
-                        end else begin
-                            keep = 64'd0;
-                            for (b = 0; b < 8; b = b + 1)
-                                if (w_mask[w_head][b]) keep[8*b +: 8] = 8'hFF;
-                            mem[addr] = (mem[addr] & keep) | (w_data[w_head] & ~keep);
-                            w_head = (w_head + 1) % 64;
-                            w_n = w_n - 1;
-                            owed = owed - 1;
-                        end
+            while (busy && next_word_at <= now) begin
+                if (writing) begin
+                    if (w_n == 0) begin
+                        break_rule(8, "write FIFO empty during a write");
+                        o_underrun <= 1'b1;
                     end else begin
-                        k = (f_head + f_n) % 64;
-                        f_data[k] = mem[addr];
-                        f_time[k] = cycle + READ_WAIT;
-                        f_n = f_n + 1;
+                        keep = 64'd0;
+                        for (b = 0; b < 8; b = b + 1)
+                            if (w_mask[w_head][b]) keep[8*b +: 8] = 8'hFF;
+                        mem[addr] = (mem[addr] & keep) | (w_data[w_head] & ~keep);
+                        w_head = (w_head + 1) % 64;
+                        w_n = w_n - 1;
+                        owed = owed - 1;
                     end
-                    addr = addr + 1;
-                    words_left = words_left - 1;
-                    if (words_left == 0) begin busy = 0; acc = 0; end
+                end else begin
+                    k = (f_head + f_n) % 64;
+                    f_data[k] = mem[addr];
+                    f_time[k] = next_word_at + READ_LATENCY_NS;
+                    f_n = f_n + 1;
                 end
+                addr = addr + 1;
+                words_left = words_left - 1;
+                next_word_at = next_word_at + WORD_NS;
+                if (words_left == 0) busy = 0;
             end
-            while (f_n != 0 && f_time[f_head] <= cycle) begin
+            while (f_n != 0 && f_time[f_head] <= now) begin
                 if (r_n >= 64) begin
                     break_rule(9, "read data arrived at a full read FIFO");
                     o_overflow <= 1'b1;
