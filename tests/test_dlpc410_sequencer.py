@@ -307,12 +307,14 @@ def waiting_after(p, frames, strobes):
     return next_ready(p, model_frames(frames, None), strobes)
 
 
-@pytest.mark.parametrize("mode", [ResetMode.GLOBAL, ResetMode.DUAL])
-def test_frame_offered_while_waiting_is_shown_next(mode, test_name):
+@pytest.mark.parametrize("mode,lead", [(ResetMode.GLOBAL, 16), (ResetMode.DUAL, 75)])
+def test_frame_offered_while_waiting_is_shown_next(mode, lead, test_name):
     """Frame 1 completes while the projector waits (frame 0 shown, its repeat preloaded): its
-    first plane is loaded at once and the next trigger shows it, not frame 0 again; with
-    nothing newer offered, the next trigger repeats frame 1."""
+    first plane is loaded ``reload_lead`` cycles later (a run-time register: 16, and 75 for a
+    slower store) and the next trigger shows it, not frame 0 again; with nothing newer offered,
+    the next trigger repeats frame 1."""
     p = fast_plan(depth=3, reset_mode=mode).params
+    p.reload_lead = lead
     first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
     idle = waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + 30
     offered = [(0, 3, 0), (1, 3, idle)]
@@ -324,7 +326,7 @@ def test_frame_offered_while_waiting_is_shown_next(mode, test_name):
     assert model.overruns == 0 and len(model.accepted) == 3
     # the reload: every group's first plane again, from slot 1, after the frame was offered
     reloads = [t for t, k, _a in model.commands if k != "pulse" and idle < t < second]
-    assert reloads and reloads[0] >= idle + schedule.RELOAD_LEAD
+    assert reloads and lead <= reloads[0] - idle <= lead + 2
     assert [s for _t, s in run.releases] == [0]
 
 
@@ -335,7 +337,7 @@ def test_trigger_during_reload_is_an_overrun(test_name):
     first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
     idle = waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + 30
     offered = [(0, 3, 0), (1, 3, idle)]
-    early = [idle - PIN_TO_STROBE, idle + schedule.RELOAD_LEAD + 10 - PIN_TO_STROBE]
+    early = [idle - PIN_TO_STROBE, idle + p.reload_lead + 10 - PIN_TO_STROBE]
     strobes = [first + PIN_TO_STROBE] + [t + PIN_TO_STROBE for t in early]
     second = next_ready(p, model_frames(offered, None), strobes) - PIN_TO_STROBE
     run, model = check(p, [(0, 3), (1, 3)], None, [first, *early, second], test_name, offered=offered)
@@ -356,4 +358,4 @@ def test_frame_offered_late_in_a_frame_is_shown_next(test_name):
     run, model = check(p, [(0, 3), (1, 3)], None, [first, second], test_name, offered=offered)
     assert [f.slot for f in model.shown] == [0, 1] and model.overruns == 0
     # frame 0's repeat was loaded first (not cut), then frame 1's first plane
-    assert second + PIN_TO_STROBE > waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + schedule.RELOAD_LEAD
+    assert second + PIN_TO_STROBE > waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + p.reload_lead

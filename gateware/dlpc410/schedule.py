@@ -39,7 +39,7 @@ first pulse is then at ``even(s + 1) + g * stagger``; otherwise it is counted as
 Frames: group 0 takes the next offered frame when its last pulse of a frame is made (else the
 frame repeats). Triggered and not chained, a frame offered while every group is loaded and
 waiting is taken at once: every group's first plane is loaded again from it, no sooner than
-``RELOAD_LEAD`` cycles later (the store's first words); a trigger before that load ends is an
+``reload_lead`` cycles later (the store's first words); a trigger before that load ends is an
 overrun, so a trigger never shows an older frame than the newest complete one it could show.
 
 Time base: cycle 0 is the first cycle after initialisation (INIT_ACTIVE low); the first loads
@@ -62,8 +62,9 @@ __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_en
 #: First load this many cycles after INIT_ACTIVE falls (DLPC910: first DVALID >= 64 clocks).
 INIT_TO_DVALID = int(TIMING["init_to_dvalid_clocks"].value)
 
-#: A frame taken while waiting for a trigger has its first row loaded this many cycles later at
-#: the earliest: the requester's occupancy look-up and the store's first words of the row.
+#: Default ``reload_lead``: a frame taken while waiting for a trigger has its first row loaded
+#: this many cycles later at the earliest (the requester's occupancy look-up and the store's
+#: first words of the row; enough for the test store, set per store at run time).
 RELOAD_LEAD = 16
 
 
@@ -95,6 +96,7 @@ class Params:
     source: Source = Source.STORE
     stagger: int = 0
     row_period: int = 0          # 0: DCLK-per-row of the DMD
+    reload_lead: int = RELOAD_LEAD
     period: int = 0
     camera_offset: int = 0
     camera_width: int = 1
@@ -104,7 +106,7 @@ class Params:
     def registers(self, dmd):
         """The values of :class:`~gateware.dlpc410.params.Registers`, as a dict."""
         regs = {k: getattr(self, k) for k in (
-            "lsb", "t_rst", "t_settle", "hide", "dark_gap", "stagger", "period",
+            "lsb", "t_rst", "t_settle", "hide", "dark_gap", "stagger", "period", "reload_lead",
             "camera_offset", "camera_width")}
         regs.update(reset_mode=self.reset_mode, order=self.order, order_table=list(self.order_table),
                     chain=int(self.chain), strict_rst=int(self.strict_rst), trigger=self.trigger,
@@ -288,7 +290,7 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
         state["queued_at"] = t + G + 1
         for g in range(G):
             st[g].pos = ("plane", fi, 0)
-            st[g].writable = max(st[g].writable, t + RELOAD_LEAD)
+            st[g].writable = max(st[g].writable, t + p.reload_lead)
             enqueue(g, fi, 0)
 
     idle_take = not p.chain and p.source != Source.PRNG
@@ -442,7 +444,8 @@ def _lattice_ok(M, s, G, sep):
 
 def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetMode.GLOBAL,
          exposure_s=0.0, strict_rst=True, chain=False, words_per_cycle=1.0, source=Source.STORE,
-         t_rst_s=None, t_settle_s=None, frame=None, order_table=(7, 6, 5, 4, 3, 2, 1, 0)):
+         t_rst_s=None, t_settle_s=None, frame=None, order_table=(7, 6, 5, 4, 3, 2, 1, 0),
+         reload_lead=RELOAD_LEAD):
     """A parameter set that shows every plane exactly on time, and the rate it reaches.
 
     ``exposure_s`` asks for a least significant plane at least that long (0: the shortest legal
@@ -454,6 +457,7 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     chosen (searching upward from the shortest legal one) so that the offsets ``g * stagger``
     never bring pulses of two groups closer than the RST rule allows (strict: ``t_rst``; loose:
     one row cycle) and the loads squeezed between other groups' pulses still finish on time.
+    ``reload_lead``: the store's latency to a row's first words, in cycles (see :class:`Params`).
     """
     R = dmd.dclk_per_row
     t_rst = even(_cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s, dclk_hz) + RST_MARGIN)
@@ -489,7 +493,8 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
             dark_gap = even(reload) if G == 1 else lsb * math.ceil(reload / lsb)
             p = Params(lsb=lsb, t_rst=t_rst, t_settle=t_settle, hide=hide, dark_gap=dark_gap,
                        reset_mode=reset_mode, order=order, order_table=order_table, chain=chain,
-                       strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period)
+                       strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period,
+                       reload_lead=reload_lead)
             fr = frame or Frame(0, depth)
             r = simulate(dmd, p, [replace(fr, ready=0)] * (3 if chain else 1), [ready_cycle(dmd, p, fr)],
                          max_frames=2)

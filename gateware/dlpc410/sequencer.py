@@ -28,7 +28,7 @@ from .facts import BlockMode, RowMode
 from .init import TRAINING_EDGES, Init
 from .params import TIME_BITS, PlaneOrder, Registers, ResetMode, Source
 from .prng import Prng
-from .schedule import INIT_TO_DVALID, RELOAD_LEAD
+from .schedule import INIT_TO_DVALID
 from .trigger import Trigger
 
 __all__ = ["Sequencer", "Status"]
@@ -481,7 +481,7 @@ class Sequencer(wiring.Component):
                                  & self.frames.valid & frame_ok)
         with m.If(take_idle):
             m.d.comb += self.frames.ready.eq(1)
-            lead = now + RELOAD_LEAD
+            lead = now + regs.reload_lead
             m.d.sync += [next_slot.eq(self.frames.payload.slot), next_depth.eq(self.frames.payload.bit_depth),
                          start_group.eq(0)]
             for g in range(GMAX):
