@@ -345,17 +345,40 @@ def test_trigger_during_reload_is_an_overrun(test_name):
     assert len(run.lights) == 2 and [f.slot for f in model.shown] == [0, 1]
 
 
-def test_frame_offered_late_in_a_frame_is_shown_next(test_name):
-    """Frame 1 completes one cycle after group 0's last pulse of frame 0 (too late to be taken
-    there): frame 0's repeat is preloaded whole, then frame 1's first plane replaces it, and
-    the next trigger shows frame 1 (phased: groups end their frame at different times)."""
-    p = fast_plan(depth=3, reset_mode=ResetMode.DUAL).params
+@pytest.mark.parametrize("mode,after", [
+    (ResetMode.GLOBAL, 1),       # inside the settle time: the stale rows are asked, not loaded
+    (ResetMode.DUAL, 1),         # group 1 still plays: taken when it ends, its load abandoned
+    (ResetMode.GLOBAL, 90),      # half-way through the stale load on the bus
+])
+def test_frame_offered_late_in_a_frame_abandons_the_stale_preload(mode, after, test_name):
+    """Frame 1 completes ``after`` cycles after group 0's last pulse of frame 0 (too late to be
+    taken there): frame 0's first plane, being preloaded again, is abandoned as soon as no group
+    plays: the row cycle on the bus ends, the words asked for are discarded, frame 1's first
+    plane is loaded (no sooner than each group's settle time allows) and the next trigger shows
+    it whole. A trigger while the stale load is being flushed is an overrun."""
+    p = fast_plan(depth=3, reset_mode=mode).params
     first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
     alone = schedule.simulate(DMD, p, model_frames([(0, 3)], None), [first + PIN_TO_STROBE])
     last_pulse = max(t for t, g, _k, _f, _e in alone.pulses if g == 0)
-    offered = [(0, 3, 0), (1, 3, last_pulse + 1)]
-    second = next_ready(p, model_frames(offered, None), [first + PIN_TO_STROBE]) - PIN_TO_STROBE
-    run, model = check(p, [(0, 3), (1, 3)], None, [first, second], test_name, offered=offered)
-    assert [f.slot for f in model.shown] == [0, 1] and model.overruns == 0
-    # frame 0's repeat was loaded first (not cut), then frame 1's first plane
-    assert second + PIN_TO_STROBE > waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + p.reload_lead
+    end = max(t for t, *_rest in alone.pulses)
+    ready = last_pulse + after
+    offered = [(0, 3, 0), (1, 3, ready)]
+    flushing = [max(ready, end) + 20 - PIN_TO_STROBE]
+    strobes = [first + PIN_TO_STROBE, flushing[0] + PIN_TO_STROBE]
+    second = next_ready(p, model_frames(offered, None), strobes) - PIN_TO_STROBE
+    run, model = check(p, [(0, 3), (1, 3)], None, [first, *flushing, second], test_name, offered=offered)
+    assert [f.slot for f in model.shown] == [0, 1] and model.overruns == 1
+    assert [s for _t, s in run.releases] == [0]
+    # the stale repeat was cut: fewer rows than a plane loaded before frame 1's first row
+    taken = max(ready, end + 1)
+    wait = schedule.flush_rows(DMD) * p.row_period
+    new_start = schedule.even(max(taken + p.reload_lead + wait, end + p.t_rst + p.t_settle))
+    loads = [t for t, k, _a in model.commands if k != "pulse" and t >= last_pulse]
+    assert new_start in loads and new_start - 2 not in loads
+    stale = [t for t in loads if t < new_start]
+    if mode == ResetMode.GLOBAL:   # the rows of the stale load on the bus before it was taken
+        assert len(stale) == max(0, (taken - (last_pulse + p.t_rst + p.t_settle)) // p.row_period + 1)
+    else:                          # group 0 had begun loading while group 1 still played
+        assert 0 < len(stale) < DMD.rows
+    # the whole reload took less than a repeat followed by a reload
+    assert second + PIN_TO_STROBE < waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + DMD.rows * p.row_period

@@ -37,10 +37,15 @@ A trigger strobe at cycle ``s`` is obeyed when every group is loaded and waiting
 first pulse is then at ``even(s + 1) + g * stagger``; otherwise it is counted as an overrun.
 
 Frames: group 0 takes the next offered frame when its last pulse of a frame is made (else the
-frame repeats). Triggered and not chained, a frame offered while every group is loaded and
-waiting is taken at once: every group's first plane is loaded again from it, no sooner than
-``reload_lead`` cycles later (the store's first words); a trigger before that load ends is an
-overrun, so a trigger never shows an older frame than the newest complete one it could show.
+frame repeats). Triggered and not chained, a frame offered while no group plays (every group
+has made its frame's last pulse) is taken at once: every group's first plane is loaded again
+from it, no sooner than ``reload_lead`` cycles later (the store's first words); a trigger before
+that load ends is an overrun, so a trigger never shows an older frame than the newest complete
+one it could show. If the first planes of the frame before were still being loaded (a frame
+completed late, just after the last pulse), those loads are abandoned: the row cycle on the bus
+ends, the queued loads are dropped, the words already asked of the store are discarded, and
+the new loads start no sooner than ``reload_lead + flush_rows * row_period`` cycles later (nor
+before each group's settle time ends, as always). Nothing abandoned is ever pulsed.
 
 Time base: cycle 0 is the first cycle after initialisation (INIT_ACTIVE low); the first loads
 may start at ``init_to_dvalid`` (64 clocks, DLPC910). Command cycles are decision cycles; the
@@ -56,8 +61,8 @@ from .facts import TIMING, BlockMode
 from .params import PlaneOrder, ResetMode, Source, TriggerMode, group_size
 
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate",
-           "plan", "bound", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "RST_MARGIN", "even",
-           "ready_cycle"]
+           "plan", "bound", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS", "flush_rows",
+           "RST_MARGIN", "even", "ready_cycle"]
 
 #: First load this many cycles after INIT_ACTIVE falls (DLPC910: first DVALID >= 64 clocks).
 INIT_TO_DVALID = int(TIMING["init_to_dvalid_clocks"].value)
@@ -66,6 +71,18 @@ INIT_TO_DVALID = int(TIMING["init_to_dvalid_clocks"].value)
 #: this many cycles later at the earliest (the requester's occupancy look-up and the store's
 #: first words of the row; enough for the test store, set per store at run time).
 RELOAD_LEAD = 16
+
+#: The sequencer's word FIFO holds this many rows.
+WORD_FIFO_ROWS = 4
+
+
+def flush_rows(dmd):
+    """Rows of stale words a newer frame may find asked for when it abandons a preload: the
+    block the store is answering, the block request held until taken, the word FIFO and one row
+    of latency. At one row per ``row_period`` they are discarded within
+    ``flush_rows * row_period`` cycles (the store's own look-ahead beyond that belongs in
+    ``reload_lead``)."""
+    return 2 * dmd.rows_per_block + WORD_FIFO_ROWS + 1
 
 
 #: Cycles added to the RST_ACTIVE time: the command leaves one cycle after its decision, and the
@@ -283,14 +300,20 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
     def waiting(t):
         return all(not s.pending and s.loaded_at is not None and s.loaded_at <= t for s in st)
 
+    def playing():
+        return any(s.pending for s in st)
+
     def take_while_waiting(t):
-        """A newer frame offered while every group waits loaded: load its first plane."""
+        """A newer frame offered while no group plays: load its first plane, abandoning the
+        stale loads still queued (their words are discarded for ``flush_rows`` row periods)."""
+        wait = 0 if waiting(t) else flush_rows(dmd) * row_period
         fi = take_frame(repeat=False)
         state["next_frame"] = fi
-        state["queued_at"] = t + G + 1
+        state["queued_at"] = t + wait + G + 1
+        queue.clear()
         for g in range(G):
             st[g].pos = ("plane", fi, 0)
-            st[g].writable = max(st[g].writable, t + p.reload_lead)
+            st[g].writable = max(st[g].writable, t + p.reload_lead + wait)
             enqueue(g, fi, 0)
 
     idle_take = not p.chain and p.source != Source.PRNG
@@ -307,7 +330,7 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
     while True:
         t_now[0] = t
         nxt = offer()
-        take_now = idle_take and t >= state["queued_at"] and waiting(t) and nxt is not None and nxt[1] <= t
+        take_now = idle_take and t >= state["queued_at"] and not playing() and nxt is not None and nxt[1] <= t
         # --- decision at t ---
         if t % 2 == 0 and t >= bus_free:
             rst_ok = [t - (state["rst_any"] if p.strict_rst else st[g].rst_free) >= 0 for g in range(G)]
@@ -373,8 +396,8 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
             cands.append(max(st[g].writable, state["next_row"]))
         nxt = offer()
         take_at = None
-        if idle_take and nxt is not None and all(not s.pending and s.loaded_at is not None for s in st):
-            take_at = max(nxt[1], state["queued_at"], *(s.loaded_at for s in st))
+        if idle_take and nxt is not None and not playing():
+            take_at = max(nxt[1], state["queued_at"], t + 1)
             cands.append(take_at)
         if not cands:
             break

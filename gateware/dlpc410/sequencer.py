@@ -26,9 +26,9 @@ from . import interface
 from .beat import LANES
 from .facts import BlockMode, RowMode
 from .init import TRAINING_EDGES, Init
-from .params import TIME_BITS, PlaneOrder, Registers, ResetMode, Source
+from .params import DURATION_BITS, TIME_BITS, PlaneOrder, Registers, ResetMode, Source
 from .prng import Prng
-from .schedule import INIT_TO_DVALID
+from .schedule import INIT_TO_DVALID, WORD_FIFO_ROWS, flush_rows
 from .trigger import Trigger
 
 __all__ = ["Sequencer", "Status"]
@@ -152,7 +152,7 @@ class Sequencer(wiring.Component):
         m.submodules.init = init = Init()
         m.submodules.trigger = trig = Trigger()
         m.submodules.prng = prng = Prng()
-        m.submodules.fifo = words = fifo.SyncFIFOBuffered(width=64, depth=4 * dmd.words_per_row)
+        m.submodules.fifo = words = fifo.SyncFIFOBuffered(width=64, depth=WORD_FIFO_ROWS * dmd.words_per_row)
         m.d.comb += [
             init.ecp2_finished.eq(self.pins.ecp2_finished),
             init.init_active.eq(self.pins.init_active),
@@ -208,7 +208,10 @@ class Sequencer(wiring.Component):
 
         next_slot = Signal(SLOT_BITS)
         next_depth = Signal(4)
-        take_idle = Signal()                   # a frame offered while waiting for a trigger
+        take_idle = Signal()                   # a frame offered while no group plays
+        flushing = Signal()                    # stale loads dropped, their words discarded
+        # words asked of the store and not yet taken from the word FIFO
+        owed = Signal(range((GMAX + 2) * dmd.words_per_plane + 1))
 
         # ---- load queue (pulse order) -> requester -> loader queue ----
         queued = data.StructLayout({"group": grp_bits, "slot": SLOT_BITS, "depth": 4, "pos": 3, "clear": 1})
@@ -249,16 +252,18 @@ class Sequencer(wiring.Component):
             self.release.valid.eq(releases.r_rdy), self.release.payload.eq(releases.r_data),
             releases.r_en.eq(self.release.ready),
         ]
-        with m.FSM(name="requester"):
+        with m.FSM(name="requester") as requester:
             with m.State("IDLE"):
                 # the last group's first load from a new slot: no group reads the old one again
                 leaves = (head.group == n_groups - 1) & ~head.clear & seen_slot & (head.slot != last_slot)
+                # flushing: stale entries are dropped here, through the same slot accounting
                 with m.If(queue.r_rdy & (~leaves | releases.w_rdy)):
                     m.d.comb += [queue.r_en.eq(1), releases.w_en.eq(leaves)]
                     m.d.sync += req_entry.eq(head)
                     with m.If((head.group == n_groups - 1) & ~head.clear):
                         m.d.sync += [last_slot.eq(head.slot), seen_slot.eq(1)]
-                    m.next = "LOOK"
+                    with m.If(~flushing):
+                        m.next = "LOOK"
             with m.State("LOOK"):
                 mask = Cat(
                     (b >= r_first) & (b <= r_last) & ~req_entry.clear
@@ -267,19 +272,28 @@ class Sequencer(wiring.Component):
                 m.d.sync += [req_mask.eq(mask), req_block.eq(r_first),
                              req_first.eq(r_first), req_last.eq(r_last)]
                 m.next = "PUSH"
+                with m.If(flushing):
+                    m.next = "IDLE"
             with m.State("PUSH"):
                 # the loader learns the mask first, so it drains the words of one block while
                 # the next block's request waits for the store
-                m.d.comb += loads.w_en.eq(1)
-                with m.If(loads.w_rdy):
-                    m.next = "REQUEST"
-            with m.State("REQUEST"):
-                with m.If(req_block > req_last):
+                with m.If(flushing):
                     m.next = "IDLE"
-                with m.Elif(req_mask.bit_select(req_block, 1) & ~use_prng):
+                with m.Else():
+                    m.d.comb += loads.w_en.eq(1)
+                    with m.If(loads.w_rdy):
+                        m.next = "REQUEST"
+            with m.State("REQUEST"):
+                wanted = req_mask.bit_select(req_block, 1) & ~use_prng
+                # flushing: a request offered is held until taken (its words are discarded)
+                with m.If((req_block > req_last) | (flushing & ~wanted)):
+                    m.next = "IDLE"
+                with m.Elif(wanted):
                     m.d.comb += self.requests.valid.eq(1)
                     with m.If(self.requests.ready):
                         m.d.sync += req_block.eq(req_block + 1)
+                        with m.If(flushing):
+                            m.next = "IDLE"
                 with m.Else():
                     m.d.sync += req_block.eq(req_block + 1)
 
@@ -326,7 +340,8 @@ class Sequencer(wiring.Component):
         next_row_at = Signal(TIME_BITS)
         data_ok = use_prng | (words.level >= dmd.words_per_row)
         l_group = lhead.group
-        can_load = running & free & ~do_pulse & loads.r_rdy & (_diff(writable[l_group], now) <= 0) & ~imminent
+        can_load = (running & ~flushing & free & ~do_pulse & loads.r_rdy
+                    & (_diff(writable[l_group], now) <= 0) & ~imminent)
         row_ready = (_diff(next_row_at, now) <= 0)
         do_row = Signal()
         do_clear = Signal()
@@ -357,7 +372,12 @@ class Sequencer(wiring.Component):
         # ---- the command registers ----
         issue = do_pulse | do_row | do_clear
         reading = do_row | (op_row & (remain != 0))
-        m.d.comb += [words.r_en.eq(reading & ~use_prng), prng.next.eq(reading & use_prng)]
+        discard = flushing & ~reading & (owed != 0)
+        m.d.comb += [words.r_en.eq(reading & ~use_prng | discard), prng.next.eq(reading & use_prng)]
+        asked = Mux(self.requests.valid & self.requests.ready, rpb * dmd.words_per_row, 0)
+        m.d.sync += owed.eq(owed + asked - (words.r_en & words.r_rdy))
+        with m.If(flushing):
+            m.d.comb += loads.r_en.eq(1)
         m.d.sync += word.eq(Mux(reading, Mux(use_prng, prng.word, words.r_data), 0))
         with m.If(issue):
             m.d.sync += [dvalid.eq(1), remain.eq(R - 1), op_row.eq(do_row),
@@ -445,6 +465,11 @@ class Sequencer(wiring.Component):
                                        & (_diff(now, cam_at + regs.camera_width) < 0))
 
         # ---- start: take the first frame, queue every group's first plane ----
+        all_ready = Cat(~active[g] | (~pending[g] & loaded[g]) for g in range(GMAX)).all()
+        playing = Cat(active[g] & pending[g] for g in range(GMAX)).any()
+        flush_until = Signal(TIME_BITS)
+        flush_cycles = Signal(DURATION_BITS)
+        m.d.comb += flush_cycles.eq(flush_rows(dmd) * regs.row_period)
         start_group = Signal(grp_bits + 1)
         with m.FSM(name="start") as start_fsm:
             with m.State("WAIT"):
@@ -469,21 +494,33 @@ class Sequencer(wiring.Component):
                 m.d.comb += running.eq(1)
                 with m.If(take_idle):
                     m.next = "RELOAD"
+                    with m.If(~all_ready):
+                        m.next = "FLUSH"
+            with m.State("FLUSH"):
+                # the stale loads are dropped: queued ones by the requester, looked-up ones
+                # here, and the words already asked for are discarded; then the newer frame's
+                # first planes are queued, exactly ``flush_cycles`` after it was taken
+                m.d.comb += [running.eq(1), flushing.eq(1)]
+                drained = requester.ongoing("IDLE") & ~queue.r_rdy & ~loads.r_rdy & (owed == 0)
+                with m.If(drained & (_diff(flush_until, now) <= 0)):
+                    m.next = "RELOAD"
             with m.State("RELOAD"):
                 m.d.comb += running.eq(1)
                 queue_first_planes()
 
         # ---- triggers ----
-        all_ready = Cat(~active[g] | (~pending[g] & loaded[g]) for g in range(GMAX)).all()
-        # a newer frame than the one waiting: load its first plane instead (the loads wait for the
-        # requester's first words); nothing is in flight, since every group is loaded
-        m.d.comb += take_idle.eq(start_fsm.ongoing("RUN") & all_ready & ~regs.chain & ~use_prng
+        # a newer frame offered while no group plays: it replaces the preloaded first planes
+        # (the loads wait for the store's first words); any stale load still in flight is
+        # abandoned: the row cycle on the bus ends, nothing of it is pulsed (no trigger is obeyed
+        # before every group is loaded again), and the settle times of the last pulses still hold
+        m.d.comb += take_idle.eq(start_fsm.ongoing("RUN") & ~playing & ~regs.chain & ~use_prng
                                  & self.frames.valid & frame_ok)
         with m.If(take_idle):
             m.d.comb += self.frames.ready.eq(1)
-            lead = now + regs.reload_lead
+            wait = Mux(all_ready, 0, flush_cycles)
+            lead = now + regs.reload_lead + wait
             m.d.sync += [next_slot.eq(self.frames.payload.slot), next_depth.eq(self.frames.payload.bit_depth),
-                         start_group.eq(0)]
+                         start_group.eq(0), flush_until.eq(now + wait), fresh.eq(1), finishing.eq(0)]
             for g in range(GMAX):
                 m.d.sync += [slot[g].eq(self.frames.payload.slot), depth[g].eq(self.frames.payload.bit_depth),
                              loaded[g].eq(0), writable[g].eq(Mux(_diff(writable[g], lead) < 0, lead, writable[g]))]
