@@ -61,8 +61,8 @@ def newer_frame(dmd, p, *, late, gateware=False):
     it on the pins, triggered as early as it is obeyed. ``late``: the frame completes one cycle
     after group 0's last pulse of the frame shown (the preload of its repeat is abandoned;
     the newer frame's load waits for the settle time of that pulse, or for the stale words to
-    be discarded, whichever is later); else while every group waits. Returns (reload cycles: complete -> a trigger is obeyed,
-    latency cycles, pin -> pulse cycles of that trigger); ``gateware``: measured on the
+    be discarded, whichever is later); else while every group waits. Returns (reload cycles:
+    complete -> a trigger is obeyed, latency cycles, pin -> pulse cycles of that trigger); ``gateware``: measured on the
     gateware in the Amaranth simulator, else the schedule model (equal cycle for cycle)."""
     pin0 = max(g.loaded_at for g in schedule.simulate(dmd, p, [schedule.Frame(0, 1)]).groups)
     alone = schedule.simulate(dmd, p, [schedule.Frame(0, 1)], [pin0 + PIN_TO_STROBE])
