@@ -104,6 +104,18 @@ def test_every_level_exact(mode, strict, order, test_name):
     assert len(run.lights) == 1
 
 
+def test_spread_phased_plan(test_name):
+    """A phased plan with the groups spread apart (what the planner picks for dual 8-bit PWM
+    here, and for quad and dual on the DLP7000): dark gaps off the LSB lattice, a stagger of
+    several LSBs; commands equal, every level exact."""
+    plan = fast_plan(reset_mode=ResetMode.DUAL)
+    p = plan.params
+    assert "load queue order" in plan.binds
+    assert p.dark_gap % p.lsb and p.stagger > 2 * p.lsb
+    ready = next_ready(p, model_frames([(0, 8)], None), [])
+    check(p, [(0, 8)], None, [ready + 10], test_name)
+
+
 def test_random_images_every_depth_with_empty_blocks(test_name):
     """Random images at bit depths 1..8 back to back (triggered as soon as ready); one slot has
     empty blocks and empty planes, cleared instead of loaded."""

@@ -330,7 +330,7 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
     while True:
         t_now[0] = t
         nxt = offer()
-        take_now = idle_take and t >= state["queued_at"] and not playing() and nxt is not None and nxt[1] <= t
+        take_now = idle_take and nxt is not None and nxt[1] <= t and t >= state["queued_at"] and not playing()
         # --- decision at t ---
         if t % 2 == 0 and t >= bus_free:
             rst_ok = [t - (state["rst_any"] if p.strict_rst else st[g].rst_free) >= 0 for g in range(G)]
@@ -480,6 +480,8 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     chosen (searching upward from the shortest legal one) so that the offsets ``g * stagger``
     never bring pulses of two groups closer than the RST rule allows (strict: ``t_rst``; loose:
     one row cycle) and the loads squeezed between other groups' pulses still finish on time.
+    For triggered multi-bit frames the plan with groups spread apart (:func:`_spread`) is taken
+    instead when it is faster; ``binds`` then names the load queue order.
     ``reload_lead``: the store's latency to a row's first words, in cycles (see :class:`Params`).
     """
     R = dmd.dclk_per_row
@@ -529,7 +531,84 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     if lsb > lsb_min and binds != "requested exposure":
         binds += " + pulse spacing" if G > 1 else ""
     frame_cycles = _frame_cycles(dmd, p, fr)
+    if G > 1 and not chain and depth > 1:
+        # phased PWM: the LSB lattice against spread groups, whichever is faster
+        spread = _spread(dmd, replace(p, dark_gap=even(t_rst + t_settle + load_g + slack)), fr,
+                         even(lsb_min), sep, load_g, clear_g, frame_cycles)
+        if spread is not None:
+            p, frame_cycles = spread
+            binds = ("settle (t_rst + t_settle + clears) + load queue order: groups spread so that "
+                     "no group's clears wait behind another group's plane load"
+                     if p.lsb == even(lsb_min) else
+                     "load queue order + pulse spacing (groups spread, LSB above the settle path)")
     return Plan(p, frame_cycles, lsb_min, binds, dclk_hz)
+
+
+def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
+    """Phased PWM with groups spread apart instead of on the LSB lattice: every group plays the
+    plain timeline (dark gaps not rounded to LSB multiples) ``stagger`` after the one before.
+    Loads are served in the order of the pulses that freed them, so a group's clears behind a
+    short plane must not queue behind another group's plane load: the stagger is the smallest
+    that keeps every pulse ``sep`` from every other group's (RST_ACTIVE) and every load inside
+    its deadline with the loads in queue order; each candidate is then checked by
+    :func:`simulate`. Returns (params, frame cycles) if faster than ``beat`` cycles, else None."""
+    G = len(groups(dmd, p.reset_mode))
+    frozen = p.t_rst + p.t_settle
+    margin = 2 * dmd.dclk_per_row * G           # other groups' pulses taking row cycles
+    exps = exponents(p.order, p.order_table, fr.depth)
+    best = None
+    step = max(2, even(lsb_min // 64))
+    for lsb in range(lsb_min, lsb_min + lsb_min // 4, step):
+        pulses, jobs, t = [0], [], 0
+        for j, e in enumerate(exps):
+            d = lsb << e
+            t += d
+            pulses.append(t)
+            if d >= p.hide and j != len(exps) - 1:
+                jobs.append(load_g)
+            else:
+                jobs += [clear_g, load_g]
+                t += p.dark_gap
+                pulses.append(t)
+        pulses = np.array(pulses[:-1])
+        cap = ((beat if best is None else best[1]) - int(pulses[-1])) // (G - 1)
+        if cap <= sep:
+            break
+        diffs = np.unique(pulses[:, None] - pulses[None, :])
+        stag = np.arange(even(sep), min(cap, int(pulses[-1])), 2)
+        ok = np.ones(len(stag), bool)
+        for k in range(1, G):
+            near = np.abs(diffs[None, :] + k * stag[:, None]).min(axis=1)
+            ok &= near >= sep
+        stag = stag[ok]
+        # the loads in queue (pulse) order, for every candidate stagger at once; the last
+        # pulse's load (the next frame's first plane) has no deadline but takes the bus
+        offsets = np.repeat(np.arange(G), len(pulses))
+        starts = np.tile(pulses, G)[None, :] + offsets[None, :] * stag[:, None]
+        order = np.argsort(starts, axis=1, kind="stable")
+        starts = np.take_along_axis(starts, order, axis=1)
+        deadlines = np.take_along_axis(
+            np.tile(np.append(pulses[1:], 1 << 62), G)[None, :] + offsets[None, :] * stag[:, None],
+            order, axis=1)
+        lengths = np.tile(np.array(jobs), G)[order]
+        end = np.zeros(len(stag), np.int64)
+        fits = np.ones(len(stag), bool)
+        for i in range(starts.shape[1]):
+            end = np.maximum(end, starts[:, i] + frozen) + lengths[:, i]
+            fits &= end + margin <= deadlines[:, i]
+        tries = 0
+        for s in stag[fits]:
+            s = int(s)
+            q = replace(p, lsb=lsb, stagger=s)
+            if simulate(dmd, q, [replace(fr, ready=0)], [ready_cycle(dmd, q, fr)], max_frames=2).late == 0:
+                cycles = _frame_cycles(dmd, q, fr)
+                if cycles < (beat if best is None else best[1]):
+                    best = (q, cycles)
+                break
+            tries += 1
+            if tries == 4:
+                break
+    return best
 
 
 def ready_cycle(dmd, p, fr):
@@ -543,22 +622,11 @@ def _frame_cycles(dmd, p, fr):
     if p.chain:
         r = simulate(dmd, p, [fr] * 4, [ready_cycle(dmd, p, fr)], max_frames=3)
         return r.frame_starts[2] - r.frame_starts[1]
-    # trigger as soon as ready: find the first cycle a second strobe is obeyed
+    # trigger as soon as ready: a second strobe is obeyed once every group, its frame played,
+    # is loaded again (the last thing each group does)
     first = ready_cycle(dmd, p, fr)
-    lo, hi = first + 1, first + 1
-    while True:
-        r2 = simulate(dmd, p, [fr], [first, hi])
-        if len(r2.accepted) == 2:
-            break
-        lo, hi = hi, hi * 2
-    while lo < hi:
-        mid = (lo + hi) // 2
-        r2 = simulate(dmd, p, [fr], [first, mid])
-        if len(r2.accepted) == 2:
-            hi = mid
-        else:
-            lo = mid + 1
-    return hi - first
+    r = simulate(dmd, p, [fr], [first])
+    return max(st.loaded_at for st in r.groups) - first
 
 
 def bound(dmd, dclk_hz, depth=8, *, t_rst_s=None, t_settle_s=None):

@@ -230,6 +230,10 @@ def run():
         figures[f"seq.gray8_frame_cycles_dlp7000_global{sfx}"] = (glob.frame_cycles, "cycle")
         figures[f"seq.gray8_lsb_cycles_dlp7000_global{sfx}"] = (glob.params.lsb, "cycle")
         figures[f"seq.gray8_rate_hz_dlp7000_phased{sfx}"] = (quad.rate_hz, "Hz")
+        figures[f"seq.gray8_lsb_cycles_dlp7000_phased{sfx}"] = (quad.params.lsb, "cycle")
+        figures[f"seq.gray8_stagger_cycles_dlp7000_phased{sfx}"] = (quad.params.stagger, "cycle")
+        dual = schedule.plan(XGA, f, reset_mode=ResetMode.DUAL)
+        figures[f"seq.gray8_rate_hz_dlp7000_phased_dual{sfx}"] = (dual.rate_hz, "Hz")
         figures[f"seq.gray8_rate_hz_dlp7000_phased_single_loose{sfx}"] = (single_loose.rate_hz, "Hz")
         figures[f"seq.gray8_bound_hz_dlp7000{sfx}"] = (schedule.bound(XGA, f), "Hz")
 
