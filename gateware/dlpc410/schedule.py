@@ -156,6 +156,11 @@ class Result:
     frame_starts: list = field(default_factory=list)
     shown: list = field(default_factory=list)        # frames taken, in order
 
+    def decoded(self):
+        """The commands a decoder of the pins logs: the no-op rows that follow a 1080p clear
+        carry no command and are left out."""
+        return [c for c in self.commands if c[1] != "noop"]
+
 
 def exponents(order, table, depth):
     """Weight exponents (0 = least significant) in display order for a frame of ``depth``."""
@@ -392,8 +397,8 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
             if s.pending and s.loaded_at is not None:
                 cands.append(max(s.pulse_at, s.rst_free if not p.strict_rst else state["rst_any"]))
         if queue:
-            g = queue[0][0]
-            cands.append(max(st[g].writable, state["next_row"]))
+            g, ops, i = queue[0]
+            cands.append(max(st[g].writable, state["next_row"]) if ops[i][0] == "row" else st[g].writable)
         nxt = offer()
         take_at = None
         if idle_take and nxt is not None and not playing():
@@ -488,7 +493,8 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     t_rst = even(_cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s, dclk_hz) + RST_MARGIN)
     t_settle = _cycles(TIMING["t_settle"].value if t_settle_s is None else t_settle_s, dclk_hz)
     words = dmd.words_per_row
-    row_period = even(max(R, math.ceil(words / words_per_cycle - 1e-9)))
+    # the on-chip source needs no memory bandwidth: one row per row cycle on any bus width
+    row_period = R if source == Source.PRNG else even(max(R, math.ceil(words / words_per_cycle - 1e-9)))
     grp = groups(dmd, reset_mode)
     G = len(grp)
     rows_g = max(len(b) for b in grp) * dmd.rows_per_block

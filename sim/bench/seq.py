@@ -84,6 +84,30 @@ def newer_frame(dmd, p, *, late, gateware=False):
     return obeyed - done, pulse + 1 - done, pulse + 1 - pin
 
 
+def dlp9500_figures(f, sfx):
+    """Four buses (DLP9500, 1080p clears): the store gives one 64-bit word per cycle, half a
+    DLP9500 beat, so rows come every two row cycles (``row_period``); the same plans with a
+    store of two words per cycle show what that costs. The on-chip source needs no store."""
+    d = DMDS["dlp9500"]
+    gray = schedule.plan(d, f)
+    mem = schedule.plan(d, f, depth=1, chain=True)
+    return {
+        f"seq.row_period_cycles_dlp9500_store{sfx}": (gray.params.row_period, "cycle"),
+        f"seq.gray8_rate_hz_dlp9500_global{sfx}": (gray.rate_hz, "Hz"),
+        f"seq.gray8_rate_hz_dlp9500_global_at_row_rate{sfx}": (
+            schedule.plan(d, f, words_per_cycle=2.0).rate_hz, "Hz"),
+        f"seq.gray8_bound_hz_dlp9500{sfx}": (schedule.bound(d, f), "Hz"),
+        f"seq.binary_rate_hz_memory_dlp9500{sfx}": (mem.rate_hz, "Hz"),
+        f"seq.binary_rate_hz_memory_dlp9500_at_row_rate{sfx}": (
+            schedule.plan(d, f, depth=1, chain=True, words_per_cycle=2.0).rate_hz, "Hz"),
+        f"seq.binary_rate_hz_prng_dlp9500{sfx}": (
+            schedule.plan(d, f, depth=1, chain=True, source=Source.PRNG).rate_hz, "Hz"),
+        f"seq.binary_rate_hz_prng_dlp9500_phased_loose{sfx}": (
+            schedule.plan(d, f, depth=1, chain=True, source=Source.PRNG, reset_mode=ResetMode.SINGLE,
+                          strict_rst=False).rate_hz, "Hz"),
+    }
+
+
 def gateware_binary_period():
     """Cycles between patterns of the Bernoulli source on the gateware (test DMD, phased):
     measured from the decoded pulses, and the model's figure."""
@@ -247,6 +271,7 @@ def run():
         figures[f"seq.binary_rate_hz_prng_phased_loose{sfx}"] = (prng_phased.rate_hz, "Hz")
         figures[f"seq.binary_rate_hz_memory{sfx}"] = (mem.rate_hz, "Hz")
         figures[f"seq.binary_rate_hz_memory_phased_loose{sfx}"] = (mem_phased.rate_hz, "Hz")
+        figures.update(dlp9500_figures(f, sfx))
 
     measured, model = gateware_binary_period()
     figures["seq.binary_period_cycles_test_dmd_gateware"] = (measured, "cycle")
