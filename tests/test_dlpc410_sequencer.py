@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from gateware.dlpc410 import prng_model, schedule
-from gateware.dlpc410.facts import TEST_DMD
+from gateware.dlpc410.facts import TEST_DMD, TEST_DMD4
 from gateware.dlpc410.params import PlaneOrder, ResetMode, Source, TriggerMode
 from gateware.dlpc410.trigger import PIN_TO_STROBE
 from sim.models import bitplane
@@ -18,16 +18,16 @@ DMD = TEST_DMD
 FAST = {"t_rst_s": 20 / 200e6, "t_settle_s": 30 / 200e6}
 
 
-def fast_plan(**kw):
-    return schedule.plan(DMD, 200e6, **FAST, **kw)
+def fast_plan(dmd=DMD, **kw):
+    return schedule.plan(dmd, 200e6, **FAST, **kw)
 
 
-def model_frames(frames, images):
+def model_frames(frames, images, dmd=DMD):
     """Model frames of (slot, depth) or (slot, depth, ready) tuples."""
     out = []
     for slot, depth, *ready in frames:
         occ = None if images is None else \
-            tuple(int(x) for x in bitplane.occupancy(images[slot], DMD.rows_per_block))
+            tuple(int(x) for x in bitplane.occupancy(images[slot], dmd.rows_per_block))
         out.append(schedule.Frame(slot, depth, occ, *ready))
     return out
 
@@ -43,9 +43,9 @@ def paced(p, frames, images):
     return offered, pins
 
 
-def next_ready(p, frames, strobes):
+def next_ready(p, frames, strobes, dmd=DMD):
     """The first cycle a trigger is obeyed after the given strobes played out."""
-    r = schedule.simulate(DMD, p, frames, strobes)
+    r = schedule.simulate(dmd, p, frames, strobes)
     return max(g.loaded_at for g in r.groups)
 
 
@@ -53,26 +53,26 @@ def same_commands(run, model):
     """Both command lists agree up to the end of the shorter run."""
     horizon = run.status["now"] - 2 * DMD.dclk_per_row
     got = [c for c in run.commands if c[0] < horizon]
-    assert got == [c for c in model.commands if c[0] < horizon]
+    assert got == [c for c in model.decoded() if c[0] < horizon]
     return got
 
 
 def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), early_pins=(),
-          offered=None):
+          offered=None, dmd=DMD):
     """Run gateware and model; assert equal commands, counters, and exact light per frame.
     ``frames``: the frames expected on the DMD; ``offered``: what the store offers (default:
-    the same)."""
+    the same). The rule model logs no no-op rows (a 1080p clear's), the schedule model does."""
     offered = frames if offered is None else offered
-    mframes = model_frames(offered, images)
+    mframes = model_frames(offered, images, dmd)
     if p.trigger == TriggerMode.SOFTWARE:
         strobes = list(soft)
     else:
         strobes = [t + PIN_TO_STROBE for t in (sync_pins if p.trigger == TriggerMode.SYNC else pins)]
-    model = schedule.simulate(DMD, p, mframes, strobes)
+    model = schedule.simulate(dmd, p, mframes, strobes)
     end = max(c[0] for c in model.commands) + extra
-    run = run_bench(DMD, p, offered, images, pins=pins, soft=soft, sync_pins=sync_pins,
+    run = run_bench(dmd, p, offered, images, pins=pins, soft=soft, sync_pins=sync_pins,
                     early_pins=early_pins, cycles=end, name=name)
-    assert run.commands == model.commands
+    assert run.commands == model.decoded()
     assert run.status["late"] == 0 == model.late
     assert run.status["underruns"] == 0
     assert run.status["overruns"] == model.overruns
@@ -82,7 +82,7 @@ def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), ea
     run.lights = frame_lights(run.model, run.frames())
     for k, light in enumerate(run.lights):
         slot, depth = frames[min(k, len(frames) - 1)][:2]
-        image = ramp_image(DMD, slot) if images is None else images[slot]
+        image = ramp_image(dmd, slot) if images is None else images[slot]
         assert np.array_equal(light, (image.astype(np.int64) >> (8 - depth)) * p.lsb), f"frame {k}"
     return run, model
 
@@ -102,6 +102,46 @@ def test_every_level_exact(mode, strict, order, test_name):
     ready = next_ready(p, model_frames([(0, 8)], None), [])
     run, _ = check(p, [(0, 8)], None, [ready + 10], test_name)
     assert len(run.lights) == 1
+
+
+def test_spread_phased_plan(test_name):
+    """A phased plan with the groups spread apart (what the planner picks for dual 8-bit PWM
+    here, and for quad and dual on the DLP7000): dark gaps off the LSB lattice, a stagger of
+    several LSBs; commands equal, every level exact."""
+    plan = fast_plan(reset_mode=ResetMode.DUAL)
+    p = plan.params
+    assert "load queue order" in plan.binds
+    assert p.dark_gap % p.lsb and p.stagger > 2 * p.lsb
+    ready = next_ready(p, model_frames([(0, 8)], None), [])
+    check(p, [(0, 8)], None, [ready + 10], test_name)
+
+
+@pytest.mark.parametrize("mode,order", [
+    (ResetMode.GLOBAL, PlaneOrder.MSB_FIRST),
+    (ResetMode.QUAD, PlaneOrder.LSB_FIRST),      # groups of 4 blocks and of the fifth alone
+])
+def test_four_buses(mode, order, test_name):
+    """A four-bus DMD (DLP9500-style: two words per DCLK on A-D, a clear plus two no-op rows):
+    a ramp frame then a random 4-bit frame with empty blocks and planes (cleared, each clear
+    followed by its no-op rows, no pulse of the block inside them); commands equal the model's,
+    every level exact under the rule model. The store's one word per cycle sets a row every
+    two row cycles."""
+    dmd = TEST_DMD4
+    rng = np.random.default_rng(4)
+    noisy = rng.integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8) & 0b11010110
+    noisy[:dmd.rows_per_block] = 0
+    images = {0: ramp_image(dmd, 0), 1: noisy}
+    p = fast_plan(dmd, reset_mode=mode, order=order).params
+    assert p.row_period == 2 * dmd.dclk_per_row
+    frames = [(0, 8), (1, 4)]
+    offered, pins = [], []
+    for slot, depth in frames:
+        offered.append((slot, depth, pins[-1] + PIN_TO_STROBE + 4 if pins else 0))
+        strobes = [t + PIN_TO_STROBE for t in pins]
+        pins.append(next_ready(p, model_frames(offered, images, dmd), strobes, dmd) - PIN_TO_STROBE)
+    run, model = check(p, frames, images, pins, test_name, offered=offered, dmd=dmd)
+    assert len(run.lights) == 2
+    assert any(k == "noop" for _t, k, _a in model.commands)
 
 
 def test_random_images_every_depth_with_empty_blocks(test_name):
@@ -191,24 +231,25 @@ def test_trigger_modes(mode, test_name):
         assert run.status["triggers"] == 1    # the TTL pin is ignored in sync mode
 
 
-def test_binary_prng_chain(test_name):
+@pytest.mark.parametrize("dmd", [DMD, TEST_DMD4], ids=["two_buses", "four_buses"])
+def test_binary_prng_chain(dmd, test_name):
     """1-bit Bernoulli frames back to back at the bus limit: the patterns the host rebuilds
-    from the seed are exactly the ones shown."""
-    p = fast_plan(depth=1, chain=True, source=Source.PRNG, reset_mode=ResetMode.SINGLE,
+    from the seed are exactly the ones shown (four buses: two words of the sequence a cycle)."""
+    p = fast_plan(dmd, depth=1, chain=True, source=Source.PRNG, reset_mode=ResetMode.SINGLE,
                   strict_rst=False).params
-    ready = next_ready(p, [schedule.Frame(0, 1)], [])
-    model = schedule.simulate(DMD, p, [], [ready + PIN_TO_STROBE], until=ready + 6 * p.lsb)
-    run = run_bench(DMD, p, [], None, pins=[ready], cycles=ready + 6 * p.lsb, name=test_name,
+    ready = next_ready(p, [schedule.Frame(0, 1)], [], dmd)
+    model = schedule.simulate(dmd, p, [], [ready + PIN_TO_STROBE], until=ready + 6 * p.lsb)
+    run = run_bench(dmd, p, [], None, pins=[ready], cycles=ready + 6 * p.lsb, name=test_name,
                     seed=0x1234)
     commands = same_commands(run, model)
-    shown = prng_model.shown_patterns(DMD, commands, 0x1234)
+    shown = prng_model.shown_patterns(dmd, commands, 0x1234)
     pulses = [t for t, k, _a in commands if k == "pulse"]
     assert len(pulses) >= 8
     # the frame period is the bus limit: one full load per pattern
-    assert p.lsb == p.stagger * DMD.blocks
+    assert p.lsb == p.stagger * dmd.blocks
     # the decoder's mirrors hold the last shown pattern, the host's rebuild of it
     assert np.array_equal(run.model.mirrors, shown[-1])
-    assert not np.array_equal(shown[-1], prng_model.shown_patterns(DMD, commands, 0)[-1])
+    assert not np.array_equal(shown[-1], prng_model.shown_patterns(dmd, commands, 0)[-1])
 
 
 @pytest.mark.parametrize("ecp2_cycles", [4, 60])
@@ -307,12 +348,14 @@ def waiting_after(p, frames, strobes):
     return next_ready(p, model_frames(frames, None), strobes)
 
 
-@pytest.mark.parametrize("mode", [ResetMode.GLOBAL, ResetMode.DUAL])
-def test_frame_offered_while_waiting_is_shown_next(mode, test_name):
+@pytest.mark.parametrize("mode,lead", [(ResetMode.GLOBAL, 16), (ResetMode.DUAL, 75)])
+def test_frame_offered_while_waiting_is_shown_next(mode, lead, test_name):
     """Frame 1 completes while the projector waits (frame 0 shown, its repeat preloaded): its
-    first plane is loaded at once and the next trigger shows it, not frame 0 again; with
-    nothing newer offered, the next trigger repeats frame 1."""
+    first plane is loaded ``reload_lead`` cycles later (a run-time register: 16, and 75 for a
+    slower store) and the next trigger shows it, not frame 0 again; with nothing newer offered,
+    the next trigger repeats frame 1."""
     p = fast_plan(depth=3, reset_mode=mode).params
+    p.reload_lead = lead
     first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
     idle = waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + 30
     offered = [(0, 3, 0), (1, 3, idle)]
@@ -324,7 +367,7 @@ def test_frame_offered_while_waiting_is_shown_next(mode, test_name):
     assert model.overruns == 0 and len(model.accepted) == 3
     # the reload: every group's first plane again, from slot 1, after the frame was offered
     reloads = [t for t, k, _a in model.commands if k != "pulse" and idle < t < second]
-    assert reloads and reloads[0] >= idle + schedule.RELOAD_LEAD
+    assert reloads and lead <= reloads[0] - idle <= lead + 2
     assert [s for _t, s in run.releases] == [0]
 
 
@@ -335,7 +378,7 @@ def test_trigger_during_reload_is_an_overrun(test_name):
     first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
     idle = waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + 30
     offered = [(0, 3, 0), (1, 3, idle)]
-    early = [idle - PIN_TO_STROBE, idle + schedule.RELOAD_LEAD + 10 - PIN_TO_STROBE]
+    early = [idle - PIN_TO_STROBE, idle + p.reload_lead + 10 - PIN_TO_STROBE]
     strobes = [first + PIN_TO_STROBE] + [t + PIN_TO_STROBE for t in early]
     second = next_ready(p, model_frames(offered, None), strobes) - PIN_TO_STROBE
     run, model = check(p, [(0, 3), (1, 3)], None, [first, *early, second], test_name, offered=offered)
@@ -343,17 +386,40 @@ def test_trigger_during_reload_is_an_overrun(test_name):
     assert len(run.lights) == 2 and [f.slot for f in model.shown] == [0, 1]
 
 
-def test_frame_offered_late_in_a_frame_is_shown_next(test_name):
-    """Frame 1 completes one cycle after group 0's last pulse of frame 0 (too late to be taken
-    there): frame 0's repeat is preloaded whole, then frame 1's first plane replaces it, and
-    the next trigger shows frame 1 (phased: groups end their frame at different times)."""
-    p = fast_plan(depth=3, reset_mode=ResetMode.DUAL).params
+@pytest.mark.parametrize("mode,after", [
+    (ResetMode.GLOBAL, 1),       # inside the settle time: the stale rows are asked, not loaded
+    (ResetMode.DUAL, 1),         # group 1 still plays: taken when it ends, its load abandoned
+    (ResetMode.GLOBAL, 90),      # half-way through the stale load on the bus
+])
+def test_frame_offered_late_in_a_frame_abandons_the_stale_preload(mode, after, test_name):
+    """Frame 1 completes ``after`` cycles after group 0's last pulse of frame 0 (too late to be
+    taken there): frame 0's first plane, being preloaded again, is abandoned as soon as no group
+    plays: the row cycle on the bus ends, the words asked for are discarded, frame 1's first
+    plane is loaded (no sooner than each group's settle time allows) and the next trigger shows
+    it whole. A trigger while the stale load is being flushed is an overrun."""
+    p = fast_plan(depth=3, reset_mode=mode).params
     first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
     alone = schedule.simulate(DMD, p, model_frames([(0, 3)], None), [first + PIN_TO_STROBE])
     last_pulse = max(t for t, g, _k, _f, _e in alone.pulses if g == 0)
-    offered = [(0, 3, 0), (1, 3, last_pulse + 1)]
-    second = next_ready(p, model_frames(offered, None), [first + PIN_TO_STROBE]) - PIN_TO_STROBE
-    run, model = check(p, [(0, 3), (1, 3)], None, [first, second], test_name, offered=offered)
-    assert [f.slot for f in model.shown] == [0, 1] and model.overruns == 0
-    # frame 0's repeat was loaded first (not cut), then frame 1's first plane
-    assert second + PIN_TO_STROBE > waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + schedule.RELOAD_LEAD
+    end = max(t for t, *_rest in alone.pulses)
+    ready = last_pulse + after
+    offered = [(0, 3, 0), (1, 3, ready)]
+    flushing = [max(ready, end) + 20 - PIN_TO_STROBE]
+    strobes = [first + PIN_TO_STROBE, flushing[0] + PIN_TO_STROBE]
+    second = next_ready(p, model_frames(offered, None), strobes) - PIN_TO_STROBE
+    run, model = check(p, [(0, 3), (1, 3)], None, [first, *flushing, second], test_name, offered=offered)
+    assert [f.slot for f in model.shown] == [0, 1] and model.overruns == 1
+    assert [s for _t, s in run.releases] == [0]
+    # the stale repeat was cut: fewer rows than a plane loaded before frame 1's first row
+    taken = max(ready, end + 1)
+    wait = schedule.flush_rows(DMD) * p.row_period
+    new_start = schedule.even(max(taken + p.reload_lead + wait, end + p.t_rst + p.t_settle))
+    loads = [t for t, k, _a in model.commands if k != "pulse" and t >= last_pulse]
+    assert new_start in loads and new_start - 2 not in loads
+    stale = [t for t in loads if t < new_start]
+    if mode == ResetMode.GLOBAL:   # the rows of the stale load on the bus before it was taken
+        assert len(stale) == max(0, (taken - (last_pulse + p.t_rst + p.t_settle)) // p.row_period + 1)
+    else:                          # group 0 had begun loading while group 1 still played
+        assert 0 < len(stale) < DMD.rows
+    # the whole reload took less than a repeat followed by a reload
+    assert second + PIN_TO_STROBE < waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + DMD.rows * p.row_period

@@ -8,13 +8,14 @@ from sim.tb.plane_source import SequencerBench
 
 
 @pytest.mark.verilog
-@pytest.mark.parametrize("mode,strict,order,depth", [
-    ("GLOBAL", True, "MSB_FIRST", 8),     # every grey level 0..255
-    ("SINGLE", False, "LSB_FIRST", 4),    # phased: 16 groups; a 4-bit frame keeps the run short
+@pytest.mark.parametrize("dmd,mode,strict,order,depth", [
+    ("dlp7000", "GLOBAL", True, "MSB_FIRST", 8),     # every grey level 0..255
+    ("dlp7000", "SINGLE", False, "LSB_FIRST", 4),    # phased: 16 groups; 4 bits keep it short
+    ("test4", "QUAD", True, "MSB_FIRST", 8),         # four buses (DIN_A..D), 1080p-style clears
 ])
-def test_sequencer_verilog_xga(mode, strict, order, depth):
-    """One frame on full XGA, RST_ACTIVE and settle scaled down (run-time parameters)."""
-    dmd = "dlp7000"
+def test_sequencer_verilog_xga(dmd, mode, strict, order, depth):
+    """One frame on full XGA (and on the small four-bus geometry), RST_ACTIVE and settle scaled
+    down (run-time parameters)."""
     bench = SequencerBench(DMDS[dmd], [(0, depth)])
     cocotb_run.run(bench, toplevel="dlpc410_sequencer_bench", module="sim.tb.seq_cocotb",
                    key=f"{dmd}-{depth}",

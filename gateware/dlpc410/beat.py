@@ -20,7 +20,7 @@ beat, rising edge before falling edge, bus A before bus B, pin 0 first; that is:
 A four-bus DMD (DLP9500) takes two words per beat: the first on A/B as above, the second on C/D.
 """
 
-__all__ = ["LANES", "word_to_lanes", "lanes_to_word", "PINS_PER_BUS"]
+__all__ = ["LANES", "word_to_lanes", "lanes_to_word", "beat_lanes", "PINS_PER_BUS"]
 
 PINS_PER_BUS = 16
 
@@ -31,6 +31,14 @@ LANES = (
     ("A", "fall", 32),
     ("B", "fall", 48),
 )
+
+
+def beat_lanes(buses):
+    """(bus, edge, first beat bit) of every 16-bit lane of a beat of ``buses // 2`` words: word
+    ``i`` of the beat (bits ``64 * i`` up) travels on buses A/B (i = 0) or C/D (i = 1)."""
+    pairs = ("AB", "CD")[:buses // 2]
+    return tuple((pair["AB".index(bus)], edge, 64 * i + lsb)
+                 for i, pair in enumerate(pairs) for bus, edge, lsb in LANES)
 
 
 def word_to_lanes(word):

@@ -109,6 +109,11 @@ DMDS = {
 #: A small DMD for fast tests: same rules, 128x96 in 4 blocks of 24 rows, XGA-style bus.
 TEST_DMD = DmdType("test 128x96", 128, 96, 128, 4, 24, 2, 64, 2, None, 1, "test geometry")
 DMDS["test"] = TEST_DMD
+#: A small four-bus DMD: DLP9500-style bus (two words per DCLK on A-D) and clear (one row cycle
+#: plus two no-op rows), 256x80 in 5 blocks of 16 rows (an odd block count, as the DLP9500's 15).
+TEST_DMD4 = DmdType("test four-bus 256x80", 256, 80, 256, 5, 16, 4, 128, 2, None, 3,
+                    "test geometry, DLP9500-style")
+DMDS["test4"] = TEST_DMD4
 
 
 class RowMode(enum.Enum, shape=2):

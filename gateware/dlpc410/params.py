@@ -85,6 +85,10 @@ class Registers(data.Struct):
         Cycles between the pulses of consecutive groups (phased modes); even.
     row_period
         Cycles from one row load to the next (at least DCLK-per-row; sets the memory bandwidth).
+    reload_lead
+        A frame taken while every group waits for a trigger has its first plane loaded no sooner
+        than this many cycles later: the requester's occupancy look-up plus the store's latency
+        to the first words of a row (set it from the store's measured read latency).
     period
         Trigger period of :attr:`TriggerMode.PERIODIC`.
     camera_offset, camera_width
@@ -106,6 +110,7 @@ class Registers(data.Struct):
     dark_gap: DURATION_BITS
     stagger: 24
     row_period: 8
+    reload_lead: 16
     period: DURATION_BITS
     camera_offset: DURATION_BITS
     camera_width: 16

@@ -2,10 +2,11 @@
 
 xorshift64 (shifts 13, 7, 17), one 64-bit word per step: every bit is a fair coin, so each
 pattern is a row of a Bernoulli(1/2) measurement matrix for compressed sensing. The host
-rebuilds the same patterns with :mod:`gateware.dlpc410.prng_model`.
+rebuilds the same patterns with :mod:`gateware.dlpc410.prng_model`. A four-bus DMD takes two
+consecutive words per cycle (the same sequence, two steps at a time).
 """
 
-from amaranth import Module, Mux, Signal
+from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -23,6 +24,12 @@ def _step(state):
 class Prng(wiring.Component):
     """xorshift64 word source.
 
+    Parameters
+    ----------
+    words : int
+        Words per cycle (1, or 2 for a four-bus beat): ``word`` holds that many consecutive
+        words of the sequence, the first in the low bits.
+
     Members
     -------
     seed : In(64)
@@ -30,13 +37,14 @@ class Prng(wiring.Component):
     reseed : In(1)
     next : In(1)
         Take ``word`` this cycle; the next word follows on the next cycle.
-    word : Out(64)
-        The current word (the state after one step from the seed, then one step per ``next``).
+    word : Out(64 * words)
+        The current words (the state after one step from the seed, then ``words`` steps per
+        ``next``).
     """
-    seed: In(64)
-    reseed: In(1)
-    next: In(1)
-    word: Out(64)
+
+    def __init__(self, words=1):
+        self._words = words
+        super().__init__({"seed": In(64), "reseed": In(1), "next": In(1), "word": Out(64 * words)})
 
     def elaborate(self, platform):
         m = Module()
@@ -44,9 +52,12 @@ class Prng(wiring.Component):
         seeded = Mux(self.seed == 0, ZERO_SEED, self.seed)
         with m.If(self.reseed):
             m.d.sync += state.eq(_step(seeded))
+        seq = [state]
+        for _ in range(self._words):
+            seq.append(_step(seq[-1]))
         with m.Elif(self.next):
-            m.d.sync += state.eq(_step(state))
-        m.d.comb += self.word.eq(state)
+            m.d.sync += state.eq(seq[-1])
+        m.d.comb += self.word.eq(Cat(*seq[:-1]))
         return m
 
 

@@ -37,10 +37,15 @@ A trigger strobe at cycle ``s`` is obeyed when every group is loaded and waiting
 first pulse is then at ``even(s + 1) + g * stagger``; otherwise it is counted as an overrun.
 
 Frames: group 0 takes the next offered frame when its last pulse of a frame is made (else the
-frame repeats). Triggered and not chained, a frame offered while every group is loaded and
-waiting is taken at once: every group's first plane is loaded again from it, no sooner than
-``RELOAD_LEAD`` cycles later (the store's first words); a trigger before that load ends is an
-overrun, so a trigger never shows an older frame than the newest complete one it could show.
+frame repeats). Triggered and not chained, a frame offered while no group plays (every group
+has made its frame's last pulse) is taken at once: every group's first plane is loaded again
+from it, no sooner than ``reload_lead`` cycles later (the store's first words); a trigger before
+that load ends is an overrun, so a trigger never shows an older frame than the newest complete
+one it could show. If the first planes of the frame before were still being loaded (a frame
+completed late, just after the last pulse), those loads are abandoned: the row cycle on the bus
+ends, the queued loads are dropped, the words already asked of the store are discarded, and
+the new loads start no sooner than ``reload_lead + flush_rows * row_period`` cycles later (nor
+before each group's settle time ends, as always). Nothing abandoned is ever pulsed.
 
 Time base: cycle 0 is the first cycle after initialisation (INIT_ACTIVE low); the first loads
 may start at ``init_to_dvalid`` (64 clocks, DLPC910). Command cycles are decision cycles; the
@@ -56,15 +61,28 @@ from .facts import TIMING, BlockMode
 from .params import PlaneOrder, ResetMode, Source, TriggerMode, group_size
 
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate",
-           "plan", "bound", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "RST_MARGIN", "even",
-           "ready_cycle"]
+           "plan", "bound", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS", "flush_rows",
+           "RST_MARGIN", "even", "ready_cycle"]
 
 #: First load this many cycles after INIT_ACTIVE falls (DLPC910: first DVALID >= 64 clocks).
 INIT_TO_DVALID = int(TIMING["init_to_dvalid_clocks"].value)
 
-#: A frame taken while waiting for a trigger has its first row loaded this many cycles later at
-#: the earliest: the requester's occupancy look-up and the store's first words of the row.
+#: Default ``reload_lead``: a frame taken while waiting for a trigger has its first row loaded
+#: this many cycles later at the earliest (the requester's occupancy look-up and the store's
+#: first words of the row; enough for the test store, set per store at run time).
 RELOAD_LEAD = 16
+
+#: The sequencer's word FIFO holds this many rows.
+WORD_FIFO_ROWS = 4
+
+
+def flush_rows(dmd):
+    """Rows of stale words a newer frame may find asked for when it abandons a preload: the
+    block the store is answering, the block request held until taken, the word FIFO and one row
+    of latency. At one row per ``row_period`` they are discarded within
+    ``flush_rows * row_period`` cycles (the store's own look-ahead beyond that belongs in
+    ``reload_lead``)."""
+    return 2 * dmd.rows_per_block + WORD_FIFO_ROWS + 1
 
 
 #: Cycles added to the RST_ACTIVE time: the command leaves one cycle after its decision, and the
@@ -95,6 +113,7 @@ class Params:
     source: Source = Source.STORE
     stagger: int = 0
     row_period: int = 0          # 0: DCLK-per-row of the DMD
+    reload_lead: int = RELOAD_LEAD
     period: int = 0
     camera_offset: int = 0
     camera_width: int = 1
@@ -104,7 +123,7 @@ class Params:
     def registers(self, dmd):
         """The values of :class:`~gateware.dlpc410.params.Registers`, as a dict."""
         regs = {k: getattr(self, k) for k in (
-            "lsb", "t_rst", "t_settle", "hide", "dark_gap", "stagger", "period",
+            "lsb", "t_rst", "t_settle", "hide", "dark_gap", "stagger", "period", "reload_lead",
             "camera_offset", "camera_width")}
         regs.update(reset_mode=self.reset_mode, order=self.order, order_table=list(self.order_table),
                     chain=int(self.chain), strict_rst=int(self.strict_rst), trigger=self.trigger,
@@ -136,6 +155,11 @@ class Result:
     accepted: list = field(default_factory=list)   # strobe cycles obeyed
     frame_starts: list = field(default_factory=list)
     shown: list = field(default_factory=list)        # frames taken, in order
+
+    def decoded(self):
+        """The commands a decoder of the pins logs: the no-op rows that follow a 1080p clear
+        carry no command and are left out."""
+        return [c for c in self.commands if c[1] != "noop"]
 
 
 def exponents(order, table, depth):
@@ -281,14 +305,20 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
     def waiting(t):
         return all(not s.pending and s.loaded_at is not None and s.loaded_at <= t for s in st)
 
+    def playing():
+        return any(s.pending for s in st)
+
     def take_while_waiting(t):
-        """A newer frame offered while every group waits loaded: load its first plane."""
+        """A newer frame offered while no group plays: load its first plane, abandoning the
+        stale loads still queued (their words are discarded for ``flush_rows`` row periods)."""
+        wait = 0 if waiting(t) else flush_rows(dmd) * row_period
         fi = take_frame(repeat=False)
         state["next_frame"] = fi
-        state["queued_at"] = t + G + 1
+        state["queued_at"] = t + wait + G + 1
+        queue.clear()
         for g in range(G):
             st[g].pos = ("plane", fi, 0)
-            st[g].writable = max(st[g].writable, t + RELOAD_LEAD)
+            st[g].writable = max(st[g].writable, t + p.reload_lead + wait)
             enqueue(g, fi, 0)
 
     idle_take = not p.chain and p.source != Source.PRNG
@@ -305,7 +335,7 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
     while True:
         t_now[0] = t
         nxt = offer()
-        take_now = idle_take and t >= state["queued_at"] and waiting(t) and nxt is not None and nxt[1] <= t
+        take_now = idle_take and nxt is not None and nxt[1] <= t and t >= state["queued_at"] and not playing()
         # --- decision at t ---
         if t % 2 == 0 and t >= bus_free:
             rst_ok = [t - (state["rst_any"] if p.strict_rst else st[g].rst_free) >= 0 for g in range(G)]
@@ -367,12 +397,12 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
             if s.pending and s.loaded_at is not None:
                 cands.append(max(s.pulse_at, s.rst_free if not p.strict_rst else state["rst_any"]))
         if queue:
-            g = queue[0][0]
-            cands.append(max(st[g].writable, state["next_row"]))
+            g, ops, i = queue[0]
+            cands.append(max(st[g].writable, state["next_row"]) if ops[i][0] == "row" else st[g].writable)
         nxt = offer()
         take_at = None
-        if idle_take and nxt is not None and all(not s.pending and s.loaded_at is not None for s in st):
-            take_at = max(nxt[1], state["queued_at"], *(s.loaded_at for s in st))
+        if idle_take and nxt is not None and not playing():
+            take_at = max(nxt[1], state["queued_at"], t + 1)
             cands.append(take_at)
         if not cands:
             break
@@ -442,7 +472,8 @@ def _lattice_ok(M, s, G, sep):
 
 def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetMode.GLOBAL,
          exposure_s=0.0, strict_rst=True, chain=False, words_per_cycle=1.0, source=Source.STORE,
-         t_rst_s=None, t_settle_s=None, frame=None, order_table=(7, 6, 5, 4, 3, 2, 1, 0)):
+         t_rst_s=None, t_settle_s=None, frame=None, order_table=(7, 6, 5, 4, 3, 2, 1, 0),
+         reload_lead=RELOAD_LEAD):
     """A parameter set that shows every plane exactly on time, and the rate it reaches.
 
     ``exposure_s`` asks for a least significant plane at least that long (0: the shortest legal
@@ -454,12 +485,16 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     chosen (searching upward from the shortest legal one) so that the offsets ``g * stagger``
     never bring pulses of two groups closer than the RST rule allows (strict: ``t_rst``; loose:
     one row cycle) and the loads squeezed between other groups' pulses still finish on time.
+    For triggered multi-bit frames the plan with groups spread apart (:func:`_spread`) is taken
+    instead when it is faster; ``binds`` then names the load queue order.
+    ``reload_lead``: the store's latency to a row's first words, in cycles (see :class:`Params`).
     """
     R = dmd.dclk_per_row
     t_rst = even(_cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s, dclk_hz) + RST_MARGIN)
     t_settle = _cycles(TIMING["t_settle"].value if t_settle_s is None else t_settle_s, dclk_hz)
     words = dmd.words_per_row
-    row_period = even(max(R, math.ceil(words / words_per_cycle - 1e-9)))
+    # the on-chip source needs no memory bandwidth: one row per row cycle on any bus width
+    row_period = R if source == Source.PRNG else even(max(R, math.ceil(words / words_per_cycle - 1e-9)))
     grp = groups(dmd, reset_mode)
     G = len(grp)
     rows_g = max(len(b) for b in grp) * dmd.rows_per_block
@@ -489,7 +524,8 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
             dark_gap = even(reload) if G == 1 else lsb * math.ceil(reload / lsb)
             p = Params(lsb=lsb, t_rst=t_rst, t_settle=t_settle, hide=hide, dark_gap=dark_gap,
                        reset_mode=reset_mode, order=order, order_table=order_table, chain=chain,
-                       strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period)
+                       strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period,
+                       reload_lead=reload_lead)
             fr = frame or Frame(0, depth)
             r = simulate(dmd, p, [replace(fr, ready=0)] * (3 if chain else 1), [ready_cycle(dmd, p, fr)],
                          max_frames=2)
@@ -501,7 +537,84 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     if lsb > lsb_min and binds != "requested exposure":
         binds += " + pulse spacing" if G > 1 else ""
     frame_cycles = _frame_cycles(dmd, p, fr)
+    if G > 1 and not chain and depth > 1:
+        # phased PWM: the LSB lattice against spread groups, whichever is faster
+        spread = _spread(dmd, replace(p, dark_gap=even(t_rst + t_settle + load_g + slack)), fr,
+                         even(lsb_min), sep, load_g, clear_g, frame_cycles)
+        if spread is not None:
+            p, frame_cycles = spread
+            binds = ("settle (t_rst + t_settle + clears) + load queue order: groups spread so that "
+                     "no group's clears wait behind another group's plane load"
+                     if p.lsb == even(lsb_min) else
+                     "load queue order + pulse spacing (groups spread, LSB above the settle path)")
     return Plan(p, frame_cycles, lsb_min, binds, dclk_hz)
+
+
+def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
+    """Phased PWM with groups spread apart instead of on the LSB lattice: every group plays the
+    plain timeline (dark gaps not rounded to LSB multiples) ``stagger`` after the one before.
+    Loads are served in the order of the pulses that freed them, so a group's clears behind a
+    short plane must not queue behind another group's plane load: the stagger is the smallest
+    that keeps every pulse ``sep`` from every other group's (RST_ACTIVE) and every load inside
+    its deadline with the loads in queue order; each candidate is then checked by
+    :func:`simulate`. Returns (params, frame cycles) if faster than ``beat`` cycles, else None."""
+    G = len(groups(dmd, p.reset_mode))
+    frozen = p.t_rst + p.t_settle
+    margin = 2 * dmd.dclk_per_row * G           # other groups' pulses taking row cycles
+    exps = exponents(p.order, p.order_table, fr.depth)
+    best = None
+    step = max(2, even(lsb_min // 64))
+    for lsb in range(lsb_min, lsb_min + lsb_min // 4, step):
+        pulses, jobs, t = [0], [], 0
+        for j, e in enumerate(exps):
+            d = lsb << e
+            t += d
+            pulses.append(t)
+            if d >= p.hide and j != len(exps) - 1:
+                jobs.append(load_g)
+            else:
+                jobs += [clear_g, load_g]
+                t += p.dark_gap
+                pulses.append(t)
+        pulses = np.array(pulses[:-1])
+        cap = ((beat if best is None else best[1]) - int(pulses[-1])) // (G - 1)
+        if cap <= sep:
+            break
+        diffs = np.unique(pulses[:, None] - pulses[None, :])
+        stag = np.arange(even(sep), min(cap, int(pulses[-1])), 2)
+        ok = np.ones(len(stag), bool)
+        for k in range(1, G):
+            near = np.abs(diffs[None, :] + k * stag[:, None]).min(axis=1)
+            ok &= near >= sep
+        stag = stag[ok]
+        # the loads in queue (pulse) order, for every candidate stagger at once; the last
+        # pulse's load (the next frame's first plane) has no deadline but takes the bus
+        offsets = np.repeat(np.arange(G), len(pulses))
+        starts = np.tile(pulses, G)[None, :] + offsets[None, :] * stag[:, None]
+        order = np.argsort(starts, axis=1, kind="stable")
+        starts = np.take_along_axis(starts, order, axis=1)
+        deadlines = np.take_along_axis(
+            np.tile(np.append(pulses[1:], 1 << 62), G)[None, :] + offsets[None, :] * stag[:, None],
+            order, axis=1)
+        lengths = np.tile(np.array(jobs), G)[order]
+        end = np.zeros(len(stag), np.int64)
+        fits = np.ones(len(stag), bool)
+        for i in range(starts.shape[1]):
+            end = np.maximum(end, starts[:, i] + frozen) + lengths[:, i]
+            fits &= end + margin <= deadlines[:, i]
+        tries = 0
+        for s in stag[fits]:
+            s = int(s)
+            q = replace(p, lsb=lsb, stagger=s)
+            if simulate(dmd, q, [replace(fr, ready=0)], [ready_cycle(dmd, q, fr)], max_frames=2).late == 0:
+                cycles = _frame_cycles(dmd, q, fr)
+                if cycles < (beat if best is None else best[1]):
+                    best = (q, cycles)
+                break
+            tries += 1
+            if tries == 4:
+                break
+    return best
 
 
 def ready_cycle(dmd, p, fr):
@@ -515,22 +628,11 @@ def _frame_cycles(dmd, p, fr):
     if p.chain:
         r = simulate(dmd, p, [fr] * 4, [ready_cycle(dmd, p, fr)], max_frames=3)
         return r.frame_starts[2] - r.frame_starts[1]
-    # trigger as soon as ready: find the first cycle a second strobe is obeyed
+    # trigger as soon as ready: a second strobe is obeyed once every group, its frame played,
+    # is loaded again (the last thing each group does)
     first = ready_cycle(dmd, p, fr)
-    lo, hi = first + 1, first + 1
-    while True:
-        r2 = simulate(dmd, p, [fr], [first, hi])
-        if len(r2.accepted) == 2:
-            break
-        lo, hi = hi, hi * 2
-    while lo < hi:
-        mid = (lo + hi) // 2
-        r2 = simulate(dmd, p, [fr], [first, mid])
-        if len(r2.accepted) == 2:
-            hi = mid
-        else:
-            lo = mid + 1
-    return hi - first
+    r = simulate(dmd, p, [fr], [first])
+    return max(st.loaded_at for st in r.groups) - first
 
 
 def bound(dmd, dclk_hz, depth=8, *, t_rst_s=None, t_settle_s=None):

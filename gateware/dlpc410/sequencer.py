@@ -23,12 +23,12 @@ from amaranth.utils import ceil_log2
 from gateware.store.layouts import SLOT_BITS, FrameInfo, PlaneRequest
 
 from . import interface
-from .beat import LANES
+from .beat import beat_lanes
 from .facts import BlockMode, RowMode
 from .init import TRAINING_EDGES, Init
-from .params import TIME_BITS, PlaneOrder, Registers, ResetMode, Source
+from .params import DURATION_BITS, TIME_BITS, PlaneOrder, Registers, ResetMode, Source
 from .prng import Prng
-from .schedule import INIT_TO_DVALID, RELOAD_LEAD
+from .schedule import INIT_TO_DVALID, WORD_FIFO_ROWS, flush_rows
 from .trigger import Trigger
 
 __all__ = ["Sequencer", "Status"]
@@ -75,12 +75,16 @@ def _exponent(m, regs, j, depth, name):
 
 
 class Sequencer(wiring.Component):
-    """DLPC410 sequencer for two-bus DMDs (DLP7000 and the test geometry).
+    """DLPC410 sequencer for two-bus (DLP7000) and four-bus (DLP9500) DMDs.
 
     Parameters
     ----------
     dmd : :class:`gateware.dlpc410.facts.DmdType`
-        Geometry; one 64-bit word per DCLK cycle, ``dclk_per_row`` words per row.
+        Geometry: a beat of ``bits_per_dclk`` bits per DCLK cycle (one 64-bit word on A/B, and
+        a second on C/D for four buses), ``dclk_per_row`` beats per row; a block clear takes
+        ``clear_row_cycles`` row cycles (1080p: the clear and two no-op rows, DLPC410.md).
+        The store gives one word per cycle at most, so a four-bus DMD loads a row every two
+        row cycles at best (the plan's ``row_period``).
 
     Members
     -------
@@ -104,7 +108,7 @@ class Sequencer(wiring.Component):
     requests : Out(stream.Signature(PlaneRequest))
         Rows to read, one block of one plane per request, in load order.
     words : In(stream.Signature(64))
-        The requested rows' words, in order.
+        The requested rows' words, in order (paired into beats for four buses).
     occ_slot : Out(SLOT_BITS), occupancy : In(ArrayLayout(8, blocks))
         Occupancy read port: per block a byte, bit k set when stored plane k has a bit set
         in the block, for slot ``occ_slot`` as it was one cycle earlier.
@@ -117,8 +121,8 @@ class Sequencer(wiring.Component):
     """
 
     def __init__(self, dmd):
-        assert dmd.buses == 2 and dmd.bits_per_dclk == 64 and dmd.clear_row_cycles == 1
-        assert dmd.words_per_row == dmd.dclk_per_row
+        assert dmd.buses in (2, 4) and dmd.bits_per_dclk == 32 * dmd.buses
+        assert dmd.words_per_row * 64 == dmd.dclk_per_row * dmd.bits_per_dclk
         self._dmd = dmd
         super().__init__({
             "pins": Out(interface.Signature(dmd.buses)),
@@ -151,8 +155,9 @@ class Sequencer(wiring.Component):
 
         m.submodules.init = init = Init()
         m.submodules.trigger = trig = Trigger()
-        m.submodules.prng = prng = Prng()
-        m.submodules.fifo = words = fifo.SyncFIFOBuffered(width=64, depth=4 * dmd.words_per_row)
+        wpb = dmd.bits_per_dclk // 64         # words per beat
+        m.submodules.prng = prng = Prng(words=wpb)
+        m.submodules.fifo = words = fifo.SyncFIFOBuffered(width=dmd.bits_per_dclk, depth=WORD_FIFO_ROWS * R)
         m.d.comb += [
             init.ecp2_finished.eq(self.pins.ecp2_finished),
             init.init_active.eq(self.pins.init_active),
@@ -160,9 +165,19 @@ class Sequencer(wiring.Component):
             trig.mode.eq(regs.trigger), trig.period.eq(regs.period), trig.run.eq(init.running),
             trig.pin.eq(self.trigger_in), trig.sync_in.eq(self.sync_in), trig.soft.eq(self.soft_trigger),
             prng.seed.eq(self.seed), prng.reseed.eq(self.reseed),
-            words.w_data.eq(self.words.payload), words.w_en.eq(self.words.valid),
-            self.words.ready.eq(words.w_rdy),
         ]
+        if wpb == 1:
+            m.d.comb += [words.w_data.eq(self.words.payload), words.w_en.eq(self.words.valid),
+                         self.words.ready.eq(words.w_rdy)]
+        else:
+            # four buses: the first word of a beat waits for the second (A/B, then C/D)
+            first = Signal(64)
+            have = Signal()
+            m.d.comb += [words.w_data.eq(Cat(first, self.words.payload)),
+                         words.w_en.eq(self.words.valid & have),
+                         self.words.ready.eq(~have | words.w_rdy)]
+            with m.If(self.words.valid & self.words.ready):
+                m.d.sync += [first.eq(self.words.payload), have.eq(~have)]
         use_prng = regs.source == Source.PRNG
 
         now = self.status.now
@@ -208,7 +223,10 @@ class Sequencer(wiring.Component):
 
         next_slot = Signal(SLOT_BITS)
         next_depth = Signal(4)
-        take_idle = Signal()                   # a frame offered while waiting for a trigger
+        take_idle = Signal()                   # a frame offered while no group plays
+        flushing = Signal()                    # stale loads dropped, their words discarded
+        # words asked of the store and not yet taken from the word FIFO
+        owed = Signal(range((GMAX + 2) * dmd.words_per_plane + 1))
 
         # ---- load queue (pulse order) -> requester -> loader queue ----
         queued = data.StructLayout({"group": grp_bits, "slot": SLOT_BITS, "depth": 4, "pos": 3, "clear": 1})
@@ -249,16 +267,18 @@ class Sequencer(wiring.Component):
             self.release.valid.eq(releases.r_rdy), self.release.payload.eq(releases.r_data),
             releases.r_en.eq(self.release.ready),
         ]
-        with m.FSM(name="requester"):
+        with m.FSM(name="requester") as requester:
             with m.State("IDLE"):
                 # the last group's first load from a new slot: no group reads the old one again
                 leaves = (head.group == n_groups - 1) & ~head.clear & seen_slot & (head.slot != last_slot)
+                # flushing: stale entries are dropped here, through the same slot accounting
                 with m.If(queue.r_rdy & (~leaves | releases.w_rdy)):
                     m.d.comb += [queue.r_en.eq(1), releases.w_en.eq(leaves)]
                     m.d.sync += req_entry.eq(head)
                     with m.If((head.group == n_groups - 1) & ~head.clear):
                         m.d.sync += [last_slot.eq(head.slot), seen_slot.eq(1)]
-                    m.next = "LOOK"
+                    with m.If(~flushing):
+                        m.next = "LOOK"
             with m.State("LOOK"):
                 mask = Cat(
                     (b >= r_first) & (b <= r_last) & ~req_entry.clear
@@ -267,25 +287,36 @@ class Sequencer(wiring.Component):
                 m.d.sync += [req_mask.eq(mask), req_block.eq(r_first),
                              req_first.eq(r_first), req_last.eq(r_last)]
                 m.next = "PUSH"
+                with m.If(flushing):
+                    m.next = "IDLE"
             with m.State("PUSH"):
                 # the loader learns the mask first, so it drains the words of one block while
                 # the next block's request waits for the store
-                m.d.comb += loads.w_en.eq(1)
-                with m.If(loads.w_rdy):
-                    m.next = "REQUEST"
-            with m.State("REQUEST"):
-                with m.If(req_block > req_last):
+                with m.If(flushing):
                     m.next = "IDLE"
-                with m.Elif(req_mask.bit_select(req_block, 1) & ~use_prng):
+                with m.Else():
+                    m.d.comb += loads.w_en.eq(1)
+                    with m.If(loads.w_rdy):
+                        m.next = "REQUEST"
+            with m.State("REQUEST"):
+                wanted = req_mask.bit_select(req_block, 1) & ~use_prng
+                # flushing: a request offered is held until taken (its words are discarded)
+                with m.If((req_block > req_last) | (flushing & ~wanted)):
+                    m.next = "IDLE"
+                with m.Elif(wanted):
                     m.d.comb += self.requests.valid.eq(1)
                     with m.If(self.requests.ready):
                         m.d.sync += req_block.eq(req_block + 1)
+                        with m.If(flushing):
+                            m.next = "IDLE"
                 with m.Else():
                     m.d.sync += req_block.eq(req_block + 1)
 
         # ---- the bus ----
         remain = Signal(range(R))              # cycles of the running row cycle after this one
-        free = (remain == 0) & ~now[0]
+        noops = Signal(range(dmd.clear_row_cycles))   # no-op rows still owed to a clear
+        free = (remain == 0) & ~now[0] & (noops == 0)
+        clear_len = dmd.clear_row_cycles * R
         op_row = Signal()                      # the running row cycle loads a row
         finishing = Signal()
         finish_group = Signal(grp_bits)
@@ -293,19 +324,23 @@ class Sequencer(wiring.Component):
         cmd = Signal(data.StructLayout({"rowmd": RowMode, "rowad": 11, "blkmd": BlockMode,
                                         "blkad": 4, "rst2blkz": 1}))
         dvalid = Signal()
-        word = Signal(64)
+        word = Signal(dmd.bits_per_dclk)
 
         rst_ok = [Mux(regs.strict_rst, _diff(rst_any, now) <= 0, _diff(rst_free[g], now) <= 0)
                   & ~init.rst_active_synced for g in range(GMAX)]
         armed = [Signal(name=f"armed{g}") for g in range(GMAX)]
         due = Signal(GMAX)
-        imminent = Signal()
+        imminent = Signal()                    # a loaded pulse falls due within a row cycle
+        imminent_clear = Signal()              # ... within a clear and its no-op rows
         for g in range(GMAX):
             m.d.comb += [
                 armed[g].eq(active[g] & pending[g] & loaded[g]),
                 due[g].eq(armed[g] & (_diff(pulse_at[g], now) <= 0) & rst_ok[g]),
             ]
-        m.d.comb += imminent.eq(Cat(armed[g] & (_diff(pulse_at[g], now) < R) for g in range(GMAX)).any())
+        m.d.comb += [
+            imminent.eq(Cat(armed[g] & (_diff(pulse_at[g], now) < R) for g in range(GMAX)).any()),
+            imminent_clear.eq(Cat(armed[g] & (_diff(pulse_at[g], now) < clear_len) for g in range(GMAX)).any()),
+        ]
         p = Signal(grp_bits)                   # the group pulsed this cycle
         for g in reversed(range(GMAX)):
             with m.If(due[g]):
@@ -324,18 +359,19 @@ class Sequencer(wiring.Component):
         cur_row = Mux(fresh, 0, l_row)
         occupied = lhead.mask.bit_select(cur_block, 1)
         next_row_at = Signal(TIME_BITS)
-        data_ok = use_prng | (words.level >= dmd.words_per_row)
+        data_ok = use_prng | (words.level >= R)
         l_group = lhead.group
-        can_load = running & free & ~do_pulse & loads.r_rdy & (_diff(writable[l_group], now) <= 0) & ~imminent
+        can_load = (running & ~flushing & free & ~do_pulse & loads.r_rdy
+                    & (_diff(writable[l_group], now) <= 0))
         row_ready = (_diff(next_row_at, now) <= 0)
         do_row = Signal()
         do_clear = Signal()
         m.d.comb += [
-            do_row.eq(can_load & occupied & row_ready & data_ok),
-            do_clear.eq(can_load & ~occupied),
+            do_row.eq(can_load & ~imminent & occupied & row_ready & data_ok),
+            do_clear.eq(can_load & ~imminent_clear & ~occupied),
         ]
         last_op = (cur_block == lhead.last) & (~occupied | (cur_row == rpb - 1))
-        underrun = can_load & occupied & row_ready & ~data_ok
+        underrun = can_load & ~imminent & occupied & row_ready & ~data_ok
         with m.If(underrun):
             m.d.sync += self.status.underruns.eq(self.status.underruns + 1)
 
@@ -351,13 +387,18 @@ class Sequencer(wiring.Component):
                     m.d.sync += [l_block.eq(cur_block + 1), l_row.eq(0)]
         with m.If(do_row):
             m.d.sync += next_row_at.eq(now + regs.row_period)
-        with m.If(finishing & (remain == 1)):
+        with m.If(finishing & (remain == 1) & (noops == 0)):
             m.d.sync += [loaded[finish_group].eq(1), finishing.eq(0)]
 
         # ---- the command registers ----
         issue = do_pulse | do_row | do_clear
         reading = do_row | (op_row & (remain != 0))
-        m.d.comb += [words.r_en.eq(reading & ~use_prng), prng.next.eq(reading & use_prng)]
+        discard = flushing & ~reading & (owed != 0)
+        m.d.comb += [words.r_en.eq(reading & ~use_prng | discard), prng.next.eq(reading & use_prng)]
+        asked = Mux(self.requests.valid & self.requests.ready, rpb * dmd.words_per_row, 0)
+        m.d.sync += owed.eq(owed + asked - Mux(words.r_en & words.r_rdy, wpb, 0))
+        with m.If(flushing):
+            m.d.comb += loads.r_en.eq(1)
         m.d.sync += word.eq(Mux(reading, Mux(use_prng, prng.word, words.r_data), 0))
         with m.If(issue):
             m.d.sync += [dvalid.eq(1), remain.eq(R - 1), op_row.eq(do_row),
@@ -366,7 +407,8 @@ class Sequencer(wiring.Component):
             with m.If(do_row):
                 m.d.sync += [cmd.rowmd.eq(RowMode.ADDRESSED), cmd.rowad.eq(cur_block * rpb + cur_row)]
             with m.Elif(do_clear):
-                m.d.sync += [cmd.blkmd.eq(BlockMode.CLEAR), cmd.blkad.eq(cur_block)]
+                m.d.sync += [cmd.blkmd.eq(BlockMode.CLEAR), cmd.blkad.eq(cur_block),
+                             noops.eq(dmd.clear_row_cycles - 1)]
             with m.Else():
                 with m.Switch(regs.reset_mode):
                     with m.Case(ResetMode.GLOBAL):
@@ -379,6 +421,10 @@ class Sequencer(wiring.Component):
                         m.d.sync += [cmd.blkmd.eq(BlockMode.RESET), cmd.blkad.eq(p)]
         with m.Elif(remain != 0):
             m.d.sync += remain.eq(remain - 1)
+        with m.Elif(noops != 0):
+            # the clear's no-op rows follow it back to back (1080p), DVALID high
+            m.d.sync += [remain.eq(R - 1), noops.eq(noops - 1), cmd.blkmd.eq(BlockMode.NOOP),
+                         cmd.blkad.eq(0)]
         with m.Else():
             m.d.sync += [dvalid.eq(0), op_row.eq(0), cmd.rowmd.eq(RowMode.NOOP),
                          cmd.blkmd.eq(BlockMode.NOOP), cmd.rst2blkz.eq(1)]
@@ -445,6 +491,11 @@ class Sequencer(wiring.Component):
                                        & (_diff(now, cam_at + regs.camera_width) < 0))
 
         # ---- start: take the first frame, queue every group's first plane ----
+        all_ready = Cat(~active[g] | (~pending[g] & loaded[g]) for g in range(GMAX)).all()
+        playing = Cat(active[g] & pending[g] for g in range(GMAX)).any()
+        flush_until = Signal(TIME_BITS)
+        flush_cycles = Signal(DURATION_BITS)
+        m.d.comb += flush_cycles.eq(flush_rows(dmd) * regs.row_period)
         start_group = Signal(grp_bits + 1)
         with m.FSM(name="start") as start_fsm:
             with m.State("WAIT"):
@@ -469,21 +520,33 @@ class Sequencer(wiring.Component):
                 m.d.comb += running.eq(1)
                 with m.If(take_idle):
                     m.next = "RELOAD"
+                    with m.If(~all_ready):
+                        m.next = "FLUSH"
+            with m.State("FLUSH"):
+                # the stale loads are dropped: queued ones by the requester, looked-up ones
+                # here, and the words already asked for are discarded; then the newer frame's
+                # first planes are queued, exactly ``flush_cycles`` after it was taken
+                m.d.comb += [running.eq(1), flushing.eq(1)]
+                drained = requester.ongoing("IDLE") & ~queue.r_rdy & ~loads.r_rdy & (owed == 0)
+                with m.If(drained & (_diff(flush_until, now) <= 0)):
+                    m.next = "RELOAD"
             with m.State("RELOAD"):
                 m.d.comb += running.eq(1)
                 queue_first_planes()
 
         # ---- triggers ----
-        all_ready = Cat(~active[g] | (~pending[g] & loaded[g]) for g in range(GMAX)).all()
-        # a newer frame than the one waiting: load its first plane instead (the loads wait for the
-        # requester's first words); nothing is in flight, since every group is loaded
-        m.d.comb += take_idle.eq(start_fsm.ongoing("RUN") & all_ready & ~regs.chain & ~use_prng
+        # a newer frame offered while no group plays: it replaces the preloaded first planes
+        # (the loads wait for the store's first words); any stale load still in flight is
+        # abandoned: the row cycle on the bus ends, nothing of it is pulsed (no trigger is obeyed
+        # before every group is loaded again), and the settle times of the last pulses still hold
+        m.d.comb += take_idle.eq(start_fsm.ongoing("RUN") & ~playing & ~regs.chain & ~use_prng
                                  & self.frames.valid & frame_ok)
         with m.If(take_idle):
             m.d.comb += self.frames.ready.eq(1)
-            lead = now + RELOAD_LEAD
+            wait = Mux(all_ready, 0, flush_cycles)
+            lead = now + regs.reload_lead + wait
             m.d.sync += [next_slot.eq(self.frames.payload.slot), next_depth.eq(self.frames.payload.bit_depth),
-                         start_group.eq(0)]
+                         start_group.eq(0), flush_until.eq(now + wait), fresh.eq(1), finishing.eq(0)]
             for g in range(GMAX):
                 m.d.sync += [slot[g].eq(self.frames.payload.slot), depth[g].eq(self.frames.payload.bit_depth),
                              loaded[g].eq(0), writable[g].eq(Mux(_diff(writable[g], lead) < 0, lead, writable[g]))]
@@ -510,12 +573,12 @@ class Sequencer(wiring.Component):
             # core) carries the falling-edge bits, the platform layer's DDR output the rest
             rise = Mux(toggle, TRAINING_EDGES[2], TRAINING_EDGES[0])
             fall = Mux(toggle, TRAINING_EDGES[3], TRAINING_EDGES[1])
-            for bus in "ab":
+            for bus in "abcd"[:dmd.buses]:
                 m.d.comb += [getattr(pins, f"din_{bus}").rise.eq(rise.replicate(16)),
                              getattr(pins, f"din_{bus}").fall.eq(fall.replicate(16))]
             m.d.comb += [pins.dvalid.eq(fall), pins.rst2blkz.eq(1)]
         with m.Else():
-            for bus, edge, lsb in LANES:
+            for bus, edge, lsb in beat_lanes(dmd.buses):
                 m.d.comb += getattr(getattr(pins, f"din_{bus.lower()}"), edge).eq(word[lsb:lsb + 16])
             m.d.comb += [pins.dvalid.eq(dvalid), pins.rowmd.eq(cmd.rowmd), pins.rowad.eq(cmd.rowad),
                          pins.blkmd.eq(cmd.blkmd), pins.blkad.eq(cmd.blkad),

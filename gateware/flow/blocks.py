@@ -53,9 +53,9 @@ def _store_reader():
     return Reader(DMDS["dlp7000"], slots=4)
 
 
-def _seq():
+def _seq(dmd="dlp7000"):
     from gateware.dlpc410.sequencer import Sequencer
-    return Sequencer(DMDS["dlp7000"])
+    return Sequencer(DMDS[dmd])
 
 
 BLOCKS = {
@@ -68,4 +68,5 @@ BLOCKS = {
     "store_writer": _store_writer,
     "store_reader": _store_reader,
     "seq": _seq,
+    "seq_dlp9500": lambda: _seq("dlp9500"),
 }

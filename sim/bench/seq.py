@@ -59,9 +59,10 @@ def newer_frame(dmd, p, *, late, gateware=False):
     """A newer frame completed just before the trigger: a trigger before its first plane is
     loaded again is an overrun, so the worst case is frame complete -> first clocking pulse of
     it on the pins, triggered as early as it is obeyed. ``late``: the frame completes one cycle
-    after group 0's last pulse of the frame shown (its repeat is preloaded first, whole);
-    else while every group waits. Returns (reload cycles: complete -> a trigger is obeyed,
-    latency cycles, pin -> pulse cycles of that trigger); ``gateware``: measured on the
+    after group 0's last pulse of the frame shown (the preload of its repeat is abandoned;
+    the newer frame's load waits for the settle time of that pulse, or for the stale words to
+    be discarded, whichever is later); else while every group waits. Returns (reload cycles:
+    complete -> a trigger is obeyed, latency cycles, pin -> pulse cycles of that trigger); ``gateware``: measured on the
     gateware in the Amaranth simulator, else the schedule model (equal cycle for cycle)."""
     pin0 = max(g.loaded_at for g in schedule.simulate(dmd, p, [schedule.Frame(0, 1)]).groups)
     alone = schedule.simulate(dmd, p, [schedule.Frame(0, 1)], [pin0 + PIN_TO_STROBE])
@@ -81,6 +82,30 @@ def newer_frame(dmd, p, *, late, gateware=False):
         assert model.overruns == 0 and [f.slot for f in model.shown] == [0, 1]
         pulse = next(t for t, _g, _k, fi, _e in model.pulses if fi == 1)
     return obeyed - done, pulse + 1 - done, pulse + 1 - pin
+
+
+def dlp9500_figures(f, sfx):
+    """Four buses (DLP9500, 1080p clears): the store gives one 64-bit word per cycle, half a
+    DLP9500 beat, so rows come every two row cycles (``row_period``); the same plans with a
+    store of two words per cycle show what that costs. The on-chip source needs no store."""
+    d = DMDS["dlp9500"]
+    gray = schedule.plan(d, f)
+    mem = schedule.plan(d, f, depth=1, chain=True)
+    return {
+        f"seq.row_period_cycles_dlp9500_store{sfx}": (gray.params.row_period, "cycle"),
+        f"seq.gray8_rate_hz_dlp9500_global{sfx}": (gray.rate_hz, "Hz"),
+        f"seq.gray8_rate_hz_dlp9500_global_at_row_rate{sfx}": (
+            schedule.plan(d, f, words_per_cycle=2.0).rate_hz, "Hz"),
+        f"seq.gray8_bound_hz_dlp9500{sfx}": (schedule.bound(d, f), "Hz"),
+        f"seq.binary_rate_hz_memory_dlp9500{sfx}": (mem.rate_hz, "Hz"),
+        f"seq.binary_rate_hz_memory_dlp9500_at_row_rate{sfx}": (
+            schedule.plan(d, f, depth=1, chain=True, words_per_cycle=2.0).rate_hz, "Hz"),
+        f"seq.binary_rate_hz_prng_dlp9500{sfx}": (
+            schedule.plan(d, f, depth=1, chain=True, source=Source.PRNG).rate_hz, "Hz"),
+        f"seq.binary_rate_hz_prng_dlp9500_phased_loose{sfx}": (
+            schedule.plan(d, f, depth=1, chain=True, source=Source.PRNG, reset_mode=ResetMode.SINGLE,
+                          strict_rst=False).rate_hz, "Hz"),
+    }
 
 
 def gateware_binary_period():
@@ -229,6 +254,10 @@ def run():
         figures[f"seq.gray8_frame_cycles_dlp7000_global{sfx}"] = (glob.frame_cycles, "cycle")
         figures[f"seq.gray8_lsb_cycles_dlp7000_global{sfx}"] = (glob.params.lsb, "cycle")
         figures[f"seq.gray8_rate_hz_dlp7000_phased{sfx}"] = (quad.rate_hz, "Hz")
+        figures[f"seq.gray8_lsb_cycles_dlp7000_phased{sfx}"] = (quad.params.lsb, "cycle")
+        figures[f"seq.gray8_stagger_cycles_dlp7000_phased{sfx}"] = (quad.params.stagger, "cycle")
+        dual = schedule.plan(XGA, f, reset_mode=ResetMode.DUAL)
+        figures[f"seq.gray8_rate_hz_dlp7000_phased_dual{sfx}"] = (dual.rate_hz, "Hz")
         figures[f"seq.gray8_rate_hz_dlp7000_phased_single_loose{sfx}"] = (single_loose.rate_hz, "Hz")
         figures[f"seq.gray8_bound_hz_dlp7000{sfx}"] = (schedule.bound(XGA, f), "Hz")
 
@@ -242,6 +271,7 @@ def run():
         figures[f"seq.binary_rate_hz_prng_phased_loose{sfx}"] = (prng_phased.rate_hz, "Hz")
         figures[f"seq.binary_rate_hz_memory{sfx}"] = (mem.rate_hz, "Hz")
         figures[f"seq.binary_rate_hz_memory_phased_loose{sfx}"] = (mem_phased.rate_hz, "Hz")
+        figures.update(dlp9500_figures(f, sfx))
 
     measured, model = gateware_binary_period()
     figures["seq.binary_period_cycles_test_dmd_gateware"] = (measured, "cycle")

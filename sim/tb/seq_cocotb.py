@@ -78,7 +78,7 @@ async def ramp_frame_matches_model(dut):
         dut.trigger_in.value = int(high_left > 0)
         high_left = max(0, high_left - 1)
     got = [c for c in model.commands(shift - 1) if c[0] < end]
-    want = [c for c in model_run.commands if c[0] < end]
+    want = [c for c in model_run.decoded() if c[0] < end]
     first = next((i for i, (x, y) in enumerate(zip(got, want, strict=False)) if x != y), None)
     where = None if first is None else (got[first], want[first])
     assert got == want, f"{len(got)} vs {len(want)} commands; first difference at {first}: {where}"
