@@ -87,7 +87,15 @@ class Sequencer(wiring.Component):
     pins : Out(:class:`gateware.dlpc410.interface.Signature`)
         The DLPC410 applications interface.
     regs : In(:class:`gateware.dlpc410.params.Registers`)
-        Run-time parameters (hold them steady while frames play).
+        Run-time parameters. Change them only while ``at_rest`` is high, with ``reload``.
+    at_rest : Out(1)
+        No frame is playing and no load is under way: before the first frame, or (triggered,
+        not chained) every group loaded and waiting for a trigger. The only time ``regs`` may
+        change.
+    reload : In(1)
+        One cycle, while ``at_rest``, in the cycle ``regs`` change: every group's first plane is
+        loaded again under the new registers (the reset mode and plane order decide what that
+        is), as for a newer frame offered while waiting; a trigger in that cycle is an overrun.
     trigger_in, sync_in : In(1)
         TTL trigger and sync inputs (asynchronous).
     soft_trigger : In(1)
@@ -123,6 +131,8 @@ class Sequencer(wiring.Component):
         super().__init__({
             "pins": Out(interface.Signature(dmd.buses)),
             "regs": In(Registers),
+            "at_rest": Out(1),
+            "reload": In(1),
             "trigger_in": In(1),
             "sync_in": In(1),
             "soft_trigger": In(1),
@@ -477,15 +487,20 @@ class Sequencer(wiring.Component):
         all_ready = Cat(~active[g] | (~pending[g] & loaded[g]) for g in range(GMAX)).all()
         # a newer frame than the one waiting: load its first plane instead (the loads wait for the
         # requester's first words); nothing is in flight, since every group is loaded
-        m.d.comb += take_idle.eq(start_fsm.ongoing("RUN") & all_ready & ~regs.chain & ~use_prng
-                                 & self.frames.valid & frame_ok)
-        with m.If(take_idle):
+        # (or, with ``reload``, the same frame again under new registers)
+        newer = ~use_prng & self.frames.valid & frame_ok
+        resting = start_fsm.ongoing("RUN") & all_ready & ~regs.chain
+        m.d.comb += [take_idle.eq(resting & (newer | self.reload)),
+                     self.at_rest.eq(start_fsm.ongoing("WAIT") | resting)]
+        with m.If(take_idle & newer):
             m.d.comb += self.frames.ready.eq(1)
+        with m.If(take_idle):
             lead = now + RELOAD_LEAD
-            m.d.sync += [next_slot.eq(self.frames.payload.slot), next_depth.eq(self.frames.payload.bit_depth),
-                         start_group.eq(0)]
+            r_slot = Mux(newer, self.frames.payload.slot, next_slot)
+            r_depth = Mux(newer, self.frames.payload.bit_depth, next_depth)
+            m.d.sync += [next_slot.eq(r_slot), next_depth.eq(r_depth), start_group.eq(0)]
             for g in range(GMAX):
-                m.d.sync += [slot[g].eq(self.frames.payload.slot), depth[g].eq(self.frames.payload.bit_depth),
+                m.d.sync += [slot[g].eq(r_slot), depth[g].eq(r_depth),
                              loaded[g].eq(0), writable[g].eq(Mux(_diff(writable[g], lead) < 0, lead, writable[g]))]
         with m.If(trig.strobe):
             with m.If(~running):
