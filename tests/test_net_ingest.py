@@ -12,11 +12,9 @@ from scapy.layers.inet import ICMP, IP, UDP
 from scapy.layers.l2 import ARP, Ether
 
 import host
-from amaranth.lib import data
-
 from gateware.dlpc410 import schedule
 from gateware.dlpc410.facts import TEST_DMD
-from gateware.dlpc410.params import PlaneOrder, Registers, ResetMode, TriggerMode
+from gateware.dlpc410.params import PlaneOrder, ResetMode, TriggerMode
 from gateware.protocol import fields
 from host import records
 from sim.models import frames, ingest_sim
@@ -58,12 +56,6 @@ GOOD_WIRE = fields.register_wire(PLAN.params.registers(TEST_DMD))
 
 def sequencer_record(sequence=0, **changes):
     return records.sequencer_record({**GOOD_WIRE, **changes}, sequence)
-
-
-def registers_bits(wire):
-    """The :class:`Registers` value the gateware must hand on for a record's wire values."""
-    layout = data.Layout.cast(Registers)
-    return sum((wire[name] & ((1 << f.width) - 1)) << f.offset for name, f in layout)
 
 
 #: Sequencer records the sequencer could not obey: ``name -> changes to a good set``.
@@ -228,7 +220,7 @@ def test_sequencer_records_handed_on_whole(replies):
     """Each valid sequencer record leaves as one register set, every field as sent."""
     out = replies[0]
     second = {**GOOD_WIRE, "order": PlaneOrder.LSB_FIRST.value, "chain": 1}
-    assert out["registers"] == [registers_bits(GOOD_WIRE), registers_bits(second)]
+    assert out["registers"] == [fields.registers_bits(GOOD_WIRE), fields.registers_bits(second)]
     assert out["app"]["records_sequencer"] == 2
 
 
@@ -300,7 +292,7 @@ def test_randomized_mix_ledger(test_name):
     assert out["rows"] == model.rows
     assert out["triggers"] == model.triggers > 0
     assert out["config"] == model.config
-    assert out["registers"] == [registers_bits(wire) for wire in model.registers] and model.registers
+    assert out["registers"] == [fields.registers_bits(wire) for wire in model.registers] and model.registers
     # Status replies and ARP/ICMP replies come from two sources that take turns: the kinds
     # match one for one, the order between the two sources may differ.
     sent = sorted("arp" if ARP in Ether(raw) else "icmp" if ICMP in Ether(raw) else "status"

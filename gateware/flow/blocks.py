@@ -58,6 +58,15 @@ def _seq():
     return Sequencer(DMDS["dlp7000"])
 
 
+def _seq_registers():
+    from gateware.dlpc410 import schedule
+    from gateware.top.control import RegisterCrossing
+    # The sequencer's register sets from the protocol (sync) into dmd, power-up value as the
+    # platform's.
+    dmd = DMDS["dlp7000"]
+    return RegisterCrossing(schedule.plan(dmd, 200e6).params.registers(dmd))
+
+
 BLOCKS = {
     "serialiser": _serialiser,
     "eth_rx": _eth_rx,
@@ -68,4 +77,5 @@ BLOCKS = {
     "store_writer": _store_writer,
     "store_reader": _store_reader,
     "seq": _seq,
+    "seq_registers": _seq_registers,
 }

@@ -51,7 +51,7 @@ class Ingest(wiring.Component):
         Run-time configuration for the sequencer and store (reset value: the build parameters).
     trigger : Out(1)
         Software trigger pulse.
-    registers : Out(stream.Signature(Registers, always_ready=True))
+    registers : Out(stream.Signature(Registers))
         The sequencer's register set of each valid sequencer record.
     status : In(Status)
         Figures from the rest of the system, reported in status replies.
@@ -70,7 +70,7 @@ class Ingest(wiring.Component):
             "pixels": Out(stream.Signature(pixel_layout(dmd, 1, frame_bits))),
             "settings": Out(Config, init=self._config),
             "trigger": Out(1),
-            "registers": Out(stream.Signature(Registers, always_ready=True)),
+            "registers": Out(stream.Signature(Registers)),
             "status": In(Status),
             "net_counters": Out(fields.layout(fields.NET_COUNTERS)),
             "app_counters": Out(fields.layout(fields.APP_COUNTERS)),

@@ -57,7 +57,7 @@ class EthernetPort(wiring.Component):
         Run-time configuration (reset value: the build parameters), in ``sync``.
     trigger : Out(1)
         Software trigger pulse, in ``sync``.
-    registers : Out(stream.Signature(Registers, always_ready=True))
+    registers : Out(stream.Signature(Registers))
         The sequencer's register set of each valid sequencer record, in ``sync``.
     status : In(:data:`.ingest.Status`)
         Figures from the rest of the system, reported in status replies, in ``sync``.
@@ -87,7 +87,7 @@ class EthernetPort(wiring.Component):
             "pixels": Out(stream.Signature(pixel_layout(dmd, 1, frame_bits))),
             "settings": Out(Config, init=self._ingest.signature.members["settings"].init),
             "trigger": Out(1),
-            "registers": Out(stream.Signature(Registers, always_ready=True)),
+            "registers": Out(stream.Signature(Registers)),
             "status": In(Status),
             "mac_counters": Out(counters_layout(32)),
             "rx_dropped": Out(32),

@@ -24,7 +24,7 @@ __all__ = [
     "HEADER", "IMAGE", "CONTROL", "CONFIG", "SEQUENCER", "NET_COUNTERS", "APP_COUNTERS",
     "SYSTEM_STATUS", "STATUS_REPLY", "size", "pack", "unpack", "layout", "view", "byte_slice",
     "to_bytes", "offsets", "image_record_length", "MAX_RECORD",
-    "register_wire", "wire_registers", "register_faults",
+    "register_wire", "wire_registers", "registers_bits", "register_faults",
 ]
 
 import enum as _enum
@@ -183,6 +183,12 @@ def wire_registers(wire):
     :class:`~gateware.dlpc410.params.Registers` value (high bits beyond each field dropped)."""
     from amaranth import Cat
     return Cat(wire[name][:field.width] for name, field in _REGISTERS)
+
+
+def registers_bits(wire):
+    """:func:`wire_registers` for the host and the models: the fields as ints -> the int value of
+    the :class:`~gateware.dlpc410.params.Registers` the gateware hands on."""
+    return sum((wire[name] & ((1 << field.width) - 1)) << field.offset for name, field in _REGISTERS)
 
 
 def _any(terms):

@@ -62,8 +62,9 @@ class Parser(wiring.Component):
         The rows of valid image records, one 8-bit pixel per transfer, left to right.
     settings : Out(fields.layout(fields.CONFIG))
         The configuration registers; control records update the fields they select.
-    registers : Out(stream.Signature(Registers, always_ready=True))
-        The register set of each valid sequencer record, one transfer per record.
+    registers : Out(stream.Signature(Registers))
+        The register set of each valid sequencer record, one transfer per record (the parser
+        waits for it to be taken).
     trigger : Out(1)
         One-cycle pulse for a control record with the software-trigger action.
     queries : Out(stream.Signature(Query))
@@ -80,7 +81,7 @@ class Parser(wiring.Component):
             "pixels": Out(stream.Signature(pixel_layout(dmd, 1, frame_bits))),
             "settings": Out(CONFIG_LAYOUT, init=config),
             "trigger": Out(1),
-            "registers": Out(stream.Signature(Registers, always_ready=True)),
+            "registers": Out(stream.Signature(Registers)),
             "queries": Out(stream.Signature(Query)),
             "counters": Out(fields.layout(fields.APP_COUNTERS)),
         })
@@ -205,8 +206,7 @@ class Parser(wiring.Component):
                             m.next = "DISCARD"
                         with m.Case(RecordType.SEQUENCER):
                             bump("records_sequencer")
-                            m.d.comb += self.registers.valid.eq(1)
-                            m.next = "DISCARD"
+                            m.next = "REGISTERS"
                         with m.Default():
                             bump("records_status")
                             m.next = "QUERY"
@@ -230,6 +230,10 @@ class Parser(wiring.Component):
                         bump("records_image")
                         m.d.sync += [index.eq(0), ended.eq(0)]
                         m.next = "HEAD"
+            with m.State("REGISTERS"):
+                m.d.comb += self.registers.valid.eq(1)
+                with m.If(self.registers.ready):
+                    m.next = "DISCARD"
             with m.State("QUERY"):
                 m.d.comb += [
                     self.queries.valid.eq(1),

@@ -30,8 +30,8 @@ class RegisterCrossing(wiring.Component):
 
     Members
     -------
-    sets : In(stream.Signature(Registers, always_ready=True))
-        Register sets of valid sequencer records (``sync``).
+    sets : In(stream.Signature(Registers))
+        Register sets of valid sequencer records (``sync``); always ready.
     superseded : Out(32)
         Sets replaced in the mailbox by a newer one before they left it (``sync``).
     at_rest : In(1)
@@ -47,7 +47,7 @@ class RegisterCrossing(wiring.Component):
     def __init__(self, power_up, *, depth=2):
         self._depth = depth
         super().__init__({
-            "sets": In(stream.Signature(Registers, always_ready=True)),
+            "sets": In(stream.Signature(Registers)),
             "superseded": Out(32),
             "at_rest": In(1),
             "regs": Out(Registers, init=power_up),
@@ -62,7 +62,7 @@ class RegisterCrossing(wiring.Component):
         # ---- sync: the mailbox, newest first ----
         pending = Signal(Registers)
         full = Signal()
-        m.d.comb += [crossing.w_data.eq(pending), crossing.w_en.eq(full)]
+        m.d.comb += [crossing.w_data.eq(pending), crossing.w_en.eq(full), self.sets.ready.eq(1)]
         with m.If(self.sets.valid):
             m.d.sync += [pending.eq(self.sets.payload), full.eq(1)]
             with m.If(full & ~crossing.w_rdy):

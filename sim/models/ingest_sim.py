@@ -104,6 +104,7 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
         while True:
             ready = not (tx_stall and trng.random() < tx_stall)
             ctx.set(dut.tx.ready, ready)
+            ctx.set(dut.registers.ready, 1)
             _, _, valid, beat, trigger, regs_valid, regs = await ctx.tick().sample(
                 dut.tx.valid, dut.tx.payload, dut.trigger, dut.registers.valid, dut.registers.payload)
             out["triggers"] += trigger
