@@ -5,7 +5,9 @@ in wire order. From a table come
 
 - the gateware's view of received bytes (:func:`layout`, :func:`view`) and the bytes it sends
   (:func:`to_bytes`), and
-- the host's encoder and decoder (:func:`pack`, :func:`unpack`), which need no Amaranth.
+- the host's encoder and decoder (:func:`pack`, :func:`unpack`), plain Python on ints (the
+  sequencer record's table and checks come from the gateware's register struct, so this module
+  imports Amaranth's data layouts).
 
 ``docs/protocol.md`` describes the meaning of each field; the widths live only here.
 
