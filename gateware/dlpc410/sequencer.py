@@ -89,9 +89,9 @@ class Sequencer(wiring.Component):
     regs : In(:class:`gateware.dlpc410.params.Registers`)
         Run-time parameters. Change them only while ``at_rest`` is high, with ``reload``.
     at_rest : Out(1)
-        No frame is playing and no load is under way: before the first frame, or (triggered,
-        not chained) every group loaded and waiting for a trigger. The only time ``regs`` may
-        change.
+        No frame is playing and no load is under way: before the first frame, or every group
+        loaded and waiting for a trigger (a chained run waits so only for its first trigger).
+        The only time ``regs`` may change.
     reload : In(1)
         One cycle, while ``at_rest``, in the cycle ``regs`` change: every group's first plane is
         loaded again under the new registers (the reset mode and plane order decide what that
@@ -488,8 +488,8 @@ class Sequencer(wiring.Component):
         # a newer frame than the one waiting: load its first plane instead (the loads wait for the
         # requester's first words); nothing is in flight, since every group is loaded
         # (or, with ``reload``, the same frame again under new registers)
-        newer = ~use_prng & self.frames.valid & frame_ok
-        resting = start_fsm.ongoing("RUN") & all_ready & ~regs.chain
+        newer = ~use_prng & ~regs.chain & self.frames.valid & frame_ok
+        resting = start_fsm.ongoing("RUN") & all_ready
         m.d.comb += [take_idle.eq(resting & (newer | self.reload)),
                      self.at_rest.eq(start_fsm.ongoing("WAIT") | resting)]
         with m.If(take_idle & newer):

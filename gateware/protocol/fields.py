@@ -148,7 +148,7 @@ SYSTEM_STATUS = [
     ("triggers", 32),          # triggers obeyed
     ("trigger_overruns", 32),  # triggers that came while a frame was still showing
     ("frames_shown", 32),
-    ("dlpc410_state", 16),     # bit 0 INIT_ACTIVE, bit 1 RST_ACTIVE, bit 2 calibrated, ...
+    ("dlpc410_state", 16),     # bits: 0 INIT_ACTIVE, 1 RST_ACTIVE, 2 ECP2_FINISHED, 3 DDR2 calibrated, 4-6 link
     ("triggers_early", 32),    # triggers before the DLPC410 finished initialising
     ("pulses_late", 32),       # clocking pulses made after their time
     ("row_underruns", 32),     # row loads that waited for the store

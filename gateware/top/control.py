@@ -3,7 +3,7 @@
 A sequencer record's register set must reach the sequencer whole, and only when the sequencer
 may take it: while it rests (:attr:`gateware.dlpc410.sequencer.Sequencer.at_rest`: before the
 first frame, or every group loaded and waiting for a trigger). Frames may play for a long time
-(a chained run never rests), so sets wait in a mailbox in ``sync`` where the newest replaces an
+(a chained run rests only when disarmed), so sets wait in a mailbox in ``sync`` where the newest replaces an
 older one not yet sent; from there they cross through a small :class:`amaranth.lib.fifo.AsyncFIFO`
 (every bit of a set crosses together) and the sequencer side takes the next one when it rests,
 telling the sequencer to load its first plane again under the new registers.
