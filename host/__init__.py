@@ -6,7 +6,7 @@ is generated from; the testbenches feed the gateware with this very encoder.
 
 from .client import Client, ClientError
 from .records import (ProtocolError, control_record, decode, image_records, rows_per_record,
-                      sequence_records, status_query)
+                      sequence_records, sequencer_record, status_query)
 
 __all__ = ["Client", "ClientError", "ProtocolError", "control_record", "decode", "image_records",
-           "rows_per_record", "sequence_records", "status_query"]
+           "rows_per_record", "sequence_records", "sequencer_record", "status_query"]

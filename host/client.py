@@ -96,6 +96,11 @@ class Client:
         """Set configuration fields (see ``docs/protocol.md``); others keep their values."""
         self._send(records.control_record(self._next(), software_trigger=software_trigger, **config))
 
+    def configure(self, plan, dmd):
+        """Send the register set of a :func:`gateware.dlpc410.schedule.plan` (checked as the
+        projector checks it); the sequencer takes it when no frame is playing."""
+        self._send(records.sequencer_record(plan.params.registers(dmd), self._next(), dmd=dmd))
+
     def status(self, retries=2):
         """Ask for a status reply and return its fields as a dict."""
         for _attempt in range(retries + 1):

@@ -6,7 +6,7 @@ from gateware.protocol import fields
 from gateware.protocol.fields import Action, RecordType
 
 __all__ = ["ProtocolError", "header", "image_records", "sequence_records", "rows_per_record",
-           "control_record", "status_query", "status_reply", "decode"]
+           "control_record", "sequencer_record", "status_query", "status_reply", "decode"]
 
 
 class ProtocolError(ValueError):
@@ -70,6 +70,25 @@ def control_record(sequence=0, *, software_trigger=False, **config):
     return header(RecordType.CONTROL, fields.size(fields.HEADER) + len(body), sequence) + body
 
 
+def sequencer_record(registers, sequence=0, *, dmd=None):
+    """A sequencer record carrying a whole register set: ``registers`` as
+    :meth:`gateware.dlpc410.schedule.Params.registers` gives it (from
+    :func:`gateware.dlpc410.schedule.plan`), or already as wire values (ints).
+
+    With ``dmd``, the set is first checked as the projector will check it
+    (:func:`gateware.protocol.fields.register_faults`); a set it would drop raises
+    :class:`ValueError` naming the failed checks."""
+    names = [name for name, _ in fields.SEQUENCER]
+    wire = registers if all(isinstance(registers.get(n), int) for n in names) \
+        else fields.register_wire(registers)
+    if dmd is not None:
+        failed = [check for check, bad in fields.register_faults(wire, dmd.dclk_per_row).items() if bad]
+        if failed:
+            raise ValueError(f"the sequencer cannot obey this register set: {', '.join(failed)}")
+    body = fields.pack(fields.SEQUENCER, wire)
+    return header(RecordType.SEQUENCER, fields.size(fields.HEADER) + len(body), sequence) + body
+
+
 def status_query(sequence=0):
     return header(RecordType.STATUS_QUERY, fields.size(fields.HEADER), sequence)
 
@@ -85,6 +104,7 @@ _BODIES = {
     RecordType.CONTROL: fields.CONTROL,
     RecordType.STATUS_QUERY: [],
     RecordType.STATUS_REPLY: fields.STATUS_REPLY,
+    RecordType.SEQUENCER: fields.SEQUENCER,
 }
 
 

@@ -25,11 +25,9 @@ from amaranth import Cat, ClockDomain, ClockSignal, Const, Instance, Module, Res
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from gateware.dlpc410.params import Registers
 from gateware.mac import gmii
 from gateware.store import mcb
 from gateware.top.system import Projector
-from sim.harness.layout import pack
 from sim.harness.paths import ROOT
 from sim.models.dlpc410 import timing_cycles
 from sim.models.dlpc410_replay import Replay
@@ -225,10 +223,9 @@ class FastSystem(wiring.Component):
         m = Module()
         dmd = self._dmd
         self._clocks_and_resets(m)
-        m.submodules.core = core = Projector(dmd, **self._addresses, sync_hz=self._clocks["sync"],
-                                             mdio_cycles=(40, 10))
-        # The sequencer's registers for the run (one place: the core's power-up registers later).
-        m.d.comb += core.regs.eq(pack(Registers, self._registers))
+        # The sequencer's registers for the run are the core's power-up registers.
+        m.submodules.core = core = Projector(dmd, **self._addresses, regs=self._registers,
+                                             sync_hz=self._clocks["sync"], mdio_cycles=(40, 10))
         m.d.comb += [core.trigger_in.eq(self.trigger_in), core.sync_in.eq(0), core.mdio_i.eq(1)]
 
         rx = Signal(gmii.RxPins)

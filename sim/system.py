@@ -14,13 +14,15 @@ import json
 import time
 from pathlib import Path
 
+from gateware.dlpc410 import schedule
 from gateware.dlpc410.facts import DMDS
+from gateware.dlpc410.params import PlaneOrder, ResetMode
 from gateware.top.system import Projector
 from sim import xga
 from sim.harness import cocotb_run
 from sim.harness.paths import build_dir
 
-__all__ = ["main", "run", "PARAMS", "XGA_FRAMES"]
+__all__ = ["main", "run", "plan", "power_up_plan", "PARAMS", "XGA_FRAMES"]
 
 MAC, IP, PORT = 0x02_00_00_00_00_01, 0x0A_00_00_02, 5000
 DMD_NS = 5.0
@@ -32,15 +34,33 @@ XGA_FRAMES = 3
 PARAMS = {"dmd": "test", "mac": "02:00:00:00:00:01", "ip": "10.0.0.2", "port": PORT,
           "memory_bytes": 4 * 2**20, "t_rst": 40, "t_settle": 60, "init_cycles": 200,
           "init_grace": 4, "mode": "GLOBAL", "order": "MSB_FIRST", "frames": 3, "seed": 1,
-          "settle_after_send": 3000}
+          "settle_after_send": 3000, "faults": True}
+
+
+def plan(p, **changes):
+    """The schedule a run configures through a sequencer record: ``p``'s DMD, scaled RST_ACTIVE
+    and settle times, reset mode and plane order (``changes``: other :func:`schedule.plan`
+    arguments)."""
+    kwargs = dict(t_rst_s=p["t_rst"] * DMD_NS * 1e-9, t_settle_s=p["t_settle"] * DMD_NS * 1e-9, depth=8,
+                  reset_mode=ResetMode[p["mode"]], order=PlaneOrder[p["order"]])
+    return schedule.plan(DMDS[p["dmd"]], 1e9 / DMD_NS, **{**kwargs, **changes})
+
+
+def power_up_plan(p):
+    """The registers the core is built with: planes three times as long as the run's, so that a
+    frame shown before the run's sequencer record is applied would not be the frame sent."""
+    return plan(p, exposure_s=3 * plan(p).params.lsb * DMD_NS * 1e-9)
 
 
 def run(key="test", **overrides):
     """Build and run the system testbench; returns its report (dict)."""
     report = build_dir("system") / f"{key}.json"
     p = {**PARAMS, **overrides, "report": str(report)}
-    build = cocotb_run.run(Projector(DMDS[p["dmd"]], mac=MAC, ip=IP, port=PORT, mdio_cycles=(40, 10)),
-                           toplevel="projector", module="sim.tb.system", key=key, params=p)
+    dmd = DMDS[p["dmd"]]
+    # built as the platform is: disarmed, the testbench configures and arms through records
+    core = Projector(dmd, mac=MAC, ip=IP, port=PORT, regs=power_up_plan(p).params.registers(dmd),
+                     armed=False, mdio_cycles=(40, 10))
+    build = cocotb_run.run(core, toplevel="projector", module="sim.tb.system", key=key, params=p)
     result = json.loads(report.read_text())
     result["build"] = str(build)
     return result

@@ -134,3 +134,34 @@ def test_python_m_host_status(projector):
                           cwd=root, timeout=60)
     assert done.returncode == 0, done.stderr
     assert "records_status" in done.stdout
+
+
+def test_cli_configure_says_the_rate_and_sends_the_plan(projector, capsys):
+    """``configure`` plans with the schedule model, prints the rate it reaches, then sends the
+    register set (checked and taken by the model as the projector takes it) and arms."""
+    from gateware.dlpc410 import schedule
+    plan = schedule.plan(TEST_DMD, 200e6, depth=6)
+    base = ["--address", "127.0.0.1", "--port", str(projector.port)]
+    assert cli.main(base + ["configure", "--dmd", "test", "--depth", "6", "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert f"{plan.rate_hz:.1f} frames/s ({plan.frame_cycles} DCLK cycles per frame)" in out
+    assert projector.received == []
+    assert cli.main(base + ["configure", "--dmd", "test", "--depth", "6"]) == 0
+    assert cli.main(base + ["arm"]) == 0
+    assert cli.main(base + ["status"]) == 0
+    model = projector.model
+    assert model.counters["records_sequencer"] == 1 and model.counters["drop_app_value"] == 0
+    assert model.registers == [fields.register_wire(plan.params.registers(TEST_DMD))]
+    assert model.config["bit_depth"] == 6 and model.config["armed"] == 1
+
+
+def test_sequencer_record_refuses_what_the_projector_would_drop():
+    from gateware.dlpc410 import schedule
+    wire = fields.register_wire(schedule.plan(TEST_DMD, 200e6).params.registers(TEST_DMD))
+    records.sequencer_record(wire, dmd=TEST_DMD)
+    with pytest.raises(ValueError, match="lsb_even_nonzero"):
+        records.sequencer_record({**wire, "lsb": 3}, dmd=TEST_DMD)
+    with pytest.raises(ValueError, match="order_known"):
+        records.sequencer_record({**wire, "order": 3}, dmd=TEST_DMD)
+    head, body, rest = records.decode(records.sequencer_record(wire, 9))
+    assert head["type"] == fields.RecordType.SEQUENCER and body == wire and rest == b""

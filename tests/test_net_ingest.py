@@ -12,7 +12,9 @@ from scapy.layers.inet import ICMP, IP, UDP
 from scapy.layers.l2 import ARP, Ether
 
 import host
+from gateware.dlpc410 import schedule
 from gateware.dlpc410.facts import TEST_DMD
+from gateware.dlpc410.params import PlaneOrder, ResetMode, TriggerMode
 from gateware.protocol import fields
 from host import records
 from sim.models import frames, ingest_sim
@@ -47,6 +49,28 @@ def _image_body(first_row=0, row_count=1, row_bytes=COLUMNS):
                                       "row_bytes": row_bytes}) + bytes(row_count * COLUMNS)
 
 
+#: A register set the sequencer can obey (a plan for the test DMD), as the record's wire values.
+PLAN = schedule.plan(TEST_DMD, 200e6, t_rst_s=200e-9, t_settle_s=300e-9, reset_mode=ResetMode.DUAL)
+GOOD_WIRE = fields.register_wire(PLAN.params.registers(TEST_DMD))
+
+
+def sequencer_record(sequence=0, **changes):
+    return records.sequencer_record({**GOOD_WIRE, **changes}, sequence)
+
+
+#: Sequencer records the sequencer could not obey: ``name -> changes to a good set``.
+BAD_REGISTERS = {
+    "lsb_odd": {"lsb": GOOD_WIRE["lsb"] + 1},
+    "lsb_zero": {"lsb": 0},
+    "order_unknown": {"order": 3},
+    "reset_mode_too_wide": {"reset_mode": 4},
+    "chain_not_a_bit": {"chain": 2},
+    "stagger_odd": {"stagger": 3},
+    "dark_gap_odd": {"dark_gap": GOOD_WIRE["dark_gap"] + 1},
+    "row_period_short": {"row_period": TEST_DMD.dclk_per_row - 1},
+    "periodic_without_period": {"trigger": TriggerMode.PERIODIC.value, "period": 0},
+}
+
 #: Malformed records: ``name -> (record bytes, counter)``.
 BAD_RECORDS = {
     "bad_magic": (_record(body=_image_body(), magic=0x1234), "drop_app_magic"),
@@ -61,6 +85,14 @@ BAD_RECORDS = {
                           "drop_app_rows"),
     "row_bytes_not_dmd": (_record(body=_image_body(row_bytes=COLUMNS * 2)), "drop_app_rows"),
     "bit_depth_out_of_range": (records.control_record(bit_depth=9, armed=1), "drop_app_value"),
+    "armed_not_a_bit": (records.control_record(armed=2), "drop_app_value"),
+    "sequence_length_zero": (records.control_record(sequence_length=0), "drop_app_value"),
+    "control_too_long": (records.control_record(armed=1) + b"\0", "drop_app_length"),
+    "sequencer_too_long": (sequencer_record() + b"\0", "drop_app_length"),
+    "sequencer_truncated": (_record(fields.RecordType.SEQUENCER, body=sequencer_record()[10:-1]),
+                            "drop_app_length"),
+    **{f"sequencer_{name}": (sequencer_record(**changes), "drop_app_value")
+       for name, changes in BAD_REGISTERS.items()},
 }
 
 PAYLOAD = records.image_records(IMAGE[:1], 1)[0]
@@ -106,6 +138,8 @@ def test_bad_frame_dropped_and_counted(case, one_by_one):
         assert net_delta["frames"] == net_delta["accepted"] == 1
     assert delta == expected
     assert after["pixel_count"] == before["pixel_count"], "pixels of a dropped frame leaked"
+    assert after["register_count"] == before["register_count"], "registers of a dropped record were handed on"
+    assert after["config"] == before["config"], "a dropped record changed the configuration"
     assert after["tx_count"] == before["tx_count"], "a dropped frame was answered"
     # The reference model names the same cause.
     model = Model(TEST_DMD, A.mac, A.ip, A.port)
@@ -126,9 +160,8 @@ def test_good_frames_around_bad_ones_arrive(one_by_one):
 def replies():
     """ARP, ICMP echo, a status query and control records, in one run."""
     new_ip, new_port = 0x0A_00_00_33, 6001
-    control = records.control_record(1, bit_depth=6, trigger_mode=fields.TriggerMode.SOFTWARE,
-                                      armed=1, frame_period_us=2500, exposure_us=2000,
-                                      sequence_start=3, sequence_length=5, software_trigger=True)
+    control = records.control_record(1, bit_depth=6, armed=1, sequence_length=5, software_trigger=True)
+    registers = [sequencer_record(5), sequencer_record(6, order=PlaneOrder.LSB_FIRST.value, chain=1)]
     readdress = records.control_record(2, ip=new_ip, port=new_port)
     moved = Addresses(ip=new_ip, port=new_port)
     status = {"uptime_cycles": 123456789, "clock_hz": 125_000_000, "triggers": 7,
@@ -143,6 +176,8 @@ def replies():
         (frames.udp(A, records.status_query(3)), False),         # old address: dropped
         (frames.udp(Addresses(ip=new_ip), records.status_query(4)), False),  # old port: dropped
         (frames.udp(moved, records.status_query(78)), False),
+        (frames.udp(moved, registers[0]), False),
+        (frames.udp(moved, registers[1]), False),
     ]
     out = ingest_sim.run(sequence, name="ingest_replies", settle_each=80, gap=(5, 5),
                          status=status)
@@ -176,11 +211,17 @@ def test_control_record_applied(replies):
     before, after = out["snapshots"][1], out["snapshots"][2]
     assert after["triggers"] - before["triggers"] == 1
     config = after["config"]
-    assert (config["bit_depth"], config["trigger_mode"], config["armed"]) == (6, 2, 1)
-    assert (config["frame_period_us"], config["exposure_us"]) == (2500, 2000)
-    assert (config["sequence_start"], config["sequence_length"]) == (3, 5)
+    assert (config["bit_depth"], config["armed"], config["sequence_length"]) == (6, 1, 5)
     assert config["mac"] == A.mac and config["ip"] == A.ip   # not selected: unchanged
     assert out["config"]["ip"] == 0x0A_00_00_33 and out["config"]["port"] == 6001
+
+
+def test_sequencer_records_handed_on_whole(replies):
+    """Each valid sequencer record leaves as one register set, every field as sent."""
+    out = replies[0]
+    second = {**GOOD_WIRE, "order": PlaneOrder.LSB_FIRST.value, "chain": 1}
+    assert out["registers"] == [fields.registers_bits(GOOD_WIRE), fields.registers_bits(second)]
+    assert out["app"]["records_sequencer"] == 2
 
 
 def test_status_query_answered(replies):
@@ -232,9 +273,13 @@ def test_randomized_mix_ledger(test_name):
             seq += 1
         elif roll < 0.69:
             control = records.control_record(seq, bit_depth=rng.randrange(0, 10),
-                                             exposure_us=rng.randrange(1 << 20),
-                                             software_trigger=rng.random() < 0.5)
+                                             sequence_length=rng.randrange(0, 3),
+                                             software_trigger=rng.random() < 0.7)
             raw, bad = frames.udp(A, control), False
+            seq += 1
+        elif roll < 0.74:
+            changes = rng.choice([{"lsb": 2 * rng.randrange(1, 1 << 20)}, rng.choice(list(BAD_REGISTERS.values()))])
+            raw, bad = frames.udp(A, sequencer_record(seq, **changes)), False
             seq += 1
         else:
             raw, bad, _ = rng.choice(bad_cases)
@@ -246,8 +291,8 @@ def test_randomized_mix_ledger(test_name):
     assert out["app"] == {name: model.counters[name] for name, _ in fields.APP_COUNTERS}
     assert out["rows"] == model.rows
     assert out["triggers"] == model.triggers > 0
-    assert {k: out["config"][k] for k in ("bit_depth", "exposure_us")} == \
-        {k: model.config[k] for k in ("bit_depth", "exposure_us")}
+    assert out["config"] == model.config
+    assert out["registers"] == [fields.registers_bits(wire) for wire in model.registers] and model.registers
     # Status replies and ARP/ICMP replies come from two sources that take turns: the kinds
     # match one for one, the order between the two sources may differ.
     sent = sorted("arp" if ARP in Ether(raw) else "icmp" if ICMP in Ether(raw) else "status"

@@ -24,5 +24,6 @@ def table_rows(table, start):
 def test_doc_tables_match_fields():
     header = fields.size(fields.HEADER)
     expected = (table_rows(fields.HEADER, 0) + table_rows(fields.IMAGE, header)
-                + table_rows(fields.CONTROL, header) + table_rows(fields.STATUS_REPLY, header))
+                + table_rows(fields.CONTROL, header) + table_rows(fields.SEQUENCER, header)
+                + table_rows(fields.STATUS_REPLY, header))
     assert doc_rows() == expected

@@ -1,4 +1,5 @@
-"""The projector's core end to end on its generated Verilog: GMII in, DLPC410 model out."""
+"""The projector's core end to end on its generated Verilog: configured, armed and fed over GMII,
+the DLPC410 model out, the status reply read back; faults interleaved (see ``sim/tb/system.py``)."""
 
 import pytest
 
@@ -9,7 +10,18 @@ from sim import system
 def test_system_small_geometry():
     report = system.run("test")
     frames = report["frames"]
-    assert len(frames) == system.PARAMS["frames"]
+    n = system.PARAMS["frames"]
+    # the scene streamed, then: a trigger burst (frame n), a new register set (frame n + 1), a
+    # frame with a lost record (never shown: frame n + 1 again), a whole frame after it
+    assert [f["index"] for f in frames] == [*range(n), n, n + 1, n + 1, n + 3]
     assert all(f["max_error_lsb"] == 0 for f in frames)
     # a trigger becomes a clocking pulse within a few cycles
     assert all(f["latency_cycles"] <= 8 for f in frames)
+    status = report["status"]      # the testbench checked every counter; the headline ones here
+    assert status["triggers"] == status["frames_shown"] == len(frames)
+    assert status["trigger_overruns"] == 3 and status["registers_applied"] == 2
+    assert status["store_frames_abandoned"] == 1
+    # bad frames interleaved with each of the scene's frames and the first fault frame
+    assert status["mac_bad_fcs"] == status["drop_udp_port"] == n + 1
+    assert status["drop_app_value"] == 4 * (n + 1) and status["drop_app_length"] == n + 1
+    assert status["records_sequencer"] == 2 and status["records_control"] == 2

@@ -91,7 +91,15 @@ class Sequencer(wiring.Component):
     pins : Out(:class:`gateware.dlpc410.interface.Signature`)
         The DLPC410 applications interface.
     regs : In(:class:`gateware.dlpc410.params.Registers`)
-        Run-time parameters (hold them steady while frames play).
+        Run-time parameters. Change them only while ``at_rest`` is high, with ``reload``.
+    at_rest : Out(1)
+        No frame is playing and no load is under way: before the first frame, or every group
+        loaded and waiting for a trigger (a chained run waits so only for its first trigger).
+        The only time ``regs`` may change.
+    reload : In(1)
+        One cycle, while ``at_rest``, in the cycle ``regs`` change: every group's first plane is
+        loaded again under the new registers (the reset mode and plane order decide what that
+        is), as for a newer frame offered while waiting; a trigger in that cycle is an overrun.
     trigger_in, sync_in : In(1)
         TTL trigger and sync inputs (asynchronous).
     soft_trigger : In(1)
@@ -127,6 +135,8 @@ class Sequencer(wiring.Component):
         super().__init__({
             "pins": Out(interface.Signature(dmd.buses)),
             "regs": In(Registers),
+            "at_rest": Out(1),
+            "reload": In(1),
             "trigger_in": In(1),
             "sync_in": In(1),
             "soft_trigger": In(1),
@@ -538,17 +548,24 @@ class Sequencer(wiring.Component):
         # a newer frame offered while no group plays: it replaces the preloaded first planes
         # (the loads wait for the store's first words); any stale load still in flight is
         # abandoned: the row cycle on the bus ends, nothing of it is pulsed (no trigger is obeyed
-        # before every group is loaded again), and the settle times of the last pulses still hold
-        m.d.comb += take_idle.eq(start_fsm.ongoing("RUN") & ~playing & ~regs.chain & ~use_prng
-                                 & self.frames.valid & frame_ok)
-        with m.If(take_idle):
+        # before every group is loaded again), and the settle times of the last pulses still hold.
+        # With ``reload`` at rest, the same frame is loaded again under new registers.
+        newer = ~use_prng & ~regs.chain & self.frames.valid & frame_ok
+        idle = start_fsm.ongoing("RUN") & ~playing
+        resting = start_fsm.ongoing("RUN") & all_ready
+        m.d.comb += [take_idle.eq((idle & newer) | (resting & self.reload)),
+                     self.at_rest.eq(start_fsm.ongoing("WAIT") | resting)]
+        with m.If(take_idle & newer):
             m.d.comb += self.frames.ready.eq(1)
+        with m.If(take_idle):
             wait = Mux(all_ready, 0, flush_cycles)
             lead = now + regs.reload_lead + wait
-            m.d.sync += [next_slot.eq(self.frames.payload.slot), next_depth.eq(self.frames.payload.bit_depth),
+            r_slot = Mux(newer, self.frames.payload.slot, next_slot)
+            r_depth = Mux(newer, self.frames.payload.bit_depth, next_depth)
+            m.d.sync += [next_slot.eq(r_slot), next_depth.eq(r_depth),
                          start_group.eq(0), flush_until.eq(now + wait), fresh.eq(1), finishing.eq(0)]
             for g in range(GMAX):
-                m.d.sync += [slot[g].eq(self.frames.payload.slot), depth[g].eq(self.frames.payload.bit_depth),
+                m.d.sync += [slot[g].eq(r_slot), depth[g].eq(r_depth),
                              loaded[g].eq(0), writable[g].eq(Mux(_diff(writable[g], lead) < 0, lead, writable[g]))]
         with m.If(trig.strobe):
             with m.If(~running):

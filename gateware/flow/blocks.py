@@ -58,6 +58,15 @@ def _seq(dmd="dlp7000"):
     return Sequencer(DMDS[dmd])
 
 
+def _seq_registers():
+    from gateware.dlpc410 import schedule
+    from gateware.top.control import RegisterCrossing
+    # The sequencer's register sets from the protocol (sync) into dmd, power-up value as the
+    # platform's.
+    dmd = DMDS["dlp7000"]
+    return RegisterCrossing(schedule.plan(dmd, 200e6).params.registers(dmd))
+
+
 BLOCKS = {
     "serialiser": _serialiser,
     "eth_rx": _eth_rx,
@@ -69,4 +78,5 @@ BLOCKS = {
     "store_reader": _store_reader,
     "seq": _seq,
     "seq_dlp9500": lambda: _seq("dlp9500"),
+    "seq_registers": _seq_registers,
 }

@@ -9,6 +9,7 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out, connect
 
 from ..bitplane import pixel_layout
+from ..dlpc410.params import Registers
 from ..mac.layouts import ByteBeat
 from ..protocol import fields
 from ..protocol.parser import CONFIG_LAYOUT, Parser, config_init
@@ -31,6 +32,8 @@ class Ingest(wiring.Component):
     dmd : :class:`gateware.dlpc410.facts.DmdType`
     mac, ip, port : int
         Addresses at reset (build parameters); a control record may change them.
+    armed : bool
+        Whether triggers reach the sequencer at reset; a control record may change it.
     frame_bits : int
         Width of the frame tag on ``pixels``.
     buffer_depth : int
@@ -48,15 +51,17 @@ class Ingest(wiring.Component):
         Run-time configuration for the sequencer and store (reset value: the build parameters).
     trigger : Out(1)
         Software trigger pulse.
+    registers : Out(stream.Signature(Registers))
+        The sequencer's register set of each valid sequencer record.
     status : In(Status)
         Figures from the rest of the system, reported in status replies.
     net_counters : Out(fields.layout(fields.NET_COUNTERS))
     app_counters : Out(fields.layout(fields.APP_COUNTERS))
     """
 
-    def __init__(self, dmd, *, mac, ip, port, frame_bits=4, buffer_depth=16384):
+    def __init__(self, dmd, *, mac, ip, port, armed=False, frame_bits=4, buffer_depth=16384):
         self._dmd = dmd
-        self._config = config_init(mac=mac, ip=ip, port=port)
+        self._config = config_init(mac=mac, ip=ip, port=port, armed=armed)
         self._frame_bits = frame_bits
         self._depth = buffer_depth
         super().__init__({
@@ -65,6 +70,7 @@ class Ingest(wiring.Component):
             "pixels": Out(stream.Signature(pixel_layout(dmd, 1, frame_bits))),
             "settings": Out(Config, init=self._config),
             "trigger": Out(1),
+            "registers": Out(stream.Signature(Registers)),
             "status": In(Status),
             "net_counters": Out(fields.layout(fields.NET_COUNTERS)),
             "app_counters": Out(fields.layout(fields.APP_COUNTERS)),
@@ -81,6 +87,7 @@ class Ingest(wiring.Component):
         connect(m, stack.datagrams, parser.datagrams)
         connect(m, parser.pixels, wiring.flipped(self.pixels))
         connect(m, parser.queries, reply.queries)
+        connect(m, parser.registers, wiring.flipped(self.registers))
         connect(m, reply.request, stack.reply_request)
         connect(m, reply.body, stack.reply_body)
         m.d.comb += [

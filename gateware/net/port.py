@@ -11,6 +11,7 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out, connect
 
 from ..bitplane import pixel_layout
+from ..dlpc410.params import Registers
 from ..mac import gmii
 from ..mac.gmii_rx import counters_layout
 from ..mac.path import ReceivePath, TransmitPath
@@ -28,6 +29,8 @@ class EthernetPort(wiring.Component):
     dmd : :class:`gateware.dlpc410.facts.DmdType`
     mac, ip, port : int
         Addresses at reset (build parameters); a control record may change them.
+    armed : bool
+        Whether triggers reach the sequencer at reset; a control record may change it.
     frame_bits : int
         Width of the frame tag on ``pixels``.
     max_frame : int
@@ -54,6 +57,8 @@ class EthernetPort(wiring.Component):
         Run-time configuration (reset value: the build parameters), in ``sync``.
     trigger : Out(1)
         Software trigger pulse, in ``sync``.
+    registers : Out(stream.Signature(Registers))
+        The sequencer's register set of each valid sequencer record, in ``sync``.
     status : In(:data:`.ingest.Status`)
         Figures from the rest of the system, reported in status replies, in ``sync``.
     mac_counters : Out(:func:`gateware.mac.gmii_rx.counters_layout`)
@@ -70,11 +75,11 @@ class EthernetPort(wiring.Component):
         Application counters: records per type, drops per cause, rows, payload bytes.
     """
 
-    def __init__(self, dmd, *, mac, ip, port, frame_bits=4, max_frame=gmii.MAX_JUMBO_FRAME_BYTES,
+    def __init__(self, dmd, *, mac, ip, port, armed=False, frame_bits=4, max_frame=gmii.MAX_JUMBO_FRAME_BYTES,
                  rx_depth=16384, tx_depth=2048, buffer_depth=16384):
         self._rx = ReceivePath(max_frame=max_frame, depth=rx_depth)
         self._tx = TransmitPath(depth=tx_depth)
-        self._ingest = Ingest(dmd, mac=mac, ip=ip, port=port, frame_bits=frame_bits,
+        self._ingest = Ingest(dmd, mac=mac, ip=ip, port=port, armed=armed, frame_bits=frame_bits,
                               buffer_depth=buffer_depth)
         super().__init__({
             "gmii_rx": In(gmii.RxPins),
@@ -82,6 +87,7 @@ class EthernetPort(wiring.Component):
             "pixels": Out(stream.Signature(pixel_layout(dmd, 1, frame_bits))),
             "settings": Out(Config, init=self._ingest.signature.members["settings"].init),
             "trigger": Out(1),
+            "registers": Out(stream.Signature(Registers)),
             "status": In(Status),
             "mac_counters": Out(counters_layout(32)),
             "rx_dropped": Out(32),
@@ -104,6 +110,7 @@ class EthernetPort(wiring.Component):
         # -- Stack and application protocol (sync) ------------------------------------------------
         connect(m, rx.frames, ingest.rx)
         connect(m, ingest.pixels, wiring.flipped(self.pixels))
+        connect(m, ingest.registers, wiring.flipped(self.registers))
         m.d.comb += [
             self.settings.eq(ingest.settings),
             self.trigger.eq(ingest.trigger),

@@ -3,17 +3,19 @@
 One UDP datagram carries one record (see ``docs/protocol.md``). The parser collects the common
 header and the type's own header, checks them all against each other, against the datagram's
 length and against the DMD geometry, and only then acts: an image record's rows go to the
-bit-plane serialiser, a control record updates :attr:`Parser.settings`, a status query asks
+bit-plane serialiser, a control record updates :attr:`Parser.settings`, a sequencer record's
+register set leaves whole on :attr:`Parser.registers`, a status query asks
 :class:`~gateware.protocol.status.StatusReply` for an answer. A record that fails a check is
 consumed and counted under its cause and has no other effect.
 """
 
-from amaranth import Module, Signal
+from amaranth import Cat, Module, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2, exact_log2
 
 from ..bitplane import pixel_layout
+from ..dlpc410.params import Registers
 from ..net.layouts import OFFSET_BITS, Datagram, Peer
 from . import fields
 from .fields import RecordType
@@ -24,7 +26,8 @@ CONFIG_LAYOUT = fields.layout(fields.CONFIG)
 _HEADER = fields.size(fields.HEADER)
 _IMAGE_END = _HEADER + fields.size(fields.IMAGE)
 _CONTROL_END = _HEADER + fields.size(fields.CONTROL)
-_CAPTURED = max(_IMAGE_END, _CONTROL_END)
+_SEQUENCER_END = _HEADER + fields.size(fields.SEQUENCER)
+_CAPTURED = max(_IMAGE_END, _CONTROL_END, _SEQUENCER_END)
 
 
 class Query(data.Struct):
@@ -33,11 +36,10 @@ class Query(data.Struct):
     sequence: 32
 
 
-def config_init(*, mac, ip, port, bit_depth=8):
+def config_init(*, mac, ip, port, bit_depth=8, armed=False):
     """The configuration the gateware starts with (build parameters)."""
-    return {"bit_depth": bit_depth, "trigger_mode": fields.TriggerMode.EXTERNAL, "armed": 0,
-            "frame_period_us": 10_000, "exposure_us": 10_000, "sequence_start": 0,
-            "sequence_length": 1, "mac": mac, "ip": ip, "port": port}
+    return {"bit_depth": bit_depth, "armed": int(armed), "sequence_length": 1,
+            "mac": mac, "ip": ip, "port": port}
 
 
 class Parser(wiring.Component):
@@ -60,6 +62,9 @@ class Parser(wiring.Component):
         The rows of valid image records, one 8-bit pixel per transfer, left to right.
     settings : Out(fields.layout(fields.CONFIG))
         The configuration registers; control records update the fields they select.
+    registers : Out(stream.Signature(Registers))
+        The register set of each valid sequencer record, one transfer per record (the parser
+        waits for it to be taken).
     trigger : Out(1)
         One-cycle pulse for a control record with the software-trigger action.
     queries : Out(stream.Signature(Query))
@@ -76,6 +81,7 @@ class Parser(wiring.Component):
             "pixels": Out(stream.Signature(pixel_layout(dmd, 1, frame_bits))),
             "settings": Out(CONFIG_LAYOUT, init=config),
             "trigger": Out(1),
+            "registers": Out(stream.Signature(Registers)),
             "queries": Out(stream.Signature(Query)),
             "counters": Out(fields.layout(fields.APP_COUNTERS)),
         })
@@ -97,6 +103,8 @@ class Parser(wiring.Component):
         header = part(fields.HEADER, 0)
         image = part(fields.IMAGE, _HEADER)
         control = part(fields.CONTROL, _HEADER)
+        sequencer = part(fields.SEQUENCER, _HEADER)
+        m.d.comb += self.registers.payload.eq(fields.wire_registers(sequencer))
         peer = Signal(Peer)
         length = Signal(OFFSET_BITS)
 
@@ -120,6 +128,8 @@ class Parser(wiring.Component):
                              expected.eq(_IMAGE_END + (image.row_count << exact_log2(dmd.columns)))]
             with m.Case(RecordType.CONTROL):
                 m.d.comb += [needed.eq(_CONTROL_END), expected.eq(_CONTROL_END)]
+            with m.Case(RecordType.SEQUENCER):
+                m.d.comb += [needed.eq(_SEQUENCER_END), expected.eq(_SEQUENCER_END)]
             with m.Default():
                 m.d.comb += [needed.eq(_HEADER), expected.eq(_HEADER)]
 
@@ -134,7 +144,7 @@ class Parser(wiring.Component):
         with m.Elif(header.version != fields.VERSION):
             m.d.comb += cause.eq(1 + causes.index("version"))
         with m.Elif((header.type != RecordType.IMAGE) & (header.type != RecordType.CONTROL)
-                    & (header.type != RecordType.STATUS_QUERY)):
+                    & (header.type != RecordType.STATUS_QUERY) & (header.type != RecordType.SEQUENCER)):
             m.d.comb += cause.eq(1 + causes.index("type"))
         with m.Elif(header.length == 0):
             m.d.comb += cause.eq(1 + causes.index("empty"))
@@ -149,9 +159,11 @@ class Parser(wiring.Component):
             m.d.comb += cause.eq(1 + causes.index("rows"))
         with m.Elif((header.type == RecordType.CONTROL)
                     & ((applies("bit_depth") & ((control.bit_depth == 0) | (control.bit_depth > 8)))
-                       | (applies("trigger_mode") & (control.trigger_mode > max(fields.TriggerMode)))
                        | (applies("armed") & (control.armed > 1))
                        | (applies("sequence_length") & (control.sequence_length == 0)))):
+            m.d.comb += cause.eq(1 + causes.index("value"))
+        with m.Elif((header.type == RecordType.SEQUENCER)
+                    & Cat(fields.register_faults(sequencer, dmd.dclk_per_row).values()).any()):
             m.d.comb += cause.eq(1 + causes.index("value"))
 
         sequence_seen = Signal()
@@ -192,6 +204,9 @@ class Parser(wiring.Component):
                             m.d.sync += self.trigger.eq(
                                 (control.action & fields.Action.SOFTWARE_TRIGGER) != 0)
                             m.next = "DISCARD"
+                        with m.Case(RecordType.SEQUENCER):
+                            bump("records_sequencer")
+                            m.next = "REGISTERS"
                         with m.Default():
                             bump("records_status")
                             m.next = "QUERY"
@@ -215,6 +230,10 @@ class Parser(wiring.Component):
                         bump("records_image")
                         m.d.sync += [index.eq(0), ended.eq(0)]
                         m.next = "HEAD"
+            with m.State("REGISTERS"):
+                m.d.comb += self.registers.valid.eq(1)
+                with m.If(self.registers.ready):
+                    m.next = "DISCARD"
             with m.State("QUERY"):
                 m.d.comb += [
                     self.queries.valid.eq(1),

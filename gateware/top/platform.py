@@ -59,7 +59,12 @@ class PlatformTop(Elaboratable):
         m.submodules.trigger = trigger = TriggerPins()
 
         # ---- The core ------------------------------------------------------------------------
-        m.submodules.core = core = Projector(dmd, sync_hz=clocks.frequencies()["sync"], **ADDRESSES)
+        # Power-up sequencer registers: the shortest legal 8-bit global schedule at the facts'
+        # timing; the host replaces them with sequencer records, and arms the triggers.
+        plan = schedule.plan(dmd, clocks.frequencies()["dmd"], depth=8)
+        m.submodules.core = core = Projector(dmd, sync_hz=clocks.frequencies()["sync"],
+                                             regs=Registers.const(plan.params.registers(dmd)),
+                                             armed=False, **ADDRESSES)
         m.d.comb += [core.gmii_rx.eq(gmii.rx), gmii.tx.eq(core.gmii_tx)]
         m.d.comb += [
             gmii.phy_reset_n.eq(core.phy_reset_n), gmii.mdc.eq(core.mdc),
@@ -71,11 +76,6 @@ class PlatformTop(Elaboratable):
             trigger.sync.eq(core.sync_out),
             trigger.camera.eq(core.camera_out),
         ]
-        # Power-up sequencer parameters: the shortest legal 8-bit global schedule at the facts'
-        # timing. (Setting them at run time from the host is still to come.)
-        plan = schedule.plan(dmd, clocks.frequencies()["dmd"], depth=8)
-        m.d.comb += core.regs.eq(Registers.const(plan.params.registers(dmd)))
-
         # ---- DDR2 through the memory controller ----------------------------------------------
         m.submodules.mcb = mcb = McbInstance(port0_domain="sync", port1_domain="dmd")
         wiring.connect(m, core.mcb_write, mcb.port0)

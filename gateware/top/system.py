@@ -6,7 +6,8 @@ Layers, as data flows through them (one banner each below):
   FIFOs into ``sync``, the network stack and the application protocol;
 * bit-plane serialiser and the store's writer (``sync``), DDR2 through MCB port 0;
 * the store's slots and plane reader (``dmd``), MCB port 1;
-* the frame broker and the DLPC410 sequencer (``dmd``);
+* the frame broker and the DLPC410 sequencer (``dmd``), its register sets crossing from the
+  protocol (:class:`.control.RegisterCrossing`) and the arming of its triggers;
 * status: counters of every domain carried into ``sync`` for the status reply.
 
 The top that instantiates this defines the four clock domains and connects the MCB ports to the
@@ -20,7 +21,7 @@ from amaranth.lib.wiring import In, Out
 
 from gateware.bitplane import Serialiser
 from gateware.dlpc410 import interface
-from gateware.dlpc410.params import Registers
+from gateware.dlpc410.params import TriggerMode
 from gateware.dlpc410.sequencer import Sequencer
 from gateware.mac import gmii
 from gateware.mac.cdc import CountSynchronizer
@@ -30,6 +31,7 @@ from gateware.store import mcb
 from gateware.store.store import Store
 
 from .broker import FrameBroker
+from .control import RegisterCrossing
 
 __all__ = ["Projector"]
 
@@ -44,6 +46,11 @@ class Projector(wiring.Component):
     dmd : DmdType
     mac, ip, port : int
         Network addresses at reset.
+    regs : dict or :class:`amaranth.lib.data.Const` of :class:`gateware.dlpc410.params.Registers`
+        The sequencer's registers at reset (for example a :func:`gateware.dlpc410.schedule.plan`'s
+        ``params.registers(dmd)``); sequencer records replace them at run time.
+    armed : bool
+        Whether triggers reach the sequencer at reset; control records arm and disarm.
     sync_hz : float
         ``sync`` frequency (status replies report it; the PHY management derives MDC from it).
     slots : int
@@ -69,13 +76,13 @@ class Projector(wiring.Component):
         TTL trigger and sync inputs (asynchronous).
     sync_out, camera_out : Out(1)
         Frame shown; camera trigger (``dmd``).
-    regs : In(Registers)
-        The sequencer's run-time parameters (``dmd``; held steady while frames play).
     """
 
-    def __init__(self, dmd, *, mac, ip, port, sync_hz=125e6, slots=4, mdio_cycles=None):
+    def __init__(self, dmd, *, mac, ip, port, regs, armed=True, sync_hz=125e6, slots=4, mdio_cycles=None):
         self._dmd = dmd
         self._addresses = dict(mac=mac, ip=ip, port=port)
+        self._regs = regs
+        self._armed = armed
         self._sync_hz = sync_hz
         self._slots = slots
         self._mdio_cycles = mdio_cycles or (None, None)
@@ -94,7 +101,6 @@ class Projector(wiring.Component):
             "sync_in": In(1),
             "sync_out": Out(1),
             "camera_out": Out(1),
-            "regs": In(Registers),
         })
 
     def elaborate(self, platform):
@@ -102,7 +108,8 @@ class Projector(wiring.Component):
         dmd = self._dmd
 
         # ---- Ethernet: GMII MAC, stack and application protocol (gmii_rx / gmii_tx -> sync) ------
-        m.submodules.ethernet = ethernet = EthernetPort(dmd, frame_bits=FRAME_BITS, **self._addresses)
+        m.submodules.ethernet = ethernet = EthernetPort(dmd, frame_bits=FRAME_BITS, armed=self._armed,
+                                                        **self._addresses)
         m.d.comb += [ethernet.gmii_rx.eq(self.gmii_rx), self.gmii_tx.eq(ethernet.gmii_tx)]
 
         m.submodules.phy = phy = StatusPoller(self._sync_hz, reset_cycles=self._mdio_cycles[0],
@@ -142,28 +149,62 @@ class Projector(wiring.Component):
         wiring.connect(m, seq.release, store.release)
         wiring.connect(m, seq.pins, wiring.flipped(self.dlpc))
         m.d.comb += [
-            seq.regs.eq(self.regs),
             seq.trigger_in.eq(self.trigger_in),
             seq.sync_in.eq(self.sync_in),
             self.sync_out.eq(seq.sync_out),
             self.camera_out.eq(seq.camera_out),
         ]
         m.submodules.soft_trigger = soft = PulseSynchronizer(i_domain="sync", o_domain="dmd")
-        m.d.comb += [soft.i.eq(ethernet.trigger), seq.soft_trigger.eq(soft.o)]
+
+        # ---- The sequencer's registers and arming (sync -> dmd) -------------------------------
+        m.submodules.registers = registers = RegisterCrossing(self._regs)
+        wiring.connect(m, ethernet.registers, registers.sets)
+        m.d.comb += [registers.at_rest.eq(seq.at_rest), seq.reload.eq(registers.reload)]
+        # Disarmed, no trigger source reaches the sequencer: the trigger mode reads as software
+        # and the software trigger is held low (a trigger pin edge then does nothing either);
+        # and frames are not chained, so a chained run ends with the frame that is playing and
+        # the sequencer comes to rest (where waiting register sets apply).
+        armed = Signal(init=self._armed)
+        m.submodules.armed_cdc = FFSynchronizer(ethernet.settings.armed[0], armed, o_domain="dmd",
+                                                init=self._armed)
+        m.d.comb += [
+            seq.regs.eq(registers.regs),
+            seq.regs.trigger.eq(Mux(armed, registers.regs.trigger, TriggerMode.SOFTWARE)),
+            seq.regs.chain.eq(registers.regs.chain & armed),
+            soft.i.eq(ethernet.trigger),
+            seq.soft_trigger.eq(soft.o & armed),
+        ]
 
         # ---- Status: what the status reply reports, carried into sync ---------------------------
         uptime = Signal(48)
         m.d.sync += uptime.eq(uptime + 1)
         m.d.comb += [ethernet.status.uptime_cycles.eq(uptime), ethernet.status.clock_hz.eq(int(self._sync_hz))]
+        status = ethernet.status
         for name, source in (("triggers", seq.status.triggers), ("trigger_overruns", seq.status.overruns),
-                             ("frames_shown", seq.status.frames)):
+                             ("frames_shown", seq.status.frames), ("triggers_early", seq.status.early),
+                             ("pulses_late", seq.status.late), ("row_underruns", seq.status.underruns),
+                             ("frames_bad_depth", seq.status.bad_frames),
+                             ("registers_applied", registers.applied)):
             sync = m.submodules[f"{name}_cdc"] = CountSynchronizer(len(source), i_domain="dmd", o_domain="sync")
-            m.d.comb += [sync.i.eq(source), getattr(ethernet.status, name).eq(sync.o)]
+            m.d.comb += [sync.i.eq(source), status[name].eq(sync.o)]
+        m.d.comb += status.registers_superseded.eq(registers.superseded)
+        for verdict, _ in ethernet.mac_counters.shape():
+            m.d.comb += status[f"mac_{verdict}"].eq(ethernet.mac_counters[verdict])
+        store_counts = store.counters
+        m.d.comb += [
+            status.mac_rx_dropped.eq(ethernet.rx_dropped),
+            status.mac_tx_underruns.eq(ethernet.tx_underruns),
+            status.store_frames_complete.eq(store_counts.frames_complete),
+            status.store_frames_replaced.eq(store_counts.frames_replaced),
+            status.store_frames_abandoned.eq(store_counts.frames_abandoned),
+            status.store_rows_refused.eq(sum(store_counts[name] for name in (
+                "rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot"))),
+        ]
         # dlpc410_state: bit 0 INIT_ACTIVE, 1 RST_ACTIVE, 2 ECP2_FINISHED, 3 DDR2 calibrated,
         # 4 Ethernet link up, 5-6 link speed (2 = 1000 Mb/s)
         state = Signal(4)
         m.submodules.state_cdc = FFSynchronizer(
             Cat(self.dlpc.init_active, self.dlpc.rst_active, self.dlpc.ecp2_finished, self.mcb_read.calib_done),
             state)
-        m.d.comb += ethernet.status.dlpc410_state.eq(Cat(state, phy.status.up, phy.status.speed))
+        m.d.comb += status.dlpc410_state.eq(Cat(state, phy.status.up, phy.status.speed))
         return m

@@ -1,7 +1,7 @@
 """Running the ingest block (:class:`gateware.net.ingest.Ingest`) in the Amaranth simulator.
 
 Frames go in as MAC byte beats with chosen gaps; everything that comes out is collected: image
-rows, transmitted frames, trigger pulses, the counters and the configuration at the end. Shared
+rows, transmitted frames, trigger pulses, sequencer register sets, the counters and the configuration at the end. Shared
 by the unit tests and the benchmark.
 """
 
@@ -49,7 +49,7 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
     a = addresses or Addresses()
     dut = Ingest(dmd, mac=a.mac, ip=a.ip, port=a.port, buffer_depth=buffer_depth)
     rng = random.Random(seed)
-    out = {"pixels": [], "tx": [], "triggers": 0, "cycle": 0, "activity": 0, "last_in": [],
+    out = {"pixels": [], "tx": [], "triggers": 0, "registers": [], "cycle": 0, "activity": 0, "last_in": [],
            "first_pixel": [], "snapshots": [], "rx_stalls": 0}
 
     async def clock(ctx):
@@ -84,7 +84,7 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
                 "app": plain(ctx.get(dut.app_counters), fields.APP_COUNTERS),
                 "config": plain(ctx.get(dut.settings), fields.CONFIG),
                 "pixel_count": len(out["pixels"]), "tx_count": len(out["tx"]),
-                "triggers": out["triggers"]}
+                "triggers": out["triggers"], "register_count": len(out["registers"])}
 
     async def pixels(ctx):
         prng = random.Random(seed + 1)
@@ -104,8 +104,12 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
         while True:
             ready = not (tx_stall and trng.random() < tx_stall)
             ctx.set(dut.tx.ready, ready)
-            _, _, valid, beat, trigger = await ctx.tick().sample(dut.tx.valid, dut.tx.payload, dut.trigger)
+            ctx.set(dut.registers.ready, 1)
+            _, _, valid, beat, trigger, regs_valid, regs = await ctx.tick().sample(
+                dut.tx.valid, dut.tx.payload, dut.trigger, dut.registers.valid, dut.registers.payload)
             out["triggers"] += trigger
+            if regs_valid:
+                out["registers"].append(regs.as_value().value)
             if valid and ready:
                 current.append(beat.data)
                 out["activity"] = out["cycle"]

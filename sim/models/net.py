@@ -39,6 +39,7 @@ class Model:
     replies: list = field(default_factory=list)     # ("arp"|"icmp"|"status", details)
     config: dict = field(default_factory=dict)
     triggers: int = 0
+    registers: list = field(default_factory=list)   # sequencer register sets passed on (wire dicts)
     _sequence: int | None = None
 
     def __post_init__(self):
@@ -136,18 +137,20 @@ class Model:
         header_size = fields.size(fields.HEADER)
         image_end = header_size + fields.size(fields.IMAGE)
         control_end = header_size + fields.size(fields.CONTROL)
-        padded = data + bytes(max(0, max(image_end, control_end) - len(data)))
+        sequencer_end = header_size + fields.size(fields.SEQUENCER)
+        padded = data + bytes(max(0, max(image_end, control_end, sequencer_end) - len(data)))
         head = fields.unpack(fields.HEADER, padded)
         image = fields.unpack(fields.IMAGE, padded[header_size:])
         kind = head["type"]
-        needed = {RecordType.IMAGE: image_end, RecordType.CONTROL: control_end}.get(kind, header_size)
+        needed = {RecordType.IMAGE: image_end, RecordType.CONTROL: control_end,
+                  RecordType.SEQUENCER: sequencer_end}.get(kind, header_size)
         expected = fields.image_record_length(image["row_count"], self.dmd.columns) \
             if kind == RecordType.IMAGE else needed
         if head["magic"] != fields.MAGIC:
             return "drop_app_magic"
         if head["version"] != fields.VERSION:
             return "drop_app_version"
-        if kind not in (RecordType.IMAGE, RecordType.CONTROL, RecordType.STATUS_QUERY):
+        if kind not in (RecordType.IMAGE, RecordType.CONTROL, RecordType.STATUS_QUERY, RecordType.SEQUENCER):
             return "drop_app_type"
         if head["length"] == 0:
             return "drop_app_empty"
@@ -167,9 +170,12 @@ class Model:
             def applies(name):
                 return control["apply"] >> names.index(name) & 1
             if ((applies("bit_depth") and not 1 <= control["bit_depth"] <= 8)
-                    or (applies("trigger_mode") and control["trigger_mode"] > max(fields.TriggerMode))
                     or (applies("armed") and control["armed"] > 1)
                     or (applies("sequence_length") and control["sequence_length"] == 0)):
+                return "drop_app_value"
+        if kind == RecordType.SEQUENCER:
+            wire = fields.unpack(fields.SEQUENCER, data[header_size:])
+            if any(fields.register_faults(wire, self.dmd.dclk_per_row).values()):
                 return "drop_app_value"
         if self._sequence is not None and head["sequence"] != (self._sequence + 1) & 0xFFFFFFFF:
             self.count("sequence_gaps")
@@ -193,6 +199,10 @@ class Model:
             self.triggers += control["action"] & 1
             self.count("records_control")
             return "control"
+        if kind == RecordType.SEQUENCER:
+            self.registers.append(wire)
+            self.count("records_sequencer")
+            return "sequencer"
         self.count("records_status")
         self.replies.append(("status", {**(peer or {}), "sequence": head["sequence"]}))
         return "status"

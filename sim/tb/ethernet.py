@@ -66,6 +66,7 @@ class Bench:
         await Timer(400, unit="ps")
         cocotb.start_soon(Clock(dut.clk, sync_ps, unit="ps").start())
         dut.status.value = pack(fields.layout(fields.SYSTEM_STATUS), {"clock_hz": CLOCK_HZ})
+        dut.registers__ready.value = 1
         for rst in (dut.rst, dut.gmii_rx_rst, dut.gmii_tx_rst):
             rst.value = 1
         await ClockCycles(dut.clk, 4)

@@ -40,6 +40,7 @@ class EthernetPins(wiring.Component):
             m.d.comb += (inner.eq(getattr(self, name)) if pins == "gmii_rx"
                          else getattr(self, name).eq(inner))
         wiring.connect(m, port.pixels, wiring.flipped(self.pixels))
+        wiring.connect(m, port.registers, wiring.flipped(self.registers))
         for name in ("settings", "trigger", "mac_counters", "rx_dropped", "tx_underruns",
                      "net_counters", "app_counters"):
             m.d.comb += getattr(self, name).eq(getattr(port, name))

@@ -14,7 +14,9 @@ from scapy.layers.inet import ICMP, IP, UDP
 from scapy.layers.l2 import ARP, Ether
 
 from gateware.bitplane import pixel_layout
+from gateware.dlpc410 import schedule
 from gateware.dlpc410.facts import DMDS
+from gateware.dlpc410.params import PlaneOrder
 from gateware.mac.layouts import ByteBeat
 from gateware.protocol import fields
 from host import records
@@ -32,6 +34,7 @@ async def reset(dut):
     cocotb.start_soon(Clock(dut.clk, 8, unit="ns").start())
     dut.rst.value = 1
     dut.status.value = 0
+    dut.registers__ready.value = 1
     await ClockCycles(dut.clk, 3)
     dut.rst.value = 0
 
@@ -56,6 +59,35 @@ class TxCollector:
                 if beat["last"]:
                     self.frames.append(bytes(self._current))
                     self._current = bytearray()
+
+
+class RegisterCollector:
+    """Every register set the block hands on (its consumer is always ready)."""
+
+    def __init__(self, dut):
+        self.dut, self.sets = dut, []
+        cocotb.start_soon(self._run())
+
+    async def _run(self):
+        while True:
+            await RisingEdge(self.dut.clk)
+            if self.dut.registers__valid.value:
+                self.sets.append(self.dut.registers__payload.value.to_unsigned())
+
+
+def control_traffic(dmd):
+    """Control and sequencer records, good and bad (values the projector cannot obey)."""
+    wire = fields.register_wire(schedule.plan(dmd, 200e6, depth=6).params.registers(dmd))
+    return [
+        records.control_record(50, bit_depth=6, armed=1, software_trigger=True),
+        records.control_record(51, armed=3),
+        records.sequencer_record(wire, 52),
+        records.sequencer_record({**wire, "lsb": wire["lsb"] | 1}, 53),
+        records.sequencer_record({**wire, "order": 3}, 54),
+        records.sequencer_record({**wire, "row_period": 0}, 55),
+        records.sequencer_record({**wire, "order": PlaneOrder.LSB_FIRST.value}, 56),
+        records.sequencer_record(wire, 57)[:-2],
+    ]
 
 
 def counters(dut):
@@ -112,7 +144,7 @@ async def mixed_traffic(dut):
     bad = [builder(A, good[0][42:]) for builder, _ in frames.BAD_FRAMES.values()]
     traffic = [(raw, False) for raw in good]
     for raw in bad + [frames.arp_request(A), frames.icmp_echo(A, b"abc" * 9),
-                      frames.udp(A, records.status_query(1000))]:
+                      frames.udp(A, records.status_query(1000))] + [frames.udp(A, r) for r in control_traffic(dmd)]:
         traffic.insert(rng.randrange(len(traffic) + 1), (raw, False))
     traffic.insert(rng.randrange(len(traffic)), (good[3], True))
     for raw, flag in traffic:
@@ -121,6 +153,7 @@ async def mixed_traffic(dut):
     source = StreamSource(dut, "rx", ByteBeat, dut.clk, idle=0.05, seed=1)
     pixels = StreamSink(dut, "pixels", pixel_layout(dmd), dut.clk, stall=0.2, seed=2)
     tx = TxCollector(dut, stall=0.2, seed=3)
+    registers = RegisterCollector(dut)
     feeder = cocotb.start_soon(feed(source, dut, traffic, rng, (0, 40)))
     got = await with_timeout(pixels.receive(len(model.rows) * dmd.columns), 20, "ms")
     await feeder
@@ -131,6 +164,9 @@ async def mixed_traffic(dut):
     assert net == {k: model.counters[k] for k, _ in fields.NET_COUNTERS}
     assert app == {k: model.counters[k] for k, _ in fields.APP_COUNTERS}
     check_replies(tx.frames, model)
+    assert registers.sets == [fields.registers_bits(wire) for wire in model.registers]
+    assert len(registers.sets) == 2
+    assert unpack(fields.layout(fields.CONFIG), dut.settings.value.to_unsigned()) == model.config
 
 
 @cocotb.test()

@@ -110,6 +110,8 @@ class SequencerBench(wiring.Component):
         super().__init__({
             "pins": Out(interface.Signature(dmd.buses)),
             "regs": In(Registers),
+            "reload": In(1),
+            "at_rest": Out(1),
             "trigger_in": In(1),
             "sync_in": In(1),
             "soft_trigger": In(1),
@@ -132,8 +134,8 @@ class SequencerBench(wiring.Component):
         m.d.comb += [src.occ_slot.eq(seq.occ_slot), seq.occupancy.eq(src.occupancy),
                      src.now.eq(seq.status.now)]
         wiring.connect(m, wiring.flipped(self.pins), seq.pins)
-        for name in ("regs", "trigger_in", "sync_in", "soft_trigger", "seed", "reseed"):
+        for name in ("regs", "reload", "trigger_in", "sync_in", "soft_trigger", "seed", "reseed"):
             m.d.comb += getattr(seq, name).eq(getattr(self, name))
-        for name in ("sync_out", "camera_out", "status"):
+        for name in ("sync_out", "camera_out", "status", "at_rest"):
             m.d.comb += getattr(self, name).eq(getattr(seq, name))
         return m

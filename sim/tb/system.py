@@ -1,14 +1,27 @@
-"""cocotb testbench of the projector's core (generated Verilog): frames in over GMII, a trigger,
-the DLPC410 model on the pins, the camera's image compared with what was sent.
+"""cocotb testbench of the projector's core (generated Verilog): configured, armed and fed over
+GMII, triggered, the DLPC410 model on the pins, the camera's image compared with what was sent,
+and the status reply read back from the GMII transmit pins.
 
 Clocks: ``sync``, ``gmii_rx``, ``gmii_tx`` at 125 MHz and ``dmd`` at 200 MHz, started at
 fractions of a nanosecond from each other so that no two domains' edges coincide. The MCB model
 serves both memory ports; the DLPC410 model drives the controller's outputs and checks every
-rule; the frames are the host encoder's records inside scapy-built UDP datagrams.
+rule; every record is the host encoder's, inside a scapy-built UDP datagram. The core is built
+disarmed with power-up registers unlike the run's: the run works only if its sequencer and
+control records reach the sequencer.
+
+The reference model of the network side (:class:`sim.models.net.Model`) sees every frame the
+test sends and predicts the stack's and protocol's counters in the status reply; the test keeps
+its own ledger of what the MAC, the sequencer and the store must have counted.
+
+Faults during the run: frames with a bad FCS, frames for another UDP port and malformed records
+(each class the parser drops) interleaved with the scene; a trigger while disarmed; a burst of
+triggers faster than the frame rate; a new register set while a frame plays; a frame with a
+lost record, then a whole one. Every frame shown must be a whole, correct frame.
 """
 
 import json
 import time
+import zlib
 from pathlib import Path
 
 import cocotb
@@ -19,26 +32,29 @@ from scapy.layers.inet import IP, UDP
 from scapy.layers.l2 import Ether
 from scapy.packet import Raw
 
-from gateware.dlpc410 import schedule
 from gateware.dlpc410.facts import DMDS
-from gateware.dlpc410.params import PlaneOrder, Registers, ResetMode
+from gateware.dlpc410.params import PlaneOrder
+from gateware.dlpc410.sequencer import Status as SequencerStatus
+from gateware.mac.gmii import TxPins
+from gateware.protocol import fields
 from gateware.store.slots import SlotCounters
 from host import records
 from sim.harness.cocotb_run import params
-from sim.harness.layout import pack, unpack
+from sim.harness.layout import unpack
 from sim.models import gmii
 from sim.models.camera import Camera, to_lsb
 from sim.models.dlpc410 import CocotbAdapter, Dlpc410
 from sim.models.mcb import CocotbPort, McbModel
+from sim.models.net import Model
 from sim.scene import default_scene
+from sim.system import plan as run_plan
 
 SYNC_NS, GMII_NS, DMD_NS = 8.0, 8.0, 5.0
-HOST_MAC, HOST_IP = "02:00:00:00:00:99", "10.0.0.1"
+HOST_MAC, HOST_IP, HOST_PORT = "02:00:00:00:00:99", "10.0.0.1", 40000
 
 
-def datagrams(p, payloads):
-    return [bytes(Ether(src=HOST_MAC, dst=p["mac"]) / IP(src=HOST_IP, dst=p["ip"])
-                  / UDP(sport=40000, dport=p["port"]) / Raw(payload)) for payload in payloads]
+def _address(text):
+    return int(text.replace(":", ""), 16) if ":" in text else int.from_bytes(bytes(map(int, text.split("."))), "big")
 
 
 class System:
@@ -46,18 +62,19 @@ class System:
         self.dut, self.p = dut, p
         self.dmd = DMDS[p["dmd"]]
         self.memory = McbModel(p["memory_bytes"])
-        self.plan = schedule.plan(self.dmd, 1e9 / DMD_NS, t_rst_s=p["t_rst"] * DMD_NS * 1e-9,
-                                  t_settle_s=p["t_settle"] * DMD_NS * 1e-9, depth=8,
-                                  reset_mode=ResetMode[p["mode"]], order=PlaneOrder[p["order"]])
+        self.plan = run_plan(p)
         self.dlpc = Dlpc410(self.dmd, dclk=1e9 / DMD_NS, rst_active_cycles=p["t_rst"],
                             settle_cycles=p["t_settle"], init_cycles=p["init_cycles"],
                             init_grace_cycles=p["init_grace"], check_training=p.get("check_training", True))
+        self.net = Model(self.dmd, _address(p["mac"]), _address(p["ip"]), p["port"])
         self.dmd_cycle = 0
         self.frames_sent = 0
+        self.mac = {"good": 0, "bad_fcs": 0}
+        self.sequence = 0                # the host's record counter, as host.Client keeps it
+        self.replies = []                # UDP payloads of frames on the transmit pins
 
     async def start(self):
         dut = self.dut
-        dut.regs.value = pack(Registers, self.plan.params.registers(self.dmd))
         dut.gmii_rx.value = 0
         dut.trigger_in.value = 0
         dut.sync_in.value = 0
@@ -78,6 +95,7 @@ class System:
         cocotb.start_soon(CocotbPort(dut, "mcb_read", dut.dmd_clk, self.memory.ports[1], DMD_NS).run())
         self.adapter = cocotb.start_soon(CocotbAdapter(self.dlpc, dut, dut.dmd_clk).run())
         cocotb.start_soon(self._count_dmd())
+        cocotb.start_soon(self._receive_tx())
 
     async def _count_dmd(self):
         edge = RisingEdge(self.dut.dmd_clk)
@@ -85,16 +103,91 @@ class System:
             await edge
             self.dmd_cycle += 1
 
-    async def send(self, frames, errors=None):
-        """Drive GMII with ``frames`` (no FCS; the stream adds preamble, FCS and gaps)."""
+    async def _receive_tx(self):
+        """Frames on the GMII transmit pins: preamble and SFD stripped, FCS checked."""
+        edge, frame = RisingEdge(self.dut.gmii_tx_clk), bytearray()
+        while True:
+            await edge
+            pins = unpack(TxPins, self.dut.gmii_tx.value.to_unsigned())
+            assert not pins["er"], "tx_er on the transmit pins"
+            if pins["en"]:
+                frame.append(pins["d"])
+            elif frame:
+                assert frame[:8] == gmii.PREAMBLE, "preamble or SFD wrong"
+                body = bytes(frame[8:])
+                assert zlib.crc32(body) == 0x2144DF1C, "bad FCS on a transmitted frame"
+                packet = Ether(body[:-4])
+                if UDP in packet:
+                    self.replies.append(bytes(packet[UDP].payload))
+                frame = bytearray()
+
+    # -- what the host sends ----------------------------------------------------------------
+
+    def datagram(self, payload, *, port=None):
+        p = self.p
+        return bytes(Ether(src=HOST_MAC, dst=p["mac"]) / IP(src=HOST_IP, dst=p["ip"])
+                     / UDP(sport=HOST_PORT, dport=p["port"] if port is None else port) / Raw(payload))
+
+    def next_sequence(self, count=1):
+        first, self.sequence = self.sequence, self.sequence + count
+        return first
+
+    def image(self, picture, frame):
+        encoded = records.image_records(picture, frame, sequence=self.sequence)
+        self.sequence += len(encoded)
+        return encoded
+
+    async def send(self, frames, bad_fcs=()):
+        """Drive GMII with ``frames`` (Ethernet frames, no FCS): preamble, FCS (corrupted for the
+        indices in ``bad_fcs``), minimum gaps. The reference model sees each as the MAC will."""
         edge = RisingEdge(self.dut.gmii_rx_clk)
         self.frames_sent += len(frames)
-        for dv, er, byte in gmii.cycles(frames, errors=errors):
-            await edge
-            self.dut.gmii_rx.value = byte | (dv << 8) | (er << 9)
-        await edge
-        self.dut.gmii_rx.value = 0
+        for i, frame in enumerate(frames):
+            wire = bytearray(gmii.wire_bytes(frame))
+            bad = i in bad_fcs
+            if bad:
+                wire[-1] ^= 0x40
+            self.mac["bad_fcs" if bad else "good"] += 1
+            self.net.frame(frame, bad)
+            for byte in gmii.PREAMBLE + bytes(wire):
+                await edge
+                self.dut.gmii_rx.value = byte | (1 << 8)
+            for _ in range(gmii.MIN_GAP):
+                await edge
+                self.dut.gmii_rx.value = 0
         self.sent_at = self.dmd_cycle
+
+    async def delivered(self):
+        """Wait until everything sent has taken effect: the projector handles datagrams in
+        order, so when the answer to a status query sent after them is back, they have been
+        handled; then ``settle_after_send`` cycles for the store to finish writing a frame and
+        the sequencer to load it."""
+        await self.status()
+        await ClockCycles(self.dut.dmd_clk, self.p["settle_after_send"])
+
+    async def deliver(self, frames, bad_fcs=()):
+        await self.send(frames, bad_fcs)
+        await self.delivered()
+
+    async def records(self, encoded):
+        """Send records, each in its own datagram to the projector, and wait until they have
+        taken effect."""
+        await self.deliver([self.datagram(r) for r in encoded])
+
+    async def status(self):
+        """Ask for a status reply over GMII; its fields as a dict."""
+        sequence = self.next_sequence()
+        count = len(self.replies)
+        await self.send([self.datagram(records.status_query(sequence))])
+        for _ in range(200):
+            await ClockCycles(self.dut.clk, 100)
+            for raw in self.replies[count:]:
+                head, body, _rest = records.decode(raw)
+                if head["type"] == fields.RecordType.STATUS_REPLY and head["sequence"] == sequence:
+                    return body
+        raise AssertionError("no status reply on the transmit pins")
+
+    # -- triggers and what the DMD shows ---------------------------------------------------
 
     async def trigger(self):
         """A trigger edge on the pin; returns the dmd cycle it was raised on."""
@@ -109,54 +202,143 @@ class System:
         return [c for c in self.dlpc.log if c.kind == "pulse" and c.cycle >= cycle]
 
 
+def bad_records(system, picture):
+    """One malformed record of each class the parser checks, with the counter it lands in."""
+    good_regs = fields.register_wire(system.plan.params.registers(system.dmd))
+    image = records.image_records(picture[:1], 0, rows=1)[0]
+    n = fields.size(fields.HEADER)
+    head = fields.unpack(fields.HEADER, image)
+    body = fields.unpack(fields.IMAGE, image[n:])
+    return [
+        records.sequencer_record({**good_regs, "lsb": good_regs["lsb"] + 1}, system.next_sequence()),
+        records.sequencer_record({**good_regs, "order": 3}, system.next_sequence()),
+        records.sequencer_record(good_regs, system.next_sequence())[:-1],          # a byte short
+        records.control_record(system.next_sequence(), armed=2),
+        records.control_record(system.next_sequence(), bit_depth=9),
+        fields.pack(fields.HEADER, {**head, "version": fields.VERSION + 1}) + image[n:],
+        image[:n] + fields.pack(fields.IMAGE, {**body, "first_row": system.dmd.rows}) + image[n + 8:],
+    ]
+
+
 @cocotb.test()
-async def frame_over_gmii_is_shown_exactly(dut):
+async def frames_over_gmii_are_shown_exactly(dut):
     p = params()
     system = System(dut, p)
     await system.start()
     dmd = system.dmd
+    faults = p.get("faults", True)
+    count = p["frames"] + (4 if faults else 0)
     if p.get("scene"):
-        images = default_scene(p["frames"], dmd.rows, dmd.columns)
+        images = default_scene(count, dmd.rows, dmd.columns)
     else:
         rng = np.random.default_rng(p["seed"])
-        images = [rng.integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8) for _ in range(p["frames"])]
+        images = [rng.integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8) for _ in range(count)]
         images[0][0, :] = np.arange(dmd.columns) % 256      # every grey level appears
     wall0 = time.monotonic()
     report = {"frames": [], "period_cycles": system.plan.frame_cycles, "rate_hz": system.plan.rate_hz,
               "lsb_cycles": system.plan.params.lsb}
+    expect = {"triggers": 0, "trigger_overruns": 0, "registers_applied": 0}
 
-    def encoded(index):
-        payloads = records.image_records(images[index], frame=index)
-        bad = datagrams({**p, "port": p["port"] + 1}, payloads[:1])   # wrong port: dropped, counted
-        return datagrams(p, payloads) + bad
+    def encoded(index, *, interleave=True, lose=None):
+        """Frame ``index``'s datagrams, with bad ones between them; ``lose``: a record left out."""
+        payloads = system.image(images[index], frame=index)
+        if lose is not None:
+            del payloads[lose]
+        frames = [system.datagram(r) for r in payloads]
+        bad_fcs = ()
+        if interleave:
+            frames.insert(1, system.datagram(payloads[0], port=p["port"] + 1))   # another port
+            frames.insert(2, system.datagram(payloads[1]))                         # its FCS broken
+            bad_fcs = (2,)
+            frames[3:3] = [system.datagram(r) for r in bad_records(system, images[index])]
+        return frames, bad_fcs
 
-    # Streaming, as a renderer does it: each frame is sent while the one before it is shown, so
-    # it is complete when the sequencer reaches the end of that frame and takes the next one.
-    await system.send(encoded(0))
-    await ClockCycles(dut.dmd_clk, p["settle_after_send"])
-    period = system.plan.frame_cycles
-    for index, image in enumerate(images):
+    async def show(index, plan, *, sending=None, burst=0):
+        """Trigger, and check that the camera sees frame ``index`` exactly under ``plan``;
+        ``sending``: frames to send meanwhile; ``burst``: extra triggers while it plays."""
+        period = plan.frame_cycles
         pin = await system.trigger()
-        sending = cocotb.start_soon(system.send(encoded(index + 1))) if index + 1 < len(images) else None
-        await ClockCycles(dut.dmd_clk, period + p["t_rst"] * 4)
+        expect["triggers"] += 1
+        task = cocotb.start_soon(system.send(*sending)) if sending else None
+        for _ in range(burst):
+            await ClockCycles(dut.dmd_clk, period // (burst + 1))
+            await system.trigger()
+            expect["trigger_overruns"] += 1
+        await ClockCycles(dut.dmd_clk, period - burst * (period // (burst + 1)) + p["t_rst"] * 4)
         pulses = system.pulses_after(pin)
-        assert pulses, "the trigger produced no clocking pulse"
+        if not pulses:     # the sequencer's counters, to say why
+            counters = unpack(SequencerStatus, int(dut.sequencer.status.value))
+            raise AssertionError(f"frame {index}: the trigger produced no clocking pulse; sequencer {counters}")
         first = pulses[0].cycle
-        light = Camera(system.dlpc, ramp_cycles=0).image(first, first + period)
-        error = np.abs(to_lsb(light, system.plan.params.lsb) - image.astype(np.float64))
-        report["frames"].append({"latency_cycles": first - pin, "max_error_lsb": float(error.max())})
-        dut._log.info("frame %d: trigger to first pulse %d cycles, max error %.3g LSB",
-                      index, first - pin, error.max())
-        matches = [j for j, other in enumerate(images)
-                   if np.abs(to_lsb(light, system.plan.params.lsb) - other).max() < 1e-9]
+        light = to_lsb(Camera(system.dlpc, ramp_cycles=0).image(first, first + period), plan.params.lsb)
+        error = np.abs(light - images[index].astype(np.float64))
+        report["frames"].append({"index": index, "latency_cycles": first - pin, "max_error_lsb": float(error.max())})
+        dut._log.info("frame %d: trigger to first pulse %d cycles, max error %.3g LSB", index, first - pin,
+                      error.max())
         if error.max() >= 1e-9:     # what the store made of the rows, to say why
+            matches = [j for j, other in enumerate(images) if np.abs(light - other).max() < 1e-9]
             dut._log.info("store counters %s", unpack(SlotCounters, int(dut.store.counters.value)))
-        assert error.max() < 1e-9, (f"frame {index}: {int((error > 1e-9).sum())} pixels wrong; the image shown "
-                                    f"equals sent frame(s) {matches}; period {period}, send ended at dmd cycle "
-                                    f"{system.sent_at}, pulses {[(c.cycle, c.kind) for c in pulses[:3]]}")
-        if sending is not None:
-            await sending
-            await ClockCycles(dut.dmd_clk, p["settle_after_send"])
+            raise AssertionError(f"frame {index}: {int((error > 1e-9).sum())} pixels wrong; the image shown "
+                                 f"equals sent frame(s) {matches}; period {period}, send ended at dmd cycle "
+                                 f"{system.sent_at}, pulses {[(c.cycle, c.kind) for c in pulses[:3]]}")
+        if task is not None:
+            await task
+            await system.delivered()
+
+    # ---- configure through records, the first frame, a trigger while disarmed, then arm ----
+    configure = [records.sequencer_record(system.plan.params.registers(dmd), system.next_sequence(), dmd=dmd),
+                 records.control_record(system.next_sequence(), bit_depth=8, sequence_length=1)]
+    await system.records(configure)
+    expect["registers_applied"] += 1
+    await system.deliver(*encoded(0))
+    pin = await system.trigger()
+    await ClockCycles(dut.dmd_clk, 200)
+    assert not system.pulses_after(pin), "a trigger reached the sequencer while disarmed"
+    await system.records([records.control_record(system.next_sequence(), armed=1)])
+
+    # ---- streaming, as a renderer does it: each frame sent while the one before it is shown ----
+    for index in range(p["frames"]):
+        following = encoded(index + 1, interleave=faults) if index + 1 < count else None
+        await show(index, system.plan, sending=following)
+
+    if faults:
+        n = p["frames"]
+        # while a frame plays: a burst of triggers faster than the frame rate (overruns, the
+        # frame shown whole), and a new register set (planes in the other order, twice as long)
+        # with the next frame: the set is taken when the sequencer rests, and the next frame is
+        # shown exactly under it
+        later = run_plan(p, order=PlaneOrder.LSB_FIRST, exposure_s=2 * system.plan.params.lsb * DMD_NS * 1e-9)
+        reconfigure = system.datagram(records.sequencer_record(later.params.registers(dmd),
+                                                               system.next_sequence(), dmd=dmd))
+        frames, _ = encoded(n + 1, interleave=False)
+        await show(n, system.plan, burst=3, sending=([reconfigure] + frames,))
+        expect["registers_applied"] += 1
+        await show(n + 1, later)
+        # a frame with a lost record is never shown: the last whole frame repeats
+        await system.deliver(*encoded(n + 2, interleave=False, lose=1))
+        await show(n + 1, later)
+        # ... until a newer whole frame comes
+        await system.deliver(*encoded(n + 3, interleave=False))
+        await show(n + 3, later)
+
+    # ---- the status reply: every counter as the test's ledger and the reference model say ----
+    status = await system.status()
+    report["status"] = status
+    for name, _ in fields.NET_COUNTERS + fields.APP_COUNTERS:
+        assert status[name] == system.net.counters[name], (name, status[name], system.net.counters[name])
+    for verdict in ("good", "bad_fcs"):
+        assert status[f"mac_{verdict}"] == system.mac[verdict], (verdict, status[f"mac_{verdict}"])
+    shown = len(report["frames"])
+    assert status["frames_shown"] == shown and status["triggers"] == expect["triggers"] == shown
+    assert status["trigger_overruns"] == expect["trigger_overruns"]
+    assert status["registers_applied"] == expect["registers_applied"] and status["registers_superseded"] == 0
+    for name in ("triggers_early", "pulses_late", "frames_bad_depth", "mac_rx_er",
+                 "mac_runt", "mac_oversize", "mac_preamble", "mac_rx_dropped", "mac_tx_underruns"):
+        assert status[name] == 0, (name, status[name])
+    assert status["store_frames_abandoned"] == (1 if faults else 0)
+    assert status["store_frames_complete"] == count - (1 if faults else 0)
+    assert status["dlpc410_state"] & 0b1001 == 0b1000, "DLPC410 initialised and memory calibrated"
+    assert status["clock_hz"] == 125_000_000
     report["wall_s"] = time.monotonic() - wall0
     report["dmd_cycles"] = system.dmd_cycle
     report["gmii_frames_sent"] = system.frames_sent

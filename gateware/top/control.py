@@ -1,0 +1,77 @@
+"""The sequencer's register set, from the protocol (``sync``) to the sequencer (``dmd``).
+
+A sequencer record's register set must reach the sequencer whole, and only when the sequencer
+may take it: while it rests (:attr:`gateware.dlpc410.sequencer.Sequencer.at_rest`: before the
+first frame, or every group loaded and waiting for a trigger). Frames may play for a long time
+(a chained run rests only when disarmed), so sets wait in a mailbox in ``sync`` where the newest replaces an
+older one not yet sent; from there they cross through a small :class:`amaranth.lib.fifo.AsyncFIFO`
+(every bit of a set crosses together) and the sequencer side takes the next one when it rests,
+telling the sequencer to load its first plane again under the new registers.
+"""
+
+from amaranth import Module, Signal
+from amaranth.lib import fifo, stream, wiring
+from amaranth.lib.wiring import In, Out
+
+from gateware.dlpc410.params import Registers
+
+__all__ = ["RegisterCrossing"]
+
+
+class RegisterCrossing(wiring.Component):
+    """Register sets from ``sync`` into ``dmd``, applied only while the sequencer rests.
+
+    Parameters
+    ----------
+    power_up : dict or :class:`amaranth.lib.data.Const` of :class:`Registers`
+        The registers from reset until the first set is applied.
+    depth : int
+        Sets in flight between the domains.
+
+    Members
+    -------
+    sets : In(stream.Signature(Registers))
+        Register sets of valid sequencer records (``sync``); always ready.
+    superseded : Out(32)
+        Sets replaced in the mailbox by a newer one before they left it (``sync``).
+    at_rest : In(1)
+        The sequencer may take new registers (``dmd``).
+    regs : Out(Registers)
+        The registers the sequencer runs with (``dmd``); they change only while ``at_rest``.
+    reload : Out(1)
+        High in the cycle a set is applied (``dmd``), for the sequencer's ``reload``.
+    applied : Out(32)
+        Sets applied (``dmd``).
+    """
+
+    def __init__(self, power_up, *, depth=2):
+        self._depth = depth
+        super().__init__({
+            "sets": In(stream.Signature(Registers)),
+            "superseded": Out(32),
+            "at_rest": In(1),
+            "regs": Out(Registers, init=power_up),
+            "reload": Out(1),
+            "applied": Out(32),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.fifo = crossing = fifo.AsyncFIFO(width=Registers.as_shape().size, depth=self._depth,
+                                                      w_domain="sync", r_domain="dmd")
+        # ---- sync: the mailbox, newest first ----
+        pending = Signal(Registers)
+        full = Signal()
+        m.d.comb += [crossing.w_data.eq(pending), crossing.w_en.eq(full), self.sets.ready.eq(1)]
+        with m.If(self.sets.valid):
+            m.d.sync += [pending.eq(self.sets.payload), full.eq(1)]
+            with m.If(full & ~crossing.w_rdy):
+                m.d.sync += self.superseded.eq(self.superseded + 1)
+        with m.Elif(crossing.w_rdy):
+            m.d.sync += full.eq(0)
+
+        # ---- dmd: applied whole, while the sequencer rests ----
+        with m.If(crossing.r_rdy & self.at_rest):
+            m.d.comb += [crossing.r_en.eq(1), self.reload.eq(1)]
+            m.d.dmd += [self.regs.eq(crossing.r_data), self.applied.eq(self.applied + 1)]
+        return m
