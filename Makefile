@@ -23,25 +23,25 @@ test: $(STAMP)
 
 # The main job: the system simulation on the default scene.
 sim: $(STAMP)
-	$(PY) -m gateware sim
+	$(PY) -m flow sim
 
 # The Spartan-6 ISE tree (Verilog, UCF, ISE scripts) and each block's Verilog, in build/spartan6.
 verilog: $(STAMP)
-	$(PY) -m gateware verilog
+	$(PY) -m flow verilog
 
 # LUT/FF/BRAM/DSP per block and in total on XC6SLX45 (Yosys synth_xilinx -family xc6s).
 resources: $(STAMP)
-	$(PY) -m gateware resources
+	$(PY) -m flow resources
 
 # Every benchmark; writes build/bench.json and prints the figures.
 bench: $(STAMP)
-	$(PY) -m gateware bench
+	$(PY) -m flow bench
 
 waves: $(STAMP)
-	$(PY) -m gateware waves
+	$(PY) -m flow waves
 
 lint: $(STAMP)
-	$(PY) -m ruff check gateware sim tests constraints $(wildcard host)
+	$(PY) -m ruff check spec gateware host flow sim tests
 
 clean:
 	rm -rf build results.xml .pytest_cache

@@ -5,9 +5,9 @@ import sys
 
 import numpy as np
 
-from gateware.dlpc410 import schedule
-from gateware.dlpc410.facts import DMDS
-from gateware.dlpc410.params import PlaneOrder, ResetMode
+from spec import schedule
+from spec.facts import DMDS
+from spec.registers import PlaneOrder, ResetMode
 
 from .client import DEFAULT_PORT, Client, ClientError
 

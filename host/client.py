@@ -3,9 +3,9 @@
 import socket
 import time
 
-from gateware.protocol.fields import RecordType
+from spec.records import RecordType
 
-from . import records
+from . import codec
 
 __all__ = ["Client", "ClientError", "DEFAULT_PORT"]
 
@@ -83,29 +83,29 @@ class Client:
 
     def send_image(self, image, frame=0):
         """Send one ``uint8`` image as frame ``frame``; returns the records sent."""
-        encoded = records.image_records(image, frame, sequence=self.sequence)
+        encoded = codec.image_records(image, frame, sequence=self.sequence)
         self.sequence = (self.sequence + len(encoded)) & 0xFFFFFFFF
         return self.send_records(encoded)
 
     def send_sequence(self, images, first_frame=0):
-        encoded = records.sequence_records(images, first_frame, sequence=self.sequence)
+        encoded = codec.sequence_records(images, first_frame, sequence=self.sequence)
         self.sequence = (self.sequence + len(encoded)) & 0xFFFFFFFF
         return self.send_records(encoded)
 
     def control(self, *, software_trigger=False, **config):
         """Set configuration fields (see ``docs/protocol.md``); others keep their values."""
-        self._send(records.control_record(self._next(), software_trigger=software_trigger, **config))
+        self._send(codec.control_record(self._next(), software_trigger=software_trigger, **config))
 
     def configure(self, plan, dmd):
-        """Send the register set of a :func:`gateware.dlpc410.schedule.plan` (checked as the
+        """Send the register set of a :func:`spec.schedule.plan` (checked as the
         projector checks it); the sequencer takes it when no frame is playing."""
-        self._send(records.sequencer_record(plan.params.registers(dmd), self._next(), dmd=dmd))
+        self._send(codec.sequencer_record(plan.params.registers(dmd), self._next(), dmd=dmd))
 
     def status(self, retries=2):
         """Ask for a status reply and return its fields as a dict."""
         for _attempt in range(retries + 1):
             sequence = self._next()
-            self._send(records.status_query(sequence))
+            self._send(codec.status_query(sequence))
             deadline = time.monotonic() + self.timeout
             while (left := deadline - time.monotonic()) > 0:
                 self._sock.settimeout(left)
@@ -119,8 +119,8 @@ class Client:
                 if sender != self.peer:
                     continue
                 try:
-                    head, body, _rest = records.decode(raw)
-                except records.ProtocolError as error:
+                    head, body, _rest = codec.decode(raw)
+                except codec.ProtocolError as error:
                     raise ClientError(f"bad status reply from {sender[0]}:{sender[1]}: {error}") \
                         from error
                 if head["type"] == RecordType.STATUS_REPLY and head["sequence"] == sequence:

@@ -131,7 +131,7 @@ class FastSystem(wiring.Component):
     ----------
     dmd : DmdType
     registers : dict
-        The sequencer's registers (:class:`gateware.dlpc410.params.Registers` fields), fixed for
+        The sequencer's registers (:class:`gateware.registers.Registers` fields), fixed for
         the run.
     mac, ip, port : int
         The core's addresses.

@@ -14,13 +14,13 @@ import json
 import time
 from pathlib import Path
 
-from gateware.dlpc410 import schedule
-from gateware.dlpc410.facts import DMDS
-from gateware.dlpc410.params import PlaneOrder, ResetMode
 from gateware.top.system import Projector
 from sim import xga
 from sim.harness import cocotb_run
 from sim.harness.paths import build_dir
+from spec import schedule
+from spec.facts import DMDS
+from spec.registers import PlaneOrder, ResetMode
 
 __all__ = ["main", "run", "plan", "power_up_plan", "PARAMS", "XGA_FRAMES"]
 

@@ -9,7 +9,7 @@ the status reply from the transmit trace, and returns the figures.
 
 Timing: DCLK 200 MHz, RST_ACTIVE and settle from the facts table (no scaling); only the
 DLPC410's initialisation (220 ms) is shortened, to ``INIT_CYCLES``. The schedule comes from
-:func:`gateware.dlpc410.schedule.plan` with the read bandwidth the memory model gives the plane
+:func:`spec.schedule.plan` with the read bandwidth the memory model gives the plane
 reader.
 """
 
@@ -22,9 +22,7 @@ from scapy.layers.inet import IP, UDP
 from scapy.layers.l2 import Ether
 from scapy.packet import Raw
 
-from gateware.dlpc410 import schedule
-from gateware.dlpc410.facts import DMDS, TIMING
-from host import records
+from host import codec
 from sim.fast_top import PLUSARGS, SOURCES, FastSystem, pin_layout, read_rate
 from sim.harness import cocotb_run
 from sim.harness.paths import build_dir
@@ -33,6 +31,8 @@ from sim.models.camera import Camera, to_lsb
 from sim.models.dlpc410 import Dlpc410
 from sim.models.mcb import McbTiming
 from sim.scene import default_scene
+from spec import records, schedule
+from spec.facts import DMDS, TIMING
 
 __all__ = ["run", "plan", "DMD", "DMD_HZ"]
 
@@ -70,7 +70,7 @@ def _replay_files(directory, images):
     to another UDP port, which the stack must drop and count) and one with a status query."""
     files, sequence, datagrams = [], 0, 0
     for index, image in enumerate(images):
-        payloads = records.image_records(image, frame=index, sequence=sequence)
+        payloads = codec.image_records(image, frame=index, sequence=sequence)
         sequence += len(payloads)
         stray = _datagrams(payloads[:1], port=PORT + 1)
         datagrams += len(payloads) + len(stray)
@@ -78,7 +78,7 @@ def _replay_files(directory, images):
         gmii.replay_file(path, _datagrams(payloads) + stray)
         files.append(str(path))
     query = directory / "status_query.bin"
-    gmii.replay_file(query, _datagrams([records.status_query(sequence)]))
+    gmii.replay_file(query, _datagrams([codec.status_query(sequence)]))
     return files, str(query), datagrams + 1
 
 
@@ -87,7 +87,7 @@ def _status(tx_trace):
     for frame in trace.gmii_frames(tx_trace):
         packet = Ether(frame[:-4])
         if UDP in packet and packet[UDP].sport == PORT:
-            head, body, _ = records.decode(bytes(packet[UDP].payload))
+            head, body, _ = codec.decode(bytes(packet[UDP].payload))
             if head["type"] == records.RecordType.STATUS_REPLY:
                 return body
     raise AssertionError("no status reply on the transmit pins")

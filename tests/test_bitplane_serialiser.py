@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from gateware.bitplane import Serialiser
-from gateware.dlpc410.facts import TEST_DMD
 from sim.harness.amaranth_sim import simulate, stream_collect, stream_feed
 from sim.models import bitplane, serialiser_stim
+from spec.facts import TEST_DMD
 
 
 def as_dict(payload):

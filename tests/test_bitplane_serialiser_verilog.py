@@ -3,8 +3,8 @@
 import pytest
 
 from gateware.bitplane import Serialiser
-from gateware.dlpc410.facts import DMDS
 from sim.harness import cocotb_run
+from spec.facts import DMDS
 
 
 @pytest.mark.verilog

@@ -8,11 +8,11 @@ gives the error an independent integration of the same schedule predicts.
 import numpy as np
 import pytest
 
-from gateware.dlpc410.facts import TEST_DMD
 from sim.models import bitplane
 from sim.models.camera import Camera, ramp_integral, to_lsb
 from sim.models.dlpc410 import Dlpc410, timing_cycles
 from sim.models.dlpc410_driver import Driver
+from spec.facts import TEST_DMD
 
 T = timing_cycles(200e6)
 R, S = T["rst_active_cycles"], T["settle_cycles"]

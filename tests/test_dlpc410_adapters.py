@@ -4,11 +4,11 @@ the generated Verilog, each fed by the replay component, agree with the model fe
 import numpy as np
 import pytest
 
-from gateware.dlpc410.facts import TEST_DMD
 from sim.harness import cocotb_run
 from sim.harness.amaranth_sim import simulate
 from sim.models.dlpc410 import RULES, Dlpc410, RuleBreak, amaranth_process
 from sim.models.dlpc410_replay import MODEL_PARAMS, NAMES, replay, sequences
+from spec.facts import TEST_DMD
 
 SEQUENCES = sequences(TEST_DMD)
 

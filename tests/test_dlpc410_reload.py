@@ -5,14 +5,15 @@ TEST_DMD)."""
 
 import numpy as np
 
-from gateware.dlpc410 import schedule
-from gateware.dlpc410.facts import TEST_DMD
-from gateware.dlpc410.params import PlaneOrder, Registers, ResetMode
+from gateware.registers import Registers
 from sim.harness.amaranth_sim import simulate
 from sim.models.camera import Camera, to_lsb
 from sim.models.dlpc410 import amaranth_process
 from sim.tb.plane_source import SequencerBench, ramp_image
 from sim.tb.seq_sim import dlpc410_for
+from spec import schedule
+from spec.facts import TEST_DMD
+from spec.registers import PlaneOrder, ResetMode
 
 DMD = TEST_DMD
 FAST = {"t_rst_s": 20 / 200e6, "t_settle_s": 30 / 200e6}

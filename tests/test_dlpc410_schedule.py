@@ -3,16 +3,17 @@
 import numpy as np
 import pytest
 
-from gateware.dlpc410 import prng_model, schedule
-from gateware.dlpc410.facts import DMDS, TEST_DMD
-from gateware.dlpc410.params import DURATION_BITS, LSB_BITS, PlaneOrder, Registers, ResetMode, Source
+from gateware.registers import Registers
 from sim.tb.plane_source import ramp_image
+from spec import prng, schedule
+from spec.facts import DMDS, TEST_DMD
+from spec.registers import DURATION_BITS, LSB_BITS, PlaneOrder, ResetMode, Source
 
 XGA = DMDS["dlp7000"]
 
 
 def test_bound_matches_derived_figure():
-    # DLPC410.md "Derived bounds": about 312 Hz at 200 MHz for 8-bit continuous-light PWM
+    # docs/bounds.md: 310.7 Hz at 200 MHz for 8-bit continuous-light PWM
     assert 305 < schedule.bound(XGA, 200e6) < 315
     assert schedule.bound(XGA, 200e6, depth=1) > 50 * schedule.bound(XGA, 200e6)
 
@@ -86,10 +87,10 @@ def test_multi_second_frames_fit_the_counters():
 
 
 def test_prng_model_is_xorshift64():
-    w = prng_model.words(1, 3)
+    w = prng.words(1, 3)
     assert w[0] == 0x40822041 and len(set(w)) == 3
-    assert prng_model.words(0, 1) == prng_model.words(prng_model.ZERO_SEED, 1)
-    bits = np.unpackbits(np.array(prng_model.words(7, 4096), dtype="<u8").view(np.uint8))
+    assert prng.words(0, 1) == prng.words(prng.ZERO_SEED, 1)
+    bits = np.unpackbits(np.array(prng.words(7, 4096), dtype="<u8").view(np.uint8))
     assert abs(bits.mean() - 0.5) < 0.01
 
 
@@ -98,7 +99,7 @@ def test_prng_patterns_follow_commands():
                       t_rst_s=100e-9, t_settle_s=150e-9).params
     start = schedule.ready_cycle(TEST_DMD, p, schedule.Frame(0, 1))
     r = schedule.simulate(TEST_DMD, p, [], [start], max_frames=3)
-    shown = prng_model.shown_patterns(TEST_DMD, r.commands, 5)
+    shown = prng.shown_patterns(TEST_DMD, r.commands, 5)
     assert len(shown) >= 3 and not np.array_equal(shown[0], shown[1])
 
 

@@ -4,14 +4,14 @@ model's cycle for cycle, and every pixel receives exactly its grey level in LSB 
 import numpy as np
 import pytest
 
-from gateware.dlpc410 import prng_model, schedule
-from gateware.dlpc410.facts import TEST_DMD, TEST_DMD4
-from gateware.dlpc410.params import PlaneOrder, ResetMode, Source, TriggerMode
 from gateware.dlpc410.trigger import PIN_TO_STROBE
 from sim.models import bitplane
-from sim.tb.plane_source import ramp_image
 from sim.models.dlpc410 import RULES, RuleBreak
+from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import INIT_CYCLES, dlpc410_for, frame_lights, run_bench
+from spec import prng, schedule
+from spec.facts import TEST_DMD, TEST_DMD4
+from spec.registers import PlaneOrder, ResetMode, Source, TriggerMode
 
 DMD = TEST_DMD
 #: RST_ACTIVE and settle scaled down (run-time parameters) so that frames simulate quickly.
@@ -242,14 +242,14 @@ def test_binary_prng_chain(dmd, test_name):
     run = run_bench(dmd, p, [], None, pins=[ready], cycles=ready + 6 * p.lsb, name=test_name,
                     seed=0x1234)
     commands = same_commands(run, model)
-    shown = prng_model.shown_patterns(dmd, commands, 0x1234)
+    shown = prng.shown_patterns(dmd, commands, 0x1234)
     pulses = [t for t, k, _a in commands if k == "pulse"]
     assert len(pulses) >= 8
     # the frame period is the bus limit: one full load per pattern
     assert p.lsb == p.stagger * dmd.blocks
     # the decoder's mirrors hold the last shown pattern, the host's rebuild of it
     assert np.array_equal(run.model.mirrors, shown[-1])
-    assert not np.array_equal(shown[-1], prng_model.shown_patterns(dmd, commands, 0)[-1])
+    assert not np.array_equal(shown[-1], prng.shown_patterns(dmd, commands, 0)[-1])
 
 
 @pytest.mark.parametrize("ecp2_cycles", [4, 60])
@@ -272,8 +272,8 @@ def test_init_driven_by_the_model(ecp2_cycles, test_name):
 def test_init_waits_for_ecp2(test_name):
     """INIT_ACTIVE low before ECP2_FINISHED rises (not yet valid, DLPC910): no command, the
     sequencer keeps sending the training pattern until ECP2_FINISHED is high."""
-    from gateware.dlpc410.facts import BlockMode, RowMode
-    from gateware.dlpc410.params import Registers
+    from gateware.dlpc410.interface import BlockMode, RowMode
+    from gateware.registers import Registers
     from sim.harness.amaranth_sim import simulate
     from sim.tb.plane_source import SequencerBench
 

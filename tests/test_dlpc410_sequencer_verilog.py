@@ -2,9 +2,9 @@
 
 import pytest
 
-from gateware.dlpc410.facts import DMDS
 from sim.harness import cocotb_run
 from sim.tb.plane_source import SequencerBench
+from spec.facts import DMDS
 
 
 @pytest.mark.verilog

@@ -1,4 +1,4 @@
-"""The whole Ethernet side (:class:`gateware.net.port.EthernetPort`) on its generated Verilog:
+"""The whole Ethernet side (:class:`gateware.protocol.port.EthernetPort`) on its generated Verilog:
 GMII pins to image rows and counters, replies back to GMII pins, under cocotb and Verilator."""
 
 import pytest

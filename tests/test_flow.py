@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from gateware.flow import bench, resources, verilog
+from flow import bench, resources, verilog
 from sim.harness.paths import build_dir
 
 

@@ -6,9 +6,9 @@ from amaranth.lib import data, wiring
 from amaranth.lib.wiring import Out
 
 from gateware.bitplane import word_layout
-from gateware.dlpc410.facts import TEST_DMD
 from sim.harness import cocotb_run
 from sim.harness.layout import pack, unpack
+from spec.facts import TEST_DMD
 
 
 def test_layout_round_trip():

@@ -7,10 +7,10 @@ import threading
 import numpy as np
 import pytest
 
-from gateware.dlpc410.facts import TEST_DMD
-from gateware.protocol import fields
-from host import Client, ClientError, cli, records
+from host import Client, ClientError, cli, codec
 from sim.models.net import Model
+from spec import records
+from spec.facts import TEST_DMD
 
 
 class FakeProjector:
@@ -40,8 +40,8 @@ class FakeProjector:
             self.model.record(raw)
             if len(self.model.replies) > replies_before and self.mode != "silent":
                 sequence = self.model.replies[-1][1]["sequence"]
-                values = {name: self.model.counters.get(name, 0) for name, _ in fields.STATUS_REPLY}
-                reply = records.status_reply(sequence, values)
+                values = {name: self.model.counters.get(name, 0) for name, _ in records.STATUS_REPLY}
+                reply = codec.status_reply(sequence, values)
                 if self.mode == "garbled":
                     reply = reply[:20]
                 self.sock.sendto(reply, sender)
@@ -139,7 +139,7 @@ def test_python_m_host_status(projector):
 def test_cli_configure_says_the_rate_and_sends_the_plan(projector, capsys):
     """``configure`` plans with the schedule model, prints the rate it reaches, then sends the
     register set (checked and taken by the model as the projector takes it) and arms."""
-    from gateware.dlpc410 import schedule
+    from spec import schedule
     plan = schedule.plan(TEST_DMD, 200e6, depth=6)
     base = ["--address", "127.0.0.1", "--port", str(projector.port)]
     assert cli.main(base + ["configure", "--dmd", "test", "--depth", "6", "--dry-run"]) == 0
@@ -151,17 +151,17 @@ def test_cli_configure_says_the_rate_and_sends_the_plan(projector, capsys):
     assert cli.main(base + ["status"]) == 0
     model = projector.model
     assert model.counters["records_sequencer"] == 1 and model.counters["drop_app_value"] == 0
-    assert model.registers == [fields.register_wire(plan.params.registers(TEST_DMD))]
+    assert model.registers == [records.register_wire(plan.params.registers(TEST_DMD))]
     assert model.config["bit_depth"] == 6 and model.config["armed"] == 1
 
 
 def test_sequencer_record_refuses_what_the_projector_would_drop():
-    from gateware.dlpc410 import schedule
-    wire = fields.register_wire(schedule.plan(TEST_DMD, 200e6).params.registers(TEST_DMD))
-    records.sequencer_record(wire, dmd=TEST_DMD)
+    from spec import schedule
+    wire = records.register_wire(schedule.plan(TEST_DMD, 200e6).params.registers(TEST_DMD))
+    codec.sequencer_record(wire, dmd=TEST_DMD)
     with pytest.raises(ValueError, match="lsb_even_nonzero"):
-        records.sequencer_record({**wire, "lsb": 3}, dmd=TEST_DMD)
+        codec.sequencer_record({**wire, "lsb": 3}, dmd=TEST_DMD)
     with pytest.raises(ValueError, match="order_known"):
-        records.sequencer_record({**wire, "order": 3}, dmd=TEST_DMD)
-    head, body, rest = records.decode(records.sequencer_record(wire, 9))
-    assert head["type"] == fields.RecordType.SEQUENCER and body == wire and rest == b""
+        codec.sequencer_record({**wire, "order": 3}, dmd=TEST_DMD)
+    head, body, rest = codec.decode(codec.sequencer_record(wire, 9))
+    assert head["type"] == records.RecordType.SEQUENCER and body == wire and rest == b""

@@ -7,10 +7,10 @@ from amaranth import Module
 from amaranth.back import verilog
 from amaranth.lib import wiring
 
-from gateware.dlpc410.facts import TEST_DMD
 from gateware.platform.mcb_instance import MODULE, McbInstance
 from gateware.store import mcb
 from gateware.store.store import Store
+from spec.facts import TEST_DMD
 
 
 def test_instance_ports():

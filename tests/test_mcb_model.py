@@ -7,7 +7,6 @@ from sim.models.mcb import READ, REFRESH, WRITE, WRITE_PRECHARGE, McbError, McbM
 from sim.models.store_stim import PortDriver
 
 
-
 def write_burst(clk, address, words, instr=WRITE):
     for w in words:
         clk.tick(wr_en=1, wr_data=w)

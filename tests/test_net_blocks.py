@@ -7,17 +7,17 @@ import numpy as np
 from scapy.layers.inet import ICMP, IP, UDP
 from scapy.layers.l2 import ARP, Ether
 
-from gateware.dlpc410.facts import TEST_DMD
 from gateware.net.buffer import FrameBuffer
 from gateware.net.layouts import ReplyKind
 from gateware.net.transmit import Transmitter
-from gateware.protocol import fields
 from gateware.protocol.parser import Parser, config_init
-from host import records
+from host import codec
 from sim.harness.amaranth_sim import simulate, stream_collect, stream_put
 from sim.models.frames import Addresses
-from sim.models.ingest_sim import assemble_rows, plain
 from sim.models.net import Model
+from sim.tb.endpoint_sim import assemble_rows, plain
+from spec import records
+from spec.facts import TEST_DMD
 
 A = Addresses()
 
@@ -130,9 +130,9 @@ def test_parser_against_model(test_name):
     model = Model(dmd, A.mac, A.ip, A.port)
     rng = random.Random(4)
     image = np.random.default_rng(4).integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8)
-    datagrams = records.image_records(image, 9, rows=8)
-    datagrams += [records.status_query(len(datagrams)), records.control_record(99, armed=1, bit_depth=4),
-                  records.control_record(100, bit_depth=0), b"\x44\x4d\x01\x01", records.status_query(5)]
+    datagrams = codec.image_records(image, 9, rows=8)
+    datagrams += [codec.status_query(len(datagrams)), codec.control_record(99, armed=1, bit_depth=4),
+                  codec.control_record(100, bit_depth=0), b"\x44\x4d\x01\x01", codec.status_query(5)]
     rng.shuffle(datagrams)
     peer = {"mac": 0x020000000099, "ip": 0x0A000001, "port": 40000}
     for d in datagrams:
@@ -146,8 +146,8 @@ def test_parser_against_model(test_name):
                                                       "length": len(d), "peer": peer})
         for _ in range(30):
             await ctx.tick()
-        out["app"] = plain(ctx.get(dut.counters), fields.APP_COUNTERS)
-        out["settings"] = plain(ctx.get(dut.settings), fields.CONFIG)
+        out["app"] = plain(ctx.get(dut.counters), records.APP_COUNTERS)
+        out["settings"] = plain(ctx.get(dut.settings), records.CONFIG)
 
     async def pixels(ctx):
         while True:
@@ -161,6 +161,6 @@ def test_parser_against_model(test_name):
 
     simulate(dut, [feed], processes=[pixels, queries], name=test_name, deadline=1e-3)
     assert assemble_rows(out["pixels"], dmd.columns) == model.rows
-    assert out["app"] == {k: model.counters[k] for k, _ in fields.APP_COUNTERS}
+    assert out["app"] == {k: model.counters[k] for k, _ in records.APP_COUNTERS}
     assert out["queries"] == [(r[1]["sequence"], 40000) for r in model.replies]
     assert out["settings"]["armed"] == 1 and out["settings"]["bit_depth"] == 4

@@ -1,9 +1,9 @@
-"""docs/protocol.md lists the same fields, widths and offsets as gateware/protocol/fields.py."""
+"""docs/protocol.md lists the same fields, widths and offsets as spec/records.py."""
 
 import re
 from pathlib import Path
 
-from gateware.protocol import fields
+from spec import records, wire
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "protocol.md"
 
@@ -22,8 +22,8 @@ def table_rows(table, start):
 
 
 def test_doc_tables_match_fields():
-    header = fields.size(fields.HEADER)
-    expected = (table_rows(fields.HEADER, 0) + table_rows(fields.IMAGE, header)
-                + table_rows(fields.CONTROL, header) + table_rows(fields.SEQUENCER, header)
-                + table_rows(fields.STATUS_REPLY, header))
+    header = wire.size(records.HEADER)
+    expected = (table_rows(records.HEADER, 0) + table_rows(records.IMAGE, header)
+                + table_rows(records.CONTROL, header) + table_rows(records.SEQUENCER, header)
+                + table_rows(records.STATUS_REPLY, header))
     assert doc_rows() == expected

@@ -5,53 +5,54 @@ import pytest
 from amaranth import C, Const
 from amaranth.lib import data
 
-from gateware.protocol import fields
-from host import records
+from gateware.wire import layout, to_bytes, view
+from host import codec
+from spec import records, wire
 
 
 def test_pack_unpack_round_trip():
-    values = {name: (i * 0x9E3779B1) & ((1 << width) - 1) for i, (name, width) in enumerate(fields.CONTROL)}
-    raw = fields.pack(fields.CONTROL, values)
-    assert len(raw) == fields.size(fields.CONTROL)
-    assert fields.unpack(fields.CONTROL, raw) == values
+    values = {name: (i * 0x9E3779B1) & ((1 << width) - 1) for i, (name, width) in enumerate(records.CONTROL)}
+    raw = wire.pack(records.CONTROL, values)
+    assert len(raw) == wire.size(records.CONTROL)
+    assert wire.unpack(records.CONTROL, raw) == values
 
 
 def test_pack_rejects_bad_values():
     with pytest.raises(ValueError):
-        fields.pack(fields.HEADER, {"version": 256})
+        wire.pack(records.HEADER, {"version": 256})
     with pytest.raises(KeyError):
-        fields.pack(fields.HEADER, {"colour": 1})
+        wire.pack(records.HEADER, {"colour": 1})
 
 
-@pytest.mark.parametrize("table", [fields.HEADER, fields.IMAGE, fields.CONTROL, fields.STATUS_REPLY])
+@pytest.mark.parametrize("table", [records.HEADER, records.IMAGE, records.CONTROL, records.STATUS_REPLY])
 def test_gateware_view_reads_host_bytes(table):
     """The struct view the gateware puts on received bytes reads what the host packed, and the
     bytes the gateware writes are what the host unpacks."""
     values = {name: (7 + 31 * i) % (1 << width) for i, (name, width) in enumerate(table)}
-    raw = fields.pack(table, values)
-    view = fields.view(table, [C(b, 8) for b in raw])
+    raw = wire.pack(table, values)
+    seen = view(table, [C(b, 8) for b in raw])
     for name, _ in table:
-        assert Const.cast(view[name]).value == values[name], name
-    sent = fields.to_bytes(table, values)
+        assert Const.cast(seen[name]).value == values[name], name
+    sent = to_bytes(table, values)
     assert bytes(Const.cast(b).value for b in sent) == raw
-    assert isinstance(fields.layout(table), data.StructLayout)
+    assert isinstance(layout(table), data.StructLayout)
 
 
 def test_record_sizes_fit_the_mtu():
-    assert records.rows_per_record(1024) == 8
-    assert records.rows_per_record(2048) == 4
-    assert fields.image_record_length(8, 1024) <= fields.MAX_RECORD
-    assert fields.image_record_length(4, 2048) <= fields.MAX_RECORD
+    assert codec.rows_per_record(1024) == 8
+    assert codec.rows_per_record(2048) == 4
+    assert records.image_record_length(8, 1024) <= records.MAX_RECORD
+    assert records.image_record_length(4, 2048) <= records.MAX_RECORD
 
 
 def test_image_records_round_trip():
     image = np.random.default_rng(0).integers(0, 256, (768, 1024), dtype=np.uint8)
-    encoded = records.image_records(image, frame=5, sequence=10)
+    encoded = codec.image_records(image, frame=5, sequence=10)
     assert len(encoded) == 96
     rebuilt = np.zeros_like(image)
     for i, record in enumerate(encoded):
-        head, body, pixels = records.decode(record)
-        assert head["sequence"] == 10 + i and head["type"] == fields.RecordType.IMAGE
+        head, body, pixels = codec.decode(record)
+        assert head["sequence"] == 10 + i and head["type"] == records.RecordType.IMAGE
         assert body["frame"] == 5 and body["row_bytes"] == 1024 and body["row_count"] == 8
         rebuilt[body["first_row"]:body["first_row"] + body["row_count"]] = \
             np.frombuffer(pixels, np.uint8).reshape(-1, 1024)
@@ -59,13 +60,13 @@ def test_image_records_round_trip():
 
 
 def test_control_record_selects_fields():
-    head, body, _ = records.decode(records.control_record(3, armed=1, port=7000, software_trigger=True))
-    names = [name for name, _ in fields.CONFIG]
+    head, body, _ = codec.decode(codec.control_record(3, armed=1, port=7000, software_trigger=True))
+    names = [name for name, _ in records.CONFIG]
     assert body["apply"] == (1 << names.index("armed")) | (1 << names.index("port"))
-    assert body["action"] == fields.Action.SOFTWARE_TRIGGER
+    assert body["action"] == records.Action.SOFTWARE_TRIGGER
     assert (body["armed"], body["port"], head["sequence"]) == (1, 7000, 3)
     with pytest.raises(KeyError):
-        records.control_record(exposure=3)
+        codec.control_record(exposure=3)
 
 
 @pytest.mark.parametrize("mutate, message", [
@@ -76,10 +77,10 @@ def test_control_record_selects_fields():
     (lambda r: r[:3] + bytes([77]) + r[4:], "unknown record type"),
 ])
 def test_decode_rejects_malformed(mutate, message):
-    with pytest.raises(records.ProtocolError, match=message):
-        records.decode(mutate(records.status_query(1)))
+    with pytest.raises(codec.ProtocolError, match=message):
+        codec.decode(mutate(codec.status_query(1)))
 
 
 def test_bad_image_input():
     with pytest.raises(ValueError):
-        records.image_records(np.zeros((4, 4), np.uint16), 0)
+        codec.image_records(np.zeros((4, 4), np.uint16), 0)

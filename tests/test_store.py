@@ -5,11 +5,11 @@ import random
 
 import numpy as np
 
-from gateware.dlpc410.facts import TEST_DMD
 from sim.harness.amaranth_sim import simulate, stream_feed
 from sim.models import store_stim
 from sim.models.mcb import McbModel, McbTiming, amaranth_process
 from sim.tb.store_chain import StoreChain
+from spec.facts import TEST_DMD
 
 DMD = TEST_DMD
 SYNC_HZ, DMD_HZ = 125e6, 200e6

@@ -6,10 +6,10 @@ in the simulators; here the full geometries)."""
 import numpy as np
 import pytest
 
-from gateware.dlpc410.facts import DMDS
 from gateware.store.addresses import MEMORY_BYTES, PLANES, AddressMap
 from sim.models import store_stim
 from sim.models.mcb import McbModel, McbTiming
+from spec.facts import DMDS
 
 
 def test_xga_plane_is_0x3000_words():

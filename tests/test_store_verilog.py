@@ -3,10 +3,10 @@ Verilator, with the MCB model's cocotb adapter on both ports."""
 
 import pytest
 
-from gateware.dlpc410.facts import DMDS
 from gateware.store.addresses import AddressMap
 from sim.harness import cocotb_run
 from sim.tb.store_chain import StoreChain
+from spec.facts import DMDS
 
 
 @pytest.mark.verilog

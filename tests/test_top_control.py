@@ -1,4 +1,4 @@
-"""The register crossing (:class:`gateware.top.control.RegisterCrossing`) in the Amaranth simulator:
+"""The register crossing (:class:`gateware.dlpc410.register_crossing.RegisterCrossing`) in the Amaranth simulator:
 register sets from ``sync`` reach ``dmd`` whole, in order, only while the sequencer rests; a set
 still in the mailbox when a newer one comes is replaced and counted."""
 
@@ -6,8 +6,8 @@ import random
 
 from amaranth.lib import data
 
-from gateware.dlpc410.params import Registers
-from gateware.top.control import RegisterCrossing
+from gateware.dlpc410.register_crossing import RegisterCrossing
+from gateware.registers import Registers
 from sim.harness.amaranth_sim import simulate
 
 LAYOUT = data.Layout.cast(Registers)

@@ -6,7 +6,6 @@ responder and recorder, on replayed sequences, agree with the model."""
 import numpy as np
 import pytest
 
-from gateware.dlpc410.facts import TEST_DMD
 from sim.fast_top import PLUSARGS, SOURCES, ResponderBench, pin_layout
 from sim.harness import cocotb_run
 from sim.harness.layout import pack
@@ -15,6 +14,7 @@ from sim.models import gmii, trace
 from sim.models.dlpc410 import RULES, Dlpc410, RuleBreak
 from sim.models.dlpc410_replay import MODEL_PARAMS, sequences
 from sim.models.dlpc410_replay import NAMES as NAMES_OF_SEQUENCES
+from spec.facts import TEST_DMD
 
 LAYOUT = pin_layout(TEST_DMD.buses)
 NAMES = [name for name, _ in LAYOUT]

@@ -1,4 +1,4 @@
-"""The bit-plane serialiser (DESIGN.md block 4).
+"""The bit-plane serialiser: 8-bit pixels in, 64-bit single-plane words out.
 
 Grey levels are shown by binary-weighted PWM, so the DMD wants an image as eight bit-planes.
 This block slices pixels as they arrive and packs each plane's bits into 64-bit words, the unit
@@ -21,26 +21,12 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
 
-__all__ = ["Serialiser", "pixel_layout", "word_layout", "row_flags_layout", "PLANES"]
+from ..protocol.layouts import pixel_layout, position_fields
+
+__all__ = ["Serialiser", "word_layout", "row_flags_layout", "PLANES"]
 
 PLANES = 8
 WORD_BITS = 64
-
-
-def _position_fields(dmd, frame_bits):
-    return {
-        "frame": frame_bits,
-        "row": ceil_log2(dmd.rows),
-    }
-
-
-def pixel_layout(dmd, lanes=1, frame_bits=4):
-    """Input beat: ``lanes`` pixels, left to right, starting at column ``column`` of ``row``."""
-    return data.StructLayout({
-        "pixels": data.ArrayLayout(8, lanes),
-        "column": ceil_log2(dmd.columns),
-        **_position_fields(dmd, frame_bits),
-    })
 
 
 def word_layout(dmd, frame_bits=4):
@@ -50,7 +36,7 @@ def word_layout(dmd, frame_bits=4):
         "plane": ceil_log2(PLANES),
         "word": max(1, ceil_log2(dmd.words_per_row)),
         "block": max(1, ceil_log2(dmd.blocks)),
-        **_position_fields(dmd, frame_bits),
+        **position_fields(dmd, frame_bits),
     })
 
 
@@ -59,7 +45,7 @@ def row_flags_layout(dmd, frame_bits=4):
     return data.StructLayout({
         "planes": PLANES,
         "block": max(1, ceil_log2(dmd.blocks)),
-        **_position_fields(dmd, frame_bits),
+        **position_fields(dmd, frame_bits),
     })
 
 
@@ -68,7 +54,7 @@ class Serialiser(wiring.Component):
 
     Parameters
     ----------
-    dmd : :class:`gateware.dlpc410.facts.DmdType`
+    dmd : :class:`spec.facts.DmdType`
         Geometry: columns per row, rows per block.
     lanes : int
         Pixels per input transfer (1, 2, 4 or 8). With 8 lanes the block takes 8 pixels and
@@ -78,7 +64,7 @@ class Serialiser(wiring.Component):
 
     Members
     -------
-    pixels : In(stream.Signature(pixel_layout))
+    pixels : In(stream.Signature(:func:`gateware.protocol.layouts.pixel_layout`))
         Pixels of whole rows, left to right (``column`` is that of the first pixel of the
         transfer and a multiple of ``lanes``). Rows may come in any order.
     words : Out(stream.Signature(word_layout))

@@ -6,7 +6,7 @@ high (DLPC910). Until then the applications FPGA sends the training pattern (DLP
 ``0100`` repeating over four DDR edges, that is two DCLK cycles) on every data pin and DVALID,
 and no command. ``running`` rises once ECP2_FINISHED is high and INIT_ACTIVE low,
 and stays high; the sequencer then keeps DVALID low for at least ``init_to_dvalid`` clocks
-(see :mod:`gateware.dlpc410.schedule`).
+(see :mod:`spec.schedule`).
 """
 
 from amaranth import Module, Signal
@@ -14,7 +14,7 @@ from amaranth.lib import wiring
 from amaranth.lib.cdc import FFSynchronizer
 from amaranth.lib.wiring import In, Out
 
-from .facts import TIMING
+from spec.facts import TIMING
 
 __all__ = ["Init", "TRAINING_EDGES"]
 

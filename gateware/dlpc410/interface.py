@@ -15,15 +15,21 @@ Row cycles (how the DLPC410 model reads these signals, and how the sequencer mus
 * when ``dvalid`` falls it stays low for an even number of cycles (DLPU045A: the controller
   runs at DCLK/2).
 
-Facts and encodings: :mod:`gateware.dlpc410.facts`.
+Facts and encodings: :mod:`spec.facts`.
 """
 
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from .facts import BlockMode, RowMode
+from spec import facts
 
-__all__ = ["DinPair", "Signature"]
+from ..wire import hdl_enum
+
+__all__ = ["DinPair", "Signature", "RowMode", "BlockMode"]
+
+#: ROWMD and BLKMD encodings (:data:`spec.facts.RowMode`, :data:`spec.facts.BlockMode`).
+RowMode = hdl_enum(facts.RowMode, 2)
+BlockMode = hdl_enum(facts.BlockMode, 2)
 
 
 class DinPair(data.Struct):

@@ -2,7 +2,7 @@
 
 xorshift64 (shifts 13, 7, 17), one 64-bit word per step: every bit is a fair coin, so each
 pattern is a row of a Bernoulli(1/2) measurement matrix for compressed sensing. The host
-rebuilds the same patterns with :mod:`gateware.dlpc410.prng_model`. A four-bus DMD takes two
+rebuilds the same patterns with :mod:`spec.prng`. A four-bus DMD takes two
 consecutive words per cycle (the same sequence, two steps at a time).
 """
 
@@ -10,7 +10,7 @@ from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from .prng_model import ZERO_SEED
+from spec.prng import ZERO_SEED
 
 __all__ = ["Prng"]
 
@@ -33,7 +33,7 @@ class Prng(wiring.Component):
     Members
     -------
     seed : In(64)
-        Loaded when ``reseed`` is high (zero is replaced by :data:`prng_model.ZERO_SEED`).
+        Loaded when ``reseed`` is high (zero is replaced by :data:`prng.ZERO_SEED`).
     reseed : In(1)
     next : In(1)
         Take ``word`` this cycle; the next word follows on the next cycle.
@@ -62,5 +62,5 @@ class Prng(wiring.Component):
 
 
 def _const_step(value):
-    from .prng_model import step
+    from spec.prng import step
     return step(value)

@@ -1,6 +1,6 @@
-"""The DLPC410 load/reset sequencer (DESIGN.md block 7): PWM frames, phased and global pulses.
+"""The DLPC410 load/reset sequencer: PWM frames, phased and global pulses.
 
-It plays the algorithm documented in :mod:`gateware.dlpc410.schedule` (the model it must match
+It plays the algorithm documented in :mod:`spec.schedule` (the model it must match
 cycle for cycle): per pulse group a timeline of clocking pulses at exact cycles, loads queued in
 pulse order and served behind the settle time, dark pulses of cleared blocks for short planes,
 and a first plane preloaded so that a trigger becomes a pulse a few cycles later.
@@ -20,15 +20,15 @@ from amaranth.lib import data, fifo, stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
 
-from gateware.store.layouts import SLOT_BITS, FrameInfo, PlaneRequest
+from spec.schedule import INIT_TO_DVALID, WORD_FIFO_ROWS, flush_rows
 
+from ..registers import DURATION_BITS, TIME_BITS, PlaneOrder, Registers, ResetMode, Source
+from ..store.layouts import SLOT_BITS, FrameInfo, PlaneRequest
 from . import interface
 from .beat import beat_lanes
-from .facts import BlockMode, RowMode
 from .init import TRAINING_EDGES, Init
-from .params import DURATION_BITS, TIME_BITS, PlaneOrder, Registers, ResetMode, Source
+from .interface import BlockMode, RowMode
 from .prng import Prng
-from .schedule import INIT_TO_DVALID, WORD_FIFO_ROWS, flush_rows
 from .trigger import Trigger
 
 __all__ = ["Sequencer", "Status"]
@@ -79,10 +79,10 @@ class Sequencer(wiring.Component):
 
     Parameters
     ----------
-    dmd : :class:`gateware.dlpc410.facts.DmdType`
+    dmd : :class:`spec.facts.DmdType`
         Geometry: a beat of ``bits_per_dclk`` bits per DCLK cycle (one 64-bit word on A/B, and
         a second on C/D for four buses), ``dclk_per_row`` beats per row; a block clear takes
-        ``clear_row_cycles`` row cycles (1080p: the clear and two no-op rows, DLPC410.md).
+        ``clear_row_cycles`` row cycles (1080p: the clear and two no-op rows; facts table).
         The store gives one word per cycle at most, so a four-bus DMD loads a row every two
         row cycles at best (the plan's ``row_period``).
 
@@ -90,7 +90,7 @@ class Sequencer(wiring.Component):
     -------
     pins : Out(:class:`gateware.dlpc410.interface.Signature`)
         The DLPC410 applications interface.
-    regs : In(:class:`gateware.dlpc410.params.Registers`)
+    regs : In(:class:`gateware.registers.Registers`)
         Run-time parameters. Change them only while ``at_rest`` is high, with ``reload``.
     at_rest : Out(1)
         No frame is playing and no load is under way: before the first frame, or every group

@@ -12,7 +12,7 @@ from amaranth.lib import wiring
 from amaranth.lib.cdc import FFSynchronizer
 from amaranth.lib.wiring import In, Out
 
-from .params import DURATION_BITS, TriggerMode
+from ..registers import DURATION_BITS, TriggerMode
 
 __all__ = ["Trigger", "PIN_TO_STROBE", "SYNC_STAGES"]
 

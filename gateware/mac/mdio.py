@@ -8,7 +8,7 @@ from amaranth import Cat, Const, Module, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from .phy_facts import PHY
+from spec.facts import PHY
 
 __all__ = ["LinkStatus", "StatusPoller"]
 

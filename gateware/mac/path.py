@@ -2,7 +2,7 @@
 
 :class:`ReceivePath` is :class:`gmii_rx.Receiver` followed by :class:`cdc.RxCrossing`;
 :class:`TransmitPath` is :class:`cdc.TxCrossing` followed by :class:`gmii_tx.Transmitter`.
-Their counters are carried into ``sync`` with :class:`cdc.CountSynchronizer`, so the status
+Their counters are carried into ``sync`` with :class:`gateware.cdc.CountSynchronizer`, so the status
 logic reads every figure in its own domain.
 """
 
@@ -10,8 +10,9 @@ from amaranth import Module
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 
+from ..cdc import CountSynchronizer
 from . import gmii
-from .cdc import CountSynchronizer, RxCrossing, TxCrossing
+from .cdc import RxCrossing, TxCrossing
 from .gmii_rx import Receiver, counters_layout
 from .gmii_tx import Transmitter
 from .layouts import ByteBeat

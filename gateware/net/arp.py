@@ -4,17 +4,13 @@ from amaranth import Module
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from ..protocol import fields
-from . import ethernet
+from spec import headers
+from spec.wire import size
+
 from .tap import Tap, capture
 
-__all__ = ["PACKET", "REQUEST", "REPLY", "Checker", "reply_fields"]
+__all__ = ["Checker", "reply_fields"]
 
-PACKET = [("htype", 16), ("ptype", 16), ("hlen", 8), ("plen", 8), ("oper", 16),
-          ("sha", 48), ("spa", 32), ("tha", 48), ("tpa", 32)]
-REQUEST = 1
-REPLY = 2
-_AT = fields.size(ethernet.HEADER)
 
 
 class Checker(wiring.Component):
@@ -39,13 +35,13 @@ class Checker(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        packet = capture(m, self.tap, _AT, PACKET, "arp")
+        packet = capture(m, self.tap, headers.ARP_AT, headers.ARP, "arp")
         m.d.comb += [
             self.request_for_us.eq(
-                (self.tap.length >= _AT + fields.size(PACKET))
-                & (packet.htype == 1) & (packet.ptype == ethernet.ETHERTYPE_IPV4)
+                (self.tap.length >= headers.ARP_AT + size(headers.ARP))
+                & (packet.htype == 1) & (packet.ptype == headers.ETHERTYPE_IPV4)
                 & (packet.hlen == 6) & (packet.plen == 4)
-                & (packet.oper == REQUEST) & (packet.tpa == self.ip)),
+                & (packet.oper == headers.ARP_REQUEST) & (packet.tpa == self.ip)),
             self.sha.eq(packet.sha),
             self.spa.eq(packet.spa),
         ]
@@ -54,5 +50,5 @@ class Checker(wiring.Component):
 
 def reply_fields(our_mac, our_ip, peer):
     """The fields of our answer to ``peer`` (a :class:`~gateware.net.layouts.Peer`)."""
-    return {"htype": 1, "ptype": ethernet.ETHERTYPE_IPV4, "hlen": 6, "plen": 4, "oper": REPLY,
+    return {"htype": 1, "ptype": headers.ETHERTYPE_IPV4, "hlen": 6, "plen": 4, "oper": headers.ARP_REPLY,
             "sha": our_mac, "spa": our_ip, "tha": peer.mac, "tpa": peer.ip}

@@ -4,17 +4,12 @@ from amaranth import Module
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from ..protocol import fields
+from spec import headers
+from spec.wire import size
+
 from .tap import Tap, capture
 
-__all__ = ["HEADER", "ETHERTYPE_IPV4", "ETHERTYPE_ARP", "VLAN_TPIDS", "BROADCAST", "Checker"]
-
-HEADER = [("dst", 48), ("src", 48), ("ethertype", 16)]
-ETHERTYPE_IPV4 = 0x0800
-ETHERTYPE_ARP = 0x0806
-#: 802.1Q, 802.1ad and the older QinQ tag: tagged frames are dropped.
-VLAN_TPIDS = (0x8100, 0x88A8, 0x9100)
-BROADCAST = (1 << 48) - 1
+__all__ = ["Checker"]
 
 
 class Checker(wiring.Component):
@@ -49,13 +44,13 @@ class Checker(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        header = capture(m, self.tap, 0, HEADER, "eth")
+        header = capture(m, self.tap, 0, headers.ETHERNET, "eth")
         m.d.comb += [
-            self.short.eq(self.tap.length < fields.size(HEADER)),
-            self.dst_ok.eq((header.dst == self.mac) | (header.dst == BROADCAST)),
-            self.vlan.eq(sum(header.ethertype == tpid for tpid in VLAN_TPIDS) != 0),
-            self.is_ipv4.eq(header.ethertype == ETHERTYPE_IPV4),
-            self.is_arp.eq(header.ethertype == ETHERTYPE_ARP),
+            self.short.eq(self.tap.length < size(headers.ETHERNET)),
+            self.dst_ok.eq((header.dst == self.mac) | (header.dst == headers.BROADCAST)),
+            self.vlan.eq(sum(header.ethertype == tpid for tpid in headers.VLAN_TPIDS) != 0),
+            self.is_ipv4.eq(header.ethertype == headers.ETHERTYPE_IPV4),
+            self.is_arp.eq(header.ethertype == headers.ETHERTYPE_ARP),
             self.src.eq(header.src),
         ]
         return m

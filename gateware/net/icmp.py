@@ -4,19 +4,14 @@ from amaranth import Module
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from ..protocol import fields
-from . import ipv4
+from spec import headers
+
 from .checksum import fold
 from .layouts import OFFSET_BITS
 from .tap import Tap, capture
 
-__all__ = ["HEADER", "ECHO_REQUEST", "ECHO_REPLY", "Checker", "reply_checksum"]
+__all__ = ["Checker", "reply_checksum"]
 
-HEADER = [("type", 8), ("code", 8), ("checksum", 16)]
-ECHO_REQUEST = 8
-ECHO_REPLY = 0
-#: Echo messages carry an identifier and a sequence number after the header.
-MIN_ECHO = fields.size(HEADER) + 4
 
 
 class Checker(wiring.Component):
@@ -44,10 +39,10 @@ class Checker(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        header = capture(m, self.tap, ipv4.PAYLOAD_AT, HEADER, "icmp")
+        header = capture(m, self.tap, headers.IP_PAYLOAD_AT, headers.ICMP, "icmp")
         m.d.comb += [
-            self.echo_request.eq((header.type == ECHO_REQUEST) & (header.code == 0)
-                                 & (self.payload_length >= MIN_ECHO)),
+            self.echo_request.eq((header.type == headers.ICMP_ECHO_REQUEST) & (header.code == 0)
+                                 & (self.payload_length >= headers.ICMP_MIN_ECHO)),
             self.checksum_ok.eq(fold(self.payload_sum) == 0xFFFF),
             self.checksum.eq(header.checksum),
         ]
@@ -56,4 +51,4 @@ class Checker(wiring.Component):
 
 def reply_checksum(request_checksum):
     """The echo reply's checksum: the request's with the type word 0x0800 taken out (RFC 1624)."""
-    return fold(request_checksum + ((ECHO_REQUEST - ECHO_REPLY) << 8))
+    return fold(request_checksum + ((headers.ICMP_ECHO_REQUEST - headers.ICMP_ECHO_REPLY) << 8))

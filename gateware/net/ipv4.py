@@ -4,26 +4,18 @@ from amaranth import Module, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from ..protocol import fields
-from . import ethernet
+from spec import headers
+from spec.wire import size
+
+from ..wire import to_bytes
 from .checksum import fold, ones_sum, word_add
 from .layouts import OFFSET_BITS
 from .tap import Tap, capture
 
-__all__ = ["HEADER", "PROTOCOL_ICMP", "PROTOCOL_UDP", "MIN_FRAME", "Checker", "header_fields"]
+__all__ = ["Checker", "header_fields"]
 
-HEADER = [("version", 4), ("ihl", 4), ("tos", 8), ("total_length", 16), ("ident", 16),
-          ("flags", 3), ("fragment_offset", 13), ("ttl", 8), ("protocol", 8), ("checksum", 16),
-          ("src", 32), ("dst", 32)]
-PROTOCOL_ICMP = 1
-PROTOCOL_UDP = 17
-FLAG_MF = 0b001
-FLAG_DF = 0b010
-#: Shortest Ethernet frame without FCS; shorter packets arrive padded to it.
-MIN_FRAME = 60
-TTL = 64
-_AT = fields.size(ethernet.HEADER)
-PAYLOAD_AT = _AT + fields.size(HEADER)
+_AT = headers.IPV4_AT
+PAYLOAD_AT = headers.IP_PAYLOAD_AT
 
 
 def _words(raw_bytes):
@@ -69,7 +61,7 @@ class Checker(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         tap = self.tap
-        header = capture(m, tap, _AT, HEADER, "ip")
+        header = capture(m, tap, _AT, headers.IPV4, "ip")
         end = Signal(OFFSET_BITS + 1)
         m.d.comb += end.eq(_AT + header.total_length)
 
@@ -85,26 +77,27 @@ class Checker(wiring.Component):
                 m.d.sync += self.payload_sum.eq(word_add(self.payload_sum, tap.data, ~tap.offset[0]))
 
         m.d.comb += [
-            self.length_ok.eq((header.total_length >= fields.size(HEADER))
-                              & ((tap.length == end) | ((end < MIN_FRAME) & (tap.length == MIN_FRAME)))),
+            self.length_ok.eq((header.total_length >= size(headers.IPV4))
+                              & ((tap.length == end)
+                                 | ((end < headers.MIN_FRAME) & (tap.length == headers.MIN_FRAME)))),
             self.version_ok.eq(header.version == 4),
             self.options.eq(header.ihl != 5),
             self.checksum_ok.eq(fold(header_sum) == 0xFFFF),
-            self.fragment.eq(((header.flags & FLAG_MF) != 0) | (header.fragment_offset != 0)),
+            self.fragment.eq(((header.flags & headers.IP_FLAG_MF) != 0) | (header.fragment_offset != 0)),
             self.dst_ok.eq(header.dst == self.ip),
             self.protocol.eq(header.protocol),
             self.src.eq(header.src),
             self.dst.eq(header.dst),
-            self.payload_length.eq(header.total_length - fields.size(HEADER)),
+            self.payload_length.eq(header.total_length - size(headers.IPV4)),
         ]
         return m
 
 
 def header_fields(protocol, payload_length, ident, src, dst):
     """Fields of a header we send (checksum included): no options, don't fragment."""
-    total = payload_length + fields.size(HEADER)
-    values = {"version": 4, "ihl": 5, "total_length": total, "ident": ident, "flags": FLAG_DF,
-              "ttl": TTL, "protocol": protocol, "src": src, "dst": dst}
-    raw = fields.to_bytes(HEADER, values)
+    total = payload_length + size(headers.IPV4)
+    values = {"version": 4, "ihl": 5, "total_length": total, "ident": ident, "flags": headers.IP_FLAG_DF,
+              "ttl": headers.IP_TTL, "protocol": protocol, "src": src, "dst": dst}
+    raw = to_bytes(headers.IPV4, values)
     values["checksum"] = ~ones_sum(_words(raw))
     return values

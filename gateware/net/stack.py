@@ -1,4 +1,4 @@
-"""The network stack (DESIGN.md block 2): Ethernet, ARP, IPv4, ICMP echo and UDP in ``sync``.
+"""The network stack: Ethernet, ARP, IPv4, ICMP echo and UDP in ``sync``.
 
 Receive is store-and-forward through :class:`~gateware.net.buffer.FrameBuffer`: every byte is
 written as it arrives while the per-protocol checkers (:mod:`.ethernet`, :mod:`.arp`,
@@ -16,8 +16,10 @@ from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.lib.wiring import In, Out, connect
 from amaranth.utils import exact_log2
 
+from spec import headers, records
+
 from ..mac.layouts import ByteBeat
-from ..protocol import fields
+from ..wire import layout
 from . import arp, ethernet, icmp, ipv4, udp
 from .buffer import FrameBuffer
 from .layouts import OFFSET_BITS, BodyByte, Datagram, Peer, ReplyKind, ReplyRequest
@@ -27,7 +29,7 @@ from .transmit import Transmitter
 __all__ = ["Stack", "DROP_CAUSES"]
 
 #: Why a frame was dropped, in the order the checks apply: the first failing one is counted.
-DROP_CAUSES = [name[len("drop_"):] for name, _ in fields.NET_COUNTERS if name.startswith("drop_")]
+DROP_CAUSES = [name[len("drop_"):] for name, _ in records.NET_COUNTERS if name.startswith("drop_")]
 
 
 def descriptor_layout(pointer_bits):
@@ -67,7 +69,7 @@ class Stack(wiring.Component):
     reply_request : In(stream.Signature(ReplyRequest))
     reply_body : In(stream.Signature(BodyByte))
         The application's UDP replies (kind UDP): destination and payload.
-    counters : Out(fields.layout(fields.NET_COUNTERS))
+    counters : Out(layout(records.NET_COUNTERS))
         Frames seen, accepted, dropped per cause, replies sent.
     """
 
@@ -83,7 +85,7 @@ class Stack(wiring.Component):
             "datagrams": Out(stream.Signature(Datagram)),
             "reply_request": In(stream.Signature(ReplyRequest)),
             "reply_body": In(stream.Signature(BodyByte)),
-            "counters": Out(fields.layout(fields.NET_COUNTERS)),
+            "counters": Out(layout(records.NET_COUNTERS)),
         })
 
     def elaborate(self, platform):
@@ -140,8 +142,8 @@ class Stack(wiring.Component):
         start = buffer.frame_start
         # The first failing check names the cause.
         is_ip = eth.is_ipv4
-        is_icmp = ip.protocol == ipv4.PROTOCOL_ICMP
-        is_udp = ip.protocol == ipv4.PROTOCOL_UDP
+        is_icmp = ip.protocol == headers.IP_PROTOCOL_ICMP
+        is_udp = ip.protocol == headers.IP_PROTOCOL_UDP
         checks = [
             (mac_bad, "mac"),
             (buffer.overflow, "overflow"),
@@ -197,13 +199,13 @@ class Stack(wiring.Component):
                 with m.Elif(is_icmp):
                     m.d.sync += [
                         descriptor.kind.eq(ReplyKind.ICMP),
-                        descriptor.addr.eq(start + ipv4.PAYLOAD_AT),
+                        descriptor.addr.eq(start + headers.IP_PAYLOAD_AT),
                         descriptor.length.eq(ip.payload_length),
                     ]
                 with m.Else():
                     m.d.sync += [
                         descriptor.kind.eq(ReplyKind.UDP),
-                        descriptor.addr.eq(start + udp.PAYLOAD_AT),
+                        descriptor.addr.eq(start + headers.UDP_PAYLOAD_AT),
                         descriptor.length.eq(udp_check.data_length),
                     ]
                 m.next = "COMMIT"
@@ -287,7 +289,7 @@ class Stack(wiring.Component):
                     ]
                     with m.Switch(index):
                         with m.Case(0):
-                            m.d.comb += body.payload.data.eq(icmp.ECHO_REPLY)
+                            m.d.comb += body.payload.data.eq(headers.ICMP_ECHO_REPLY)
                         with m.Case(2):
                             m.d.comb += body.payload.data.eq(reply_checksum[8:])
                         with m.Case(3):

@@ -4,7 +4,9 @@ from amaranth import Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import Out
 
-from ..protocol import fields
+from spec.wire import size
+
+from ..wire import byte_slice, layout
 from .layouts import OFFSET_BITS
 
 __all__ = ["Tap", "capture"]
@@ -35,11 +37,11 @@ class Tap(wiring.Signature):
 
 def capture(m, tap, at, table, name):
     """A register holding the header ``table`` found at byte ``at`` of the frame, as a struct
-    view (see :func:`gateware.protocol.fields.layout`). It loads as the bytes pass and keeps its
+    view (see :func:`gateware.wire.layout`). It loads as the bytes pass and keeps its
     value until the same offset of the next frame."""
-    n = fields.size(table)
-    header = Signal(fields.layout(table), name=name)
+    n = size(table)
+    header = Signal(layout(table), name=name)
     for i in range(n):
         with m.If(tap.valid & (tap.offset == at + i)):
-            m.d.sync += fields.byte_slice(header.as_value(), n, i, 1).eq(tap.data)
+            m.d.sync += byte_slice(header.as_value(), n, i, 1).eq(tap.data)
     return header

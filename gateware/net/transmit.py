@@ -9,9 +9,12 @@ from amaranth import Array, Cat, Module, Mux, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 
+from spec import headers
+from spec.wire import size
+
 from ..mac.layouts import ByteBeat
-from ..protocol import fields
-from . import arp, ethernet, ipv4, udp
+from ..wire import to_bytes
+from . import arp, ipv4
 from .layouts import BodyByte, ReplyKind, ReplyRequest
 
 __all__ = ["Transmitter"]
@@ -57,22 +60,22 @@ class Transmitter(wiring.Component):
 
         is_arp = request.kind == ReplyKind.ARP
         is_udp = request.kind == ReplyKind.UDP
-        ip_payload = Mux(is_udp, request.length + fields.size(udp.HEADER), request.length)
-        eth_bytes = fields.to_bytes(ethernet.HEADER, {
+        ip_payload = Mux(is_udp, request.length + size(headers.UDP), request.length)
+        eth_bytes = to_bytes(headers.ETHERNET, {
             "dst": request.peer.mac, "src": self.mac,
-            "ethertype": Mux(is_arp, ethernet.ETHERTYPE_ARP, ethernet.ETHERTYPE_IPV4)})
-        arp_bytes = fields.to_bytes(arp.PACKET, arp.reply_fields(self.mac, self.ip, request.peer))
-        ip_bytes = fields.to_bytes(ipv4.HEADER, ipv4.header_fields(
-            Mux(is_udp, ipv4.PROTOCOL_UDP, ipv4.PROTOCOL_ICMP), ip_payload, ident, self.ip,
+            "ethertype": Mux(is_arp, headers.ETHERTYPE_ARP, headers.ETHERTYPE_IPV4)})
+        arp_bytes = to_bytes(headers.ARP, arp.reply_fields(self.mac, self.ip, request.peer))
+        ip_bytes = to_bytes(headers.IPV4, ipv4.header_fields(
+            Mux(is_udp, headers.IP_PROTOCOL_UDP, headers.IP_PROTOCOL_ICMP), ip_payload, ident, self.ip,
             request.peer.ip))
-        udp_bytes = fields.to_bytes(udp.HEADER, {
+        udp_bytes = to_bytes(headers.UDP, {
             "src_port": self.port, "dst_port": request.peer.port,
-            "length": request.length + fields.size(udp.HEADER)})
+            "length": request.length + size(headers.UDP)})
         # An ARP packet is as long as the IPv4 and UDP headers together: one 42-byte header table.
         header = Array([*eth_bytes, *(Mux(is_arp, a, b)
                                       for a, b in zip(arp_bytes, ip_bytes + udp_bytes, strict=True))])
         header_end = Mux(request.kind == ReplyKind.ICMP,
-                         fields.size(ethernet.HEADER) + fields.size(ipv4.HEADER), len(header))
+                         headers.IP_PAYLOAD_AT, len(header))
 
         with m.FSM():
             with m.State("IDLE"):

@@ -4,16 +4,15 @@ from amaranth import Module, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from ..protocol import fields
-from . import ethernet, ipv4
+from spec import headers
+from spec.wire import offsets, size
+
 from .checksum import fold, word_add
 from .layouts import OFFSET_BITS
 from .tap import Tap, capture
 
-__all__ = ["HEADER", "PAYLOAD_AT", "Checker"]
+__all__ = ["Checker"]
 
-HEADER = [("src_port", 16), ("dst_port", 16), ("length", 16), ("checksum", 16)]
-PAYLOAD_AT = ipv4.PAYLOAD_AT + fields.size(HEADER)
 
 
 class Checker(wiring.Component):
@@ -49,25 +48,25 @@ class Checker(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        header = capture(m, self.tap, ipv4.PAYLOAD_AT, HEADER, "udp")
+        header = capture(m, self.tap, headers.IP_PAYLOAD_AT, headers.UDP, "udp")
         # The pseudo-header's addresses and UDP length, summed as their bytes pass (the
         # protocol number is a constant).
         pseudo = Signal(20)
         tap = self.tap
-        addresses = fields.offsets(ipv4.HEADER)["src"] + fields.size(ethernet.HEADER)
-        length_at = ipv4.PAYLOAD_AT + fields.offsets(HEADER)["length"]
+        addresses = offsets(headers.IPV4)["src"] + headers.IPV4_AT
+        length_at = headers.IP_PAYLOAD_AT + offsets(headers.UDP)["length"]
         with m.If(tap.valid):
             with m.If(tap.offset == 0):
-                m.d.sync += pseudo.eq(ipv4.PROTOCOL_UDP)
+                m.d.sync += pseudo.eq(headers.IP_PROTOCOL_UDP)
             with m.Elif(((tap.offset >= addresses) & (tap.offset < addresses + 8))
                         | (tap.offset == length_at) | (tap.offset == length_at + 1)):
                 m.d.sync += pseudo.eq(word_add(pseudo, tap.data, ~tap.offset[0]))
         m.d.comb += [
-            self.length_ok.eq((header.length > fields.size(HEADER))
+            self.length_ok.eq((header.length > size(headers.UDP))
                               & (header.length == self.payload_length)),
             self.port_ok.eq(header.dst_port == self.port),
             self.checksum_ok.eq((header.checksum == 0) | (fold(self.payload_sum + pseudo) == 0xFFFF)),
             self.src_port.eq(header.src_port),
-            self.data_length.eq(header.length - fields.size(HEADER)),
+            self.data_length.eq(header.length - size(headers.UDP)),
         ]
         return m

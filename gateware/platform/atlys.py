@@ -3,7 +3,7 @@ projector's board: amaranth-boards' platform plus the DLPC410 adapter and trigge
 
 from amaranth_boards.atlys import AtlysPlatform
 
-from constraints.dlpc410_adapter import dlpc410_resources, trigger_resources
+from .dlpc410_adapter import dlpc410_resources, trigger_resources
 
 __all__ = ["AtlysProjectorPlatform"]
 

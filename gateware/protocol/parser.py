@@ -14,19 +14,21 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2, exact_log2
 
-from ..bitplane import pixel_layout
-from ..dlpc410.params import Registers
+from spec import records, wire
+from spec.records import RecordType
+
 from ..net.layouts import OFFSET_BITS, Datagram, Peer
-from . import fields
-from .fields import RecordType
+from ..registers import Registers, wire_registers
+from ..wire import byte_slice, layout
+from .layouts import pixel_layout
 
 __all__ = ["Parser", "Query", "config_init", "CONFIG_LAYOUT"]
 
-CONFIG_LAYOUT = fields.layout(fields.CONFIG)
-_HEADER = fields.size(fields.HEADER)
-_IMAGE_END = _HEADER + fields.size(fields.IMAGE)
-_CONTROL_END = _HEADER + fields.size(fields.CONTROL)
-_SEQUENCER_END = _HEADER + fields.size(fields.SEQUENCER)
+CONFIG_LAYOUT = layout(records.CONFIG)
+_HEADER = wire.size(records.HEADER)
+_IMAGE_END = _HEADER + wire.size(records.IMAGE)
+_CONTROL_END = _HEADER + wire.size(records.CONTROL)
+_SEQUENCER_END = _HEADER + wire.size(records.SEQUENCER)
 _CAPTURED = max(_IMAGE_END, _CONTROL_END, _SEQUENCER_END)
 
 
@@ -47,7 +49,7 @@ class Parser(wiring.Component):
 
     Parameters
     ----------
-    dmd : :class:`gateware.dlpc410.facts.DmdType`
+    dmd : :class:`spec.facts.DmdType`
         Rows and columns that image records must fit.
     config : dict
         Initial configuration (:func:`config_init`).
@@ -60,7 +62,7 @@ class Parser(wiring.Component):
         Committed UDP payloads from :class:`gateware.net.stack.Stack`.
     pixels : Out(stream.Signature(pixel_layout(dmd, 1, frame_bits)))
         The rows of valid image records, one 8-bit pixel per transfer, left to right.
-    settings : Out(fields.layout(fields.CONFIG))
+    settings : Out(layout(records.CONFIG))
         The configuration registers; control records update the fields they select.
     registers : Out(stream.Signature(Registers))
         The register set of each valid sequencer record, one transfer per record (the parser
@@ -69,7 +71,7 @@ class Parser(wiring.Component):
         One-cycle pulse for a control record with the software-trigger action.
     queries : Out(stream.Signature(Query))
         Valid status queries, for the status reply.
-    counters : Out(fields.layout(fields.APP_COUNTERS))
+    counters : Out(layout(records.APP_COUNTERS))
         Records accepted per type, dropped per cause, sequence gaps, rows and bytes handed on.
     """
 
@@ -83,7 +85,7 @@ class Parser(wiring.Component):
             "trigger": Out(1),
             "registers": Out(stream.Signature(Registers)),
             "queries": Out(stream.Signature(Query)),
-            "counters": Out(fields.layout(fields.APP_COUNTERS)),
+            "counters": Out(layout(records.APP_COUNTERS)),
         })
 
     def elaborate(self, platform):
@@ -98,13 +100,13 @@ class Parser(wiring.Component):
         captured = Signal(8 * _CAPTURED)
 
         def part(table, first):
-            return data.View(fields.layout(table),
-                             fields.byte_slice(captured, _CAPTURED, first, fields.size(table)))
-        header = part(fields.HEADER, 0)
-        image = part(fields.IMAGE, _HEADER)
-        control = part(fields.CONTROL, _HEADER)
-        sequencer = part(fields.SEQUENCER, _HEADER)
-        m.d.comb += self.registers.payload.eq(fields.wire_registers(sequencer))
+            return data.View(layout(table),
+                             byte_slice(captured, _CAPTURED, first, wire.size(table)))
+        header = part(records.HEADER, 0)
+        image = part(records.IMAGE, _HEADER)
+        control = part(records.CONTROL, _HEADER)
+        sequencer = part(records.SEQUENCER, _HEADER)
+        m.d.comb += self.registers.payload.eq(wire_registers(sequencer))
         peer = Signal(Peer)
         length = Signal(OFFSET_BITS)
 
@@ -115,7 +117,7 @@ class Parser(wiring.Component):
                 m.d.sync += captured.eq(beat.data << 8 * (_CAPTURED - 1))
             for i in range(1, _CAPTURED):
                 with m.If(index == i):
-                    m.d.sync += fields.byte_slice(captured, _CAPTURED, i, 1).eq(beat.data)
+                    m.d.sync += byte_slice(captured, _CAPTURED, i, 1).eq(beat.data)
             with m.If(index == 0):
                 m.d.sync += [peer.eq(beat.peer), length.eq(beat.length)]
 
@@ -135,13 +137,13 @@ class Parser(wiring.Component):
 
         cause = Signal(range(8))
         causes = ["magic", "version", "type", "empty", "length", "rows", "value"]
-        names = [name for name, _ in fields.CONFIG]
+        names = [name for name, _ in records.CONFIG]
 
         def applies(name):
             return control.apply[names.index(name)]
-        with m.If(header.magic != fields.MAGIC):
+        with m.If(header.magic != records.MAGIC):
             m.d.comb += cause.eq(1 + causes.index("magic"))
-        with m.Elif(header.version != fields.VERSION):
+        with m.Elif(header.version != records.VERSION):
             m.d.comb += cause.eq(1 + causes.index("version"))
         with m.Elif((header.type != RecordType.IMAGE) & (header.type != RecordType.CONTROL)
                     & (header.type != RecordType.STATUS_QUERY) & (header.type != RecordType.SEQUENCER)):
@@ -163,7 +165,7 @@ class Parser(wiring.Component):
                        | (applies("sequence_length") & (control.sequence_length == 0)))):
             m.d.comb += cause.eq(1 + causes.index("value"))
         with m.Elif((header.type == RecordType.SEQUENCER)
-                    & Cat(fields.register_faults(sequencer, dmd.dclk_per_row).values()).any()):
+                    & Cat(records.register_faults(sequencer, dmd.dclk_per_row).values()).any()):
             m.d.comb += cause.eq(1 + causes.index("value"))
 
         sequence_seen = Signal()
@@ -198,11 +200,11 @@ class Parser(wiring.Component):
                             m.next = "PIXELS"
                         with m.Case(RecordType.CONTROL):
                             bump("records_control")
-                            for i, (name, _) in enumerate(fields.CONFIG):
+                            for i, (name, _) in enumerate(records.CONFIG):
                                 with m.If(control.apply[i]):
                                     m.d.sync += self.settings[name].eq(control[name])
                             m.d.sync += self.trigger.eq(
-                                (control.action & fields.Action.SOFTWARE_TRIGGER) != 0)
+                                (control.action & records.Action.SOFTWARE_TRIGGER) != 0)
                             m.next = "DISCARD"
                         with m.Case(RecordType.SEQUENCER):
                             bump("records_sequencer")

@@ -4,14 +4,16 @@ from amaranth import Cat, Module, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 
+from spec import records, wire
+from spec.records import RecordType
+
 from ..net.layouts import BodyByte, Peer, ReplyKind, ReplyRequest
-from . import fields
-from .fields import RecordType
+from ..wire import layout, to_bytes
 from .parser import Query
 
 __all__ = ["StatusReply", "REPLY_LENGTH"]
 
-REPLY_LENGTH = fields.size(fields.HEADER) + fields.size(fields.STATUS_REPLY)
+REPLY_LENGTH = wire.size(records.HEADER) + wire.size(records.STATUS_REPLY)
 
 
 class StatusReply(wiring.Component):
@@ -22,9 +24,9 @@ class StatusReply(wiring.Component):
     Members
     -------
     queries : In(stream.Signature(Query))
-    net : In(fields.layout(fields.NET_COUNTERS))
-    app : In(fields.layout(fields.APP_COUNTERS))
-    system : In(fields.layout(fields.SYSTEM_STATUS))
+    net : In(layout(records.NET_COUNTERS))
+    app : In(layout(records.APP_COUNTERS))
+    system : In(layout(records.SYSTEM_STATUS))
     request : Out(stream.Signature(ReplyRequest))
         A UDP reply to the asker, ``REPLY_LENGTH`` bytes.
     body : Out(stream.Signature(BodyByte))
@@ -32,21 +34,21 @@ class StatusReply(wiring.Component):
     """
 
     queries: In(stream.Signature(Query))
-    net: In(fields.layout(fields.NET_COUNTERS))
-    app: In(fields.layout(fields.APP_COUNTERS))
-    system: In(fields.layout(fields.SYSTEM_STATUS))
+    net: In(layout(records.NET_COUNTERS))
+    app: In(layout(records.APP_COUNTERS))
+    system: In(layout(records.SYSTEM_STATUS))
     request: Out(stream.Signature(ReplyRequest))
     body: Out(stream.Signature(BodyByte))
 
     def elaborate(self, platform):
         m = Module()
         query = self.queries.payload
-        values = {"magic": fields.MAGIC, "version": fields.VERSION, "type": RecordType.STATUS_REPLY,
+        values = {"magic": records.MAGIC, "version": records.VERSION, "type": RecordType.STATUS_REPLY,
                   "length": REPLY_LENGTH, "sequence": query.sequence}
-        for source, table in ((self.net, fields.NET_COUNTERS), (self.app, fields.APP_COUNTERS),
-                              (self.system, fields.SYSTEM_STATUS)):
+        for source, table in ((self.net, records.NET_COUNTERS), (self.app, records.APP_COUNTERS),
+                              (self.system, records.SYSTEM_STATUS)):
             values.update({name: source[name] for name, _ in table})
-        record = Cat(*fields.to_bytes(fields.HEADER + fields.STATUS_REPLY, values))
+        record = Cat(*to_bytes(records.HEADER + records.STATUS_REPLY, values))
         snapshot = Signal(len(record))
         peer = Signal(Peer)
         index = Signal(range(REPLY_LENGTH))

@@ -1,4 +1,4 @@
-"""The plane reader (DESIGN.md block 6): planes out of DDR2 for the sequencer (``dmd`` domain).
+"""The plane reader: planes out of DDR2 for the sequencer (``dmd`` domain).
 
 A :class:`~gateware.store.layouts.PlaneRequest` names a slot, a plane and a run of rows; the
 rows of a plane are one contiguous run of memory (:mod:`gateware.store.addresses`), so the
@@ -32,7 +32,7 @@ class Reader(wiring.Component):
 
     Parameters
     ----------
-    dmd : :class:`gateware.dlpc410.facts.DmdType`
+    dmd : :class:`spec.facts.DmdType`
     slots : int
         Frame slots in the memory (the address map).
     fifo_depth : int

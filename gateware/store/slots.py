@@ -41,6 +41,7 @@ from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
 
 from gateware.bitplane.serialiser import row_flags_layout, word_layout
+
 from .addresses import PLANES
 from .layouts import BLOCK_BITS, SLOT_BITS, FrameInfo, OccupancySignature
 from .writer import write_word_layout
@@ -80,7 +81,7 @@ class FrameSlots(wiring.Component):
 
     Parameters
     ----------
-    dmd : :class:`gateware.dlpc410.facts.DmdType`
+    dmd : :class:`spec.facts.DmdType`
     slots : int
         Frame slots (3 to 16).
     frame_bits : int

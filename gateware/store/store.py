@@ -11,6 +11,7 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from gateware.bitplane.serialiser import row_flags_layout, word_layout
+
 from . import mcb
 from .layouts import SLOT_BITS, FrameInfo, OccupancySignature, PlaneRequest
 from .reader import Reader
@@ -25,7 +26,7 @@ class Store(wiring.Component):
 
     Parameters
     ----------
-    dmd : :class:`gateware.dlpc410.facts.DmdType`
+    dmd : :class:`spec.facts.DmdType`
     slots : int
         Frame slots (3..16).
     frame_bits : int

@@ -1,4 +1,4 @@
-"""The DDR2 writer (DESIGN.md block 5): plane words in, MCB write bursts out (``sync`` domain).
+"""The DDR2 writer: plane words in, MCB write bursts out (``sync`` domain).
 
 The serialiser emits the eight planes of every 64-pixel run in turn, but DDR2 keeps planes apart
 (:mod:`gateware.store.addresses`). The writer therefore gathers rows in a buffer and then writes
@@ -51,7 +51,7 @@ class Writer(wiring.Component):
 
     Parameters
     ----------
-    dmd : :class:`gateware.dlpc410.facts.DmdType`
+    dmd : :class:`spec.facts.DmdType`
         Geometry (words per row, rows).
     slots : int
         Frame slots in the memory (the address map).

@@ -14,9 +14,9 @@ from amaranth.lib.fifo import AsyncFIFO
 
 from gateware.bitplane import Serialiser
 from gateware.dlpc410 import beat
-from gateware.dlpc410.facts import DMDS
 from gateware.platform.clocks import Spartan6Clocks
 from gateware.platform.pins import Dlpc410Pins, TriggerPins
+from spec.facts import DMDS
 
 __all__ = ["BringupTop"]
 

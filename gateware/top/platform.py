@@ -7,12 +7,12 @@ Everything vendor-specific lives here and in :mod:`gateware.platform`; the core
 from amaranth import ClockDomain, Elaboratable, Module
 from amaranth.lib import io, wiring
 
-from gateware.dlpc410 import schedule
-from gateware.dlpc410.facts import DMDS
-from gateware.dlpc410.params import Registers
 from gateware.platform.clocks import Spartan6Clocks
 from gateware.platform.mcb_instance import McbInstance
 from gateware.platform.pins import Dlpc410Pins, GmiiPins, TriggerPins
+from gateware.registers import Registers
+from spec import schedule
+from spec.facts import DMDS
 
 from .system import Projector
 
@@ -35,7 +35,7 @@ class PlatformTop(Elaboratable):
     Parameters
     ----------
     dmd : str
-        DMD name in :data:`gateware.dlpc410.facts.DMDS`.
+        DMD name in :data:`spec.facts.DMDS`.
     """
 
     def __init__(self, dmd="dlp7000"):

@@ -2,7 +2,7 @@
 
 Layers, as data flows through them (one banner each below):
 
-* Ethernet (:class:`gateware.net.port.EthernetPort`): the MAC in ``gmii_rx`` / ``gmii_tx``, its
+* Ethernet (:class:`gateware.protocol.port.EthernetPort`): the MAC in ``gmii_rx`` / ``gmii_tx``, its
   FIFOs into ``sync``, the network stack and the application protocol;
 * bit-plane serialiser and the store's writer (``sync``), DDR2 through MCB port 0;
 * the store's slots and plane reader (``dmd``), MCB port 1;
@@ -20,18 +20,17 @@ from amaranth.lib.cdc import FFSynchronizer, PulseSynchronizer
 from amaranth.lib.wiring import In, Out
 
 from gateware.bitplane import Serialiser
+from gateware.cdc import CountSynchronizer
 from gateware.dlpc410 import interface
-from gateware.dlpc410.params import TriggerMode
+from gateware.dlpc410.register_crossing import RegisterCrossing
 from gateware.dlpc410.sequencer import Sequencer
 from gateware.mac import gmii
-from gateware.mac.cdc import CountSynchronizer
 from gateware.mac.mdio import StatusPoller
-from gateware.net.port import EthernetPort
+from gateware.protocol.port import EthernetPort
+from gateware.registers import TriggerMode
 from gateware.store import mcb
+from gateware.store.broker import FrameBroker
 from gateware.store.store import Store
-
-from .broker import FrameBroker
-from .control import RegisterCrossing
 
 __all__ = ["Projector"]
 
@@ -46,8 +45,8 @@ class Projector(wiring.Component):
     dmd : DmdType
     mac, ip, port : int
         Network addresses at reset.
-    regs : dict or :class:`amaranth.lib.data.Const` of :class:`gateware.dlpc410.params.Registers`
-        The sequencer's registers at reset (for example a :func:`gateware.dlpc410.schedule.plan`'s
+    regs : dict or :class:`amaranth.lib.data.Const` of :class:`gateware.registers.Registers`
+        The sequencer's registers at reset (for example a :func:`spec.schedule.plan`'s
         ``params.registers(dmd)``); sequencer records replace them at run time.
     armed : bool
         Whether triggers reach the sequencer at reset; control records arm and disarm.

@@ -1,6 +1,6 @@
 """Benchmarks: each module here has ``run() -> {figure name: (value, unit)}``.
 
-``make bench`` (``python -m gateware bench``) runs every module listed in :data:`MODULES`, adds
+``make bench`` (``python -m flow bench``) runs every module listed in :data:`MODULES`, adds
 the resource figures and writes ``build/bench.json``. Figures are measured, never written down:
 each comes from a simulation or a synthesis run made by the benchmark itself.
 """

@@ -3,9 +3,9 @@
 import numpy as np
 
 from gateware.bitplane import Serialiser
-from gateware.dlpc410.facts import DMDS
 from sim.harness.amaranth_sim import simulate
 from sim.models import bitplane, serialiser_stim
+from spec.facts import DMDS
 
 
 def serialiser_throughput(lanes=8, rows=8, dmd="dlp7000"):

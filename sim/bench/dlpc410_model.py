@@ -8,11 +8,11 @@ import time
 
 import numpy as np
 
-from gateware.dlpc410.facts import DMDS
 from sim.models import bitplane
 from sim.models.camera import Camera
 from sim.models.dlpc410 import Dlpc410
 from sim.models.dlpc410_driver import Driver, expand
+from spec.facts import DMDS
 
 
 def _rate(count, func):

@@ -1,12 +1,12 @@
 """Ethernet ingest figures.
 
-End to end (:func:`port_at_line_rate`): the whole Ethernet side (:class:`gateware.net.port.
+End to end (:func:`port_at_line_rate`): the whole Ethernet side (:class:`gateware.protocol.port.
 EthernetPort`, GMII MAC + stack + protocol) as generated Verilog under Verilator and cocotb,
 XGA image records in jumbo frames back to back at the minimum gap on the GMII receive pins
 (:mod:`sim.tb.ethernet_bench`). This gives the payload rate, the XGA image rate, the drops and
 the commit latency.
 
-Stack alone (:func:`ingest_at_line_rate`, Amaranth simulator): the ingest block fed at GMII
+Stack alone (:func:`endpoint_at_line_rate`, Amaranth simulator): the endpoint fed at GMII
 timing: one byte per cycle, and between frames the 8 preamble/SFD, 4 FCS and 12 inter-frame gap
 cycles the line spends on them (24 idle cycles). The consumer of the pixels never stalls.
 """
@@ -15,26 +15,27 @@ import json
 
 import numpy as np
 
-from gateware.dlpc410.facts import DMDS
-from host import records
+from host import codec
 from sim.harness import cocotb_run
 from sim.harness.paths import build_dir
-from sim.models import frames, ingest_sim
+from sim.models import frames
+from sim.tb import endpoint_sim
+from spec.facts import DMDS
 
 #: Line cycles per frame that carry no frame byte: preamble + SFD, FCS, inter-frame gap.
 GMII_OVERHEAD = 8 + 4 + 12
 LINE_RATE = 125e6  # bytes per second on gigabit GMII
 
 
-def ingest_at_line_rate(records_count=6, dmd="dlp7000"):
+def endpoint_at_line_rate(records_count=6, dmd="dlp7000"):
     geometry = DMDS[dmd]
-    rows = records.rows_per_record(geometry.columns)
+    rows = codec.rows_per_record(geometry.columns)
     image = np.random.default_rng(0).integers(0, 256, (rows * records_count, geometry.columns),
                                               dtype=np.uint8)
-    encoded = records.image_records(image, 1)
+    encoded = codec.image_records(image, 1)
     a = frames.Addresses()
     sequence = [(frames.udp(a, record), False) for record in encoded]
-    out = ingest_sim.run(sequence, name="bench_net_line_rate", dmd=geometry, gap=(GMII_OVERHEAD,) * 2,
+    out = endpoint_sim.run(sequence, name="bench_net_line_rate", dmd=geometry, gap=(GMII_OVERHEAD,) * 2,
                          waves=False, settle=50)
     assert out["app"]["payload_bytes"] == len(out["pixels"]) == image.size
     # Steady state: the records leave one after another, so the payload rate is the payload of
@@ -60,7 +61,7 @@ def port_at_line_rate(records_count=None, sync_ps=8000):
     records (default: one whole 1024x768 image). Returns its figures."""
     from sim.tb.ethernet_pins import TOPLEVEL, build
     xga = DMDS["dlp7000"]
-    records_count = records_count or xga.rows // records.rows_per_record(xga.columns)
+    records_count = records_count or xga.rows // codec.rows_per_record(xga.columns)
     out = build_dir("bench") / "ethernet_port_line_rate.json"
     out.unlink(missing_ok=True)
     cocotb_run.run(build("dlp7000"), toplevel=TOPLEVEL, module="sim.tb.ethernet_bench", key="dlp7000",
@@ -73,7 +74,7 @@ def run():
     :mod:`sim.tb.ethernet_bench` for the two events it spans (the largest over all records)."""
     port = port_at_line_rate()
     fraction = port["payload_bytes"] / port["line_bytes"]
-    stack = ingest_at_line_rate()
+    stack = endpoint_at_line_rate()
     xga = DMDS["dlp7000"]
     return {
         "eth.payload_fraction_of_line_rate": (fraction, "fraction"),

@@ -24,9 +24,6 @@ import csv
 
 import numpy as np
 
-from gateware.dlpc410 import schedule
-from gateware.dlpc410.facts import DMDS, TEST_DMD
-from gateware.dlpc410.params import ResetMode, Source
 from gateware.dlpc410.trigger import PIN_TO_STROBE
 from sim.harness.paths import build_dir
 from sim.models.camera import Camera, to_lsb
@@ -34,9 +31,12 @@ from sim.models.dlpc410 import Dlpc410
 from sim.models.dlpc410_driver import Driver, play_schedule
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import run_bench
+from spec import schedule
+from spec.facts import DMDS, TEST_DMD
+from spec.registers import ResetMode, Source
 
 XGA = DMDS["dlp7000"]
-#: DDR2 read bandwidth that feeds row loads (DLPC410.md "Derived bounds": 1.3 GB/s).
+#: DDR2 read bandwidth assumed to feed row loads in the model figures (the seed design's 1.3 GB/s).
 DDR2_BYTES_PER_S = 1.3e9
 FAST = {"t_rst_s": 20 / 200e6, "t_settle_s": 30 / 200e6}
 

@@ -10,12 +10,12 @@ word in memory, over whole DLP7000 rows. ``store.read_words_per_dmd_cycle``: the
 
 import numpy as np
 
-from gateware.dlpc410.facts import DMDS
 from gateware.store.reader import Reader
 from sim.harness.amaranth_sim import simulate
 from sim.models import bitplane, serialiser_stim
 from sim.models.mcb import McbModel, McbTiming, amaranth_process
 from sim.tb.store_chain import StoreChain
+from spec.facts import DMDS
 
 SYNC_HZ, DMD_HZ = 125e6, 200e6
 

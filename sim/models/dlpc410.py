@@ -44,12 +44,12 @@ Assumptions where the TI documents are uncertain (see also ``docs/dlpc410_model.
   ROWMD, ROWAD, BLKMD, BLKAD and RST2BLKZ they must be held through the row cycle.
 * Block commands (refHDL, confidence medium): dual and quad groups that reach past the last block
   (DLP9500 has 15) pulse the blocks that exist; a group with none is a block-address break.
-* A clear occupies ``clear_row_cycles`` row cycles (:mod:`~gateware.dlpc410.facts`): its own,
+* A clear occupies ``clear_row_cycles`` row cycles (:mod:`~spec.facts`): its own,
   whose ROWMD must be 00, then no-op rows (ROWMD 00, no second clear, no pulse of the block
   being cleared; a pulse of other blocks may ride on them). Idle gaps do not count.
-* Open question of DLPC410.md: with ``strict_rst_active`` (default) no pulse may start while
-  RST_ACTIVE is high; with it off, a pulse may start while RST_ACTIVE is high from a pulse of
-  other blocks, never of its own blocks.
+* Open question (facts ``t_rst_active``; ``docs/dlpc410_model.md``): with ``strict_rst_active``
+  (default) no pulse may start while RST_ACTIVE is high; with it off, a pulse may start while
+  RST_ACTIVE is high from a pulse of other blocks, never of its own blocks.
 * Settle: any write (row or clear) to a block from its pulse until ``settle_cycles`` after its
   RST_ACTIVE fell breaks the rule, whether or not the data differ.
 * Initialisation: INIT_ACTIVE is high while ARSTZ is low and for ``init_cycles`` after ARSTZ
@@ -72,7 +72,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gateware.dlpc410.beat import PINS_PER_BUS, lanes_to_word
-from gateware.dlpc410.facts import TIMING, BlockMode, RowMode
+from spec.facts import TIMING, BlockMode, RowMode
 
 __all__ = ["Rule", "RULES", "RuleBreak", "Command", "Dlpc410", "timing_cycles",
            "INPUTS", "OUTPUTS", "amaranth_process", "CocotbAdapter"]
@@ -127,7 +127,7 @@ def _held(signals):
 
 
 def timing_cycles(dclk):
-    """The timing rules of :data:`gateware.dlpc410.facts.TIMING` in cycles of ``dclk`` Hz,
+    """The timing rules of :data:`spec.facts.TIMING` in cycles of ``dclk`` Hz,
     rounded up (never laxer than the fact)."""
     def cycles(key):
         return math.ceil(round(TIMING[key].value * dclk, 6))
@@ -167,7 +167,7 @@ class Dlpc410:
 
     Parameters
     ----------
-    dmd : gateware.dlpc410.facts.DmdType
+    dmd : spec.facts.DmdType
     dclk : float
         DCLK in Hz; the timing defaults are the facts at this rate (:func:`timing_cycles`).
     rst_active_cycles, settle_cycles, init_cycles, init_to_dvalid_clocks : int, optional
@@ -552,7 +552,7 @@ class Dlpc410:
     # --- the log as the schedule model speaks it -----------------------------------------------
 
     def commands(self, shift=0):
-        """:attr:`log` as the command tuples of :mod:`gateware.dlpc410.schedule`:
+        """:attr:`log` as the command tuples of :mod:`spec.schedule`:
         ``(cycle + shift, "row", row)``, ``(.., "clear", block)`` and ``(.., "pulse", blocks)``,
         in cycle order (``shift`` maps model cycles to the sequencer's time base)."""
         out = []

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gateware.dlpc410.beat import PINS_PER_BUS, word_to_lanes
-from gateware.dlpc410.facts import BlockMode, RowMode
+from spec.facts import BlockMode, RowMode
 
 __all__ = ["Idle", "Driver", "row_words", "expand"]
 
@@ -145,12 +145,12 @@ class Driver:
 
 
 def play_schedule(driver, dmd, p, result, images, offset):
-    """Append the command stream of a :func:`gateware.dlpc410.schedule.simulate` ``result`` to
+    """Append the command stream of a :func:`spec.schedule.simulate` ``result`` to
     ``driver``: schedule cycle ``t`` becomes driver cycle ``t + offset`` (asserted, so a gap the
     schedule leaves odd or too short shows here). Each row carries the plane its group's next
     pulse shows (``images[frame index]``, 8-bit; zeros after the group's last pulse); dark pulses
     show cleared blocks."""
-    from gateware.dlpc410.schedule import groups, pulse_encoding
+    from spec.schedule import groups, pulse_encoding
 
     grp = groups(dmd, p.reset_mode)
     group_of = {b: g for g, blocks in enumerate(grp) for b in blocks}

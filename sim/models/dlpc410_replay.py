@@ -14,7 +14,7 @@ from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from gateware.dlpc410 import interface
-from gateware.dlpc410.facts import TEST_DMD
+from spec.facts import TEST_DMD
 
 from .dlpc410_driver import Driver, expand
 

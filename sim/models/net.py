@@ -1,4 +1,4 @@
-"""Reference model of the ingest block (network stack + application protocol), in plain Python.
+"""Reference model of the endpoint (network stack + application protocol), in plain Python.
 
 It reads frames byte by byte with its own parsing (only the application field tables are shared
 with the gateware, as the protocol's single definition) and predicts, frame by frame, every
@@ -7,8 +7,8 @@ counter, every image row handed on, every configuration change and every reply.
 
 from dataclasses import dataclass, field
 
-from gateware.protocol import fields
-from gateware.protocol.fields import RecordType
+from spec import records, wire
+from spec.records import RecordType
 
 __all__ = ["Model", "ones_sum", "BROADCAST"]
 
@@ -43,7 +43,7 @@ class Model:
     _sequence: int | None = None
 
     def __post_init__(self):
-        for name, _ in fields.NET_COUNTERS + fields.APP_COUNTERS:
+        for name, _ in records.NET_COUNTERS + records.APP_COUNTERS:
             self.counters.setdefault(name, 0)
         from gateware.protocol.parser import config_init
         self.config = {k: int(v) for k, v in config_init(mac=self.mac, ip=self.ip, port=self.port).items()}
@@ -134,21 +134,21 @@ class Model:
         return outcome
 
     def _record(self, data, peer):
-        header_size = fields.size(fields.HEADER)
-        image_end = header_size + fields.size(fields.IMAGE)
-        control_end = header_size + fields.size(fields.CONTROL)
-        sequencer_end = header_size + fields.size(fields.SEQUENCER)
+        header_size = wire.size(records.HEADER)
+        image_end = header_size + wire.size(records.IMAGE)
+        control_end = header_size + wire.size(records.CONTROL)
+        sequencer_end = header_size + wire.size(records.SEQUENCER)
         padded = data + bytes(max(0, max(image_end, control_end, sequencer_end) - len(data)))
-        head = fields.unpack(fields.HEADER, padded)
-        image = fields.unpack(fields.IMAGE, padded[header_size:])
+        head = wire.unpack(records.HEADER, padded)
+        image = wire.unpack(records.IMAGE, padded[header_size:])
         kind = head["type"]
         needed = {RecordType.IMAGE: image_end, RecordType.CONTROL: control_end,
                   RecordType.SEQUENCER: sequencer_end}.get(kind, header_size)
-        expected = fields.image_record_length(image["row_count"], self.dmd.columns) \
+        expected = records.image_record_length(image["row_count"], self.dmd.columns) \
             if kind == RecordType.IMAGE else needed
-        if head["magic"] != fields.MAGIC:
+        if head["magic"] != records.MAGIC:
             return "drop_app_magic"
-        if head["version"] != fields.VERSION:
+        if head["version"] != records.VERSION:
             return "drop_app_version"
         if kind not in (RecordType.IMAGE, RecordType.CONTROL, RecordType.STATUS_QUERY, RecordType.SEQUENCER):
             return "drop_app_type"
@@ -164,8 +164,8 @@ class Model:
                                          or image["row_bytes"] != self.dmd.columns):
             return "drop_app_rows"
         if kind == RecordType.CONTROL:
-            control = fields.unpack(fields.CONTROL, data[header_size:])
-            names = [name for name, _ in fields.CONFIG]
+            control = wire.unpack(records.CONTROL, data[header_size:])
+            names = [name for name, _ in records.CONFIG]
 
             def applies(name):
                 return control["apply"] >> names.index(name) & 1
@@ -174,8 +174,8 @@ class Model:
                     or (applies("sequence_length") and control["sequence_length"] == 0)):
                 return "drop_app_value"
         if kind == RecordType.SEQUENCER:
-            wire = fields.unpack(fields.SEQUENCER, data[header_size:])
-            if any(fields.register_faults(wire, self.dmd.dclk_per_row).values()):
+            registers = wire.unpack(records.SEQUENCER, data[header_size:])
+            if any(records.register_faults(registers, self.dmd.dclk_per_row).values()):
                 return "drop_app_value"
         if self._sequence is not None and head["sequence"] != (self._sequence + 1) & 0xFFFFFFFF:
             self.count("sequence_gaps")
@@ -193,14 +193,14 @@ class Model:
             self.counters["last_frame"] = image["frame"]
             return "image"
         if kind == RecordType.CONTROL:
-            for i, (name, _) in enumerate(fields.CONFIG):
+            for i, (name, _) in enumerate(records.CONFIG):
                 if control["apply"] >> i & 1:
                     self.config[name] = control[name]
             self.triggers += control["action"] & 1
             self.count("records_control")
             return "control"
         if kind == RecordType.SEQUENCER:
-            self.registers.append(wire)
+            self.registers.append(registers)
             self.count("records_sequencer")
             return "sequencer"
         self.count("records_status")

@@ -7,6 +7,7 @@ and the address ranges a run may write (:class:`gateware.store.addresses.Address
 import numpy as np
 
 from gateware.store.addresses import PLANES, AddressMap
+
 from . import bitplane, serialiser_stim
 
 

@@ -9,10 +9,10 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, RisingEdge, with_timeout
 
-from gateware.dlpc410.facts import DMDS
 from sim.harness.cocotb_run import params
 from sim.models.dlpc410 import RULES, CocotbAdapter, Dlpc410, RuleBreak
 from sim.models.dlpc410_replay import MODEL_PARAMS, NAMES, sequences
+from spec.facts import DMDS
 
 
 def relative(log, origin):

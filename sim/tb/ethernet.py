@@ -1,4 +1,4 @@
-"""cocotb testbench of the whole Ethernet side (:class:`gateware.net.port.EthernetPort`) on its
+"""cocotb testbench of the whole Ethernet side (:class:`gateware.protocol.port.EthernetPort`) on its
 generated Verilog: GMII pins in, image rows, counters and GMII replies out.
 
 cocotbext-eth's ``GmiiSource`` drives the receive pins (frames built by scapy and the host
@@ -19,18 +19,19 @@ from cocotb.triggers import ClockCycles, RisingEdge, Timer, with_timeout
 from cocotb.utils import get_sim_time
 from cocotbext.eth import GmiiFrame, GmiiSink, GmiiSource
 
-from gateware.bitplane import pixel_layout
-from gateware.dlpc410.facts import DMDS
 from gateware.mac.gmii_rx import counters_layout
-from gateware.protocol import fields
-from host import records
+from gateware.protocol.layouts import pixel_layout
+from gateware.wire import layout
+from host import codec
 from sim.harness.cocotb_run import params
 from sim.harness.layout import pack, unpack
 from sim.models import frames, mac
-from sim.models.ingest_sim import assemble_rows
 from sim.models.net import Model
-from sim.tb.ingest import check_replies
+from sim.tb.endpoint import check_replies
+from sim.tb.endpoint_sim import assemble_rows
 from sim.tb.mac_rx import symbols_of
+from spec import records, wire
+from spec.facts import DMDS
 
 A = frames.Addresses()
 GMII_PS = 8000
@@ -65,7 +66,7 @@ class Bench:
         cocotb.start_soon(Clock(dut.gmii_tx_clk, GMII_PS, unit="ps").start())
         await Timer(400, unit="ps")
         cocotb.start_soon(Clock(dut.clk, sync_ps, unit="ps").start())
-        dut.status.value = pack(fields.layout(fields.SYSTEM_STATUS), {"clock_hz": CLOCK_HZ})
+        dut.status.value = pack(layout(records.SYSTEM_STATUS), {"clock_hz": CLOCK_HZ})
         dut.registers__ready.value = 1
         for rst in (dut.rst, dut.gmii_rx_rst, dut.gmii_tx_rst):
             rst.value = 1
@@ -126,8 +127,8 @@ class Bench:
         dut = self.dut
         return {
             "mac": unpack(counters_layout(), dut.mac_counters.value.to_unsigned()),
-            "net": unpack(fields.layout(fields.NET_COUNTERS), dut.net_counters.value.to_unsigned()),
-            "app": unpack(fields.layout(fields.APP_COUNTERS), dut.app_counters.value.to_unsigned()),
+            "net": unpack(layout(records.NET_COUNTERS), dut.net_counters.value.to_unsigned()),
+            "app": unpack(layout(records.APP_COUNTERS), dut.app_counters.value.to_unsigned()),
             "rx_dropped": int(dut.rx_dropped.value),
             "tx_underruns": int(dut.tx_underruns.value),
         }
@@ -161,8 +162,8 @@ async def expect(bench, gmii_frames):
     assert bench.rows() == model.rows
     got = bench.counters()
     assert got["mac"] == mac.counts(received)
-    assert got["net"] == {k: model.counters[k] for k, _ in fields.NET_COUNTERS}
-    assert got["app"] == {k: model.counters[k] for k, _ in fields.APP_COUNTERS}
+    assert got["net"] == {k: model.counters[k] for k, _ in records.NET_COUNTERS}
+    assert got["app"] == {k: model.counters[k] for k, _ in records.APP_COUNTERS}
     assert got["rx_dropped"] == 0 and got["tx_underruns"] == 0
     check_replies(bench.transmitted(), model)
     return model, got
@@ -173,7 +174,7 @@ def image(dmd, seed):
 
 
 def image_frames(picture, frame, rows_per_record, rows):
-    return [frames.udp(A, r) for r in records.image_records(picture[:rows], frame, rows=rows_per_record)]
+    return [frames.udp(A, r) for r in codec.image_records(picture[:rows], frame, rows=rows_per_record)]
 
 
 @cocotb.test()
@@ -186,7 +187,7 @@ async def good_traffic_back_to_back(dut):
     picture = image(bench.dmd, 1)
     good = image_frames(picture, 1, 1, 12) + image_frames(picture, 2, 3, 12) + image_frames(picture, 3, 8, 24)
     others = [frames.icmp_echo(A, rng.randbytes(rng.randint(18, 1472)), seq=i) for i in range(4)]
-    others += [frames.arp_request(A), frames.udp(A, records.status_query(7))]
+    others += [frames.arp_request(A), frames.udp(A, codec.status_query(7))]
     others += [frames.udp(A, rng.randbytes(8972), dport=A.port + 1) for _ in range(2)]
     traffic = list(good)
     for raw in others:
@@ -204,7 +205,7 @@ async def replies(dut):
     """ARP request, ICMP echo and status query: each reply read back by scapy from the pins."""
     bench = await Bench.start(dut)
     traffic = [frames.arp_request(A), frames.icmp_echo(A, b"projector" * 8),
-               frames.udp(A, records.status_query(42))]
+               frames.udp(A, codec.status_query(42))]
     model, got = await expect(bench, [gmii(raw) for raw in traffic])
     assert [kind for kind, _ in model.replies] == ["arp", "icmp", "status"]
     assert got["net"]["arp_replies"] == got["net"]["icmp_replies"] == 1
@@ -212,15 +213,15 @@ async def replies(dut):
 
 def _with_header(record, **changes):
     """``record`` (from the host encoder) with header fields changed."""
-    size = fields.size(fields.HEADER)
-    head = {**fields.unpack(fields.HEADER, record[:size]), **changes}
-    return fields.pack(fields.HEADER, head) + record[size:]
+    size = wire.size(records.HEADER)
+    head = {**wire.unpack(records.HEADER, record[:size]), **changes}
+    return wire.pack(records.HEADER, head) + record[size:]
 
 
 def _with_image_fields(record, **changes):
-    size, end = fields.size(fields.HEADER), fields.size(fields.HEADER) + fields.size(fields.IMAGE)
-    body = {**fields.unpack(fields.IMAGE, record[size:end]), **changes}
-    return record[:size] + fields.pack(fields.IMAGE, body) + record[end:]
+    size, end = wire.size(records.HEADER), wire.size(records.HEADER) + wire.size(records.IMAGE)
+    body = {**wire.unpack(records.IMAGE, record[size:end]), **changes}
+    return record[:size] + wire.pack(records.IMAGE, body) + record[end:]
 
 
 def bad_frames(dmd, record):
@@ -240,7 +241,7 @@ def bad_frames(dmd, record):
         out.append((name, gmii(builder(A, record)), ("net", counter)))
     last_row = dmd.rows - 1
     malformed = {
-        "unknown_version": (_with_header(record, version=fields.VERSION + 1), "drop_app_version"),
+        "unknown_version": (_with_header(record, version=records.VERSION + 1), "drop_app_version"),
         "zero_length": (_with_header(record, length=0), "drop_app_empty"),
         "length_not_datagram": (_with_header(record, length=len(record) - 1), "drop_app_length"),
         "rows_beyond_frame": (_with_image_fields(record, first_row=last_row), "drop_app_rows"),
@@ -258,7 +259,7 @@ async def bad_frames_counted_by_cause(dut):
     dmd = bench.dmd
     picture = image(dmd, 2)
     rows_per_record = 2
-    bad = bad_frames(dmd, records.image_records(picture[:rows_per_record], 6, rows=rows_per_record)[0])
+    bad = bad_frames(dmd, codec.image_records(picture[:rows_per_record], 6, rows=rows_per_record)[0])
     good = [gmii(f) for f in image_frames(picture, 5, rows_per_record, (len(bad) + 2) * rows_per_record)]
     traffic = []
     for i, (_name, frame, _cause) in enumerate(bad):

@@ -1,4 +1,4 @@
-"""cocotb benchmark run of the whole Ethernet side (:class:`gateware.net.port.EthernetPort`) on
+"""cocotb benchmark run of the whole Ethernet side (:class:`gateware.protocol.port.EthernetPort`) on
 its generated Verilog: XGA image records in jumbo frames sent back to back at the minimum gap on
 the GMII receive pins, ``sync`` at 125 MHz shifted 0.7 ns from the PHY clock, the pixel consumer
 always ready. Writes its figures as JSON to the ``out`` parameter.
@@ -16,11 +16,11 @@ import math
 import cocotb
 import numpy as np
 
-from gateware.protocol import fields
-from host import records
+from host import codec
 from sim.harness.cocotb_run import params
 from sim.models import frames
-from sim.tb.ethernet import A, GMII_PS, Bench, gmii
+from sim.tb.ethernet import GMII_PS, A, Bench, gmii
+from spec import records
 
 
 @cocotb.test()
@@ -29,9 +29,9 @@ async def line_rate(dut):
     sync_ps = p["sync_ps"]
     bench = await Bench.start(dut, sync_ps=sync_ps, sink=False)
     dmd = bench.dmd
-    rows = records.rows_per_record(dmd.columns)
+    rows = codec.rows_per_record(dmd.columns)
     picture = np.random.default_rng(8).integers(0, 256, (p["records"] * rows, dmd.columns), dtype=np.uint8)
-    encoded = records.image_records(picture, 1)
+    encoded = codec.image_records(picture, 1)
     fcs_sampled = []
     gmii_frames = [gmii(frames.udp(A, r)) for r in encoded]
     for frame in gmii_frames:
@@ -57,5 +57,5 @@ async def line_rate(dut):
             "records_image": got["app"]["records_image"], "mac_good": got["mac"]["good"],
             "payload_bytes": payload, "line_bytes": (starts[-1] - starts[0]) / GMII_PS,
             "latency_min": min(latencies), "latency_max": max(latencies),
-            "header_bytes": fields.image_record_length(rows, dmd.columns) - rows * dmd.columns,
+            "header_bytes": records.image_record_length(rows, dmd.columns) - rows * dmd.columns,
         }, f)

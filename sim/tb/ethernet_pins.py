@@ -1,4 +1,4 @@
-""":class:`gateware.net.port.EthernetPort` with one Verilog port per GMII pin, for cocotbext-eth.
+""":class:`gateware.protocol.port.EthernetPort` with one Verilog port per GMII pin, for cocotbext-eth.
 
 The composition carries its pins as :class:`gateware.mac.gmii.RxPins`/``TxPins`` structs (one
 packed vector each in Verilog); cocotbext-eth's ``GmiiSource``/``GmiiSink`` need a handle per
@@ -9,9 +9,9 @@ from amaranth import Module
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from gateware.dlpc410.facts import DMDS
-from gateware.net.port import EthernetPort
+from gateware.protocol.port import EthernetPort
 from sim.models.frames import Addresses
+from spec.facts import DMDS
 
 __all__ = ["EthernetPins", "TOPLEVEL", "build"]
 

@@ -11,7 +11,6 @@ from amaranth.lib import wiring
 from cocotb.triggers import Timer
 
 from gateware.store import mcb
-
 from sim.harness.cocotb_run import params
 from sim.models import mcb_client
 

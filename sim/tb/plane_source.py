@@ -6,16 +6,16 @@ ports as the sequencer sees them (:mod:`gateware.store.layouts`), wrapped with t
 """
 
 import numpy as np
-
 from amaranth import Array, Cat, Const, Module, Signal
 from amaranth.lib import data, memory, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from gateware.dlpc410 import interface
-from gateware.dlpc410.params import TIME_BITS, Registers
 from gateware.dlpc410.sequencer import Sequencer, Status
+from gateware.registers import Registers
 from gateware.store.layouts import FrameInfo, PlaneRequest
 from sim.models import bitplane
+from spec.registers import TIME_BITS
 
 __all__ = ["PlaneSource", "SequencerBench", "ramp_image"]
 

@@ -12,15 +12,16 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, FallingEdge
 
-from gateware.dlpc410 import schedule
-from gateware.dlpc410.facts import DMDS
-from gateware.dlpc410.params import PlaneOrder, Registers, ResetMode
 from gateware.dlpc410.trigger import PIN_TO_STROBE
+from gateware.registers import Registers
 from sim.harness.cocotb_run import params
 from sim.harness.layout import pack
 from sim.models.dlpc410 import CocotbAdapter
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import dlpc410_for, frame_lights
+from spec import schedule
+from spec.facts import DMDS
+from spec.registers import PlaneOrder, ResetMode
 
 
 def plan_from(prm):

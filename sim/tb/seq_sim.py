@@ -14,12 +14,12 @@ model; the model's mirror history feeds the camera model (:func:`frame_lights`).
 
 from dataclasses import dataclass, field
 
-from gateware.dlpc410.params import Registers
-from gateware.dlpc410.schedule import RST_MARGIN
+from gateware.registers import Registers
 from sim.harness.amaranth_sim import simulate
 from sim.models.camera import Camera
 from sim.models.dlpc410 import Dlpc410, amaranth_process
 from sim.tb.plane_source import SequencerBench
+from spec.schedule import RST_MARGIN
 
 __all__ = ["Run", "run_bench", "dlpc410_for", "frame_lights", "INIT_CYCLES", "INIT_GRACE",
            "CAMERA_RAMP", "CAMERA_DELAY"]
@@ -55,7 +55,7 @@ class Run:
 
 def dlpc410_for(dmd, p, *, dclk=200e6, init_cycles=INIT_CYCLES, ecp2_cycles=4):
     """The rule model with the RST_ACTIVE and settle times ``p`` (schedule Params) was planned
-    for: ``t_rst`` covers RST_ACTIVE plus :data:`~gateware.dlpc410.schedule.RST_MARGIN`."""
+    for: ``t_rst`` covers RST_ACTIVE plus :data:`~spec.schedule.RST_MARGIN`."""
     return Dlpc410(dmd, dclk=dclk, rst_active_cycles=p.t_rst - RST_MARGIN, settle_cycles=p.t_settle,
                    init_cycles=init_cycles, init_grace_cycles=INIT_GRACE, ecp2_cycles=ecp2_cycles,
                    strict_rst_active=p.strict_rst)

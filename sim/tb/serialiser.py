@@ -7,11 +7,12 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, with_timeout
 
-from gateware.bitplane import pixel_layout, row_flags_layout, word_layout
-from gateware.dlpc410.facts import DMDS
+from gateware.bitplane import row_flags_layout, word_layout
+from gateware.protocol.layouts import pixel_layout
 from sim.harness.cocotb_run import params
 from sim.harness.cocotb_stream import StreamSink, StreamSource
 from sim.models import bitplane, serialiser_stim
+from spec.facts import DMDS
 
 
 async def reset(dut):

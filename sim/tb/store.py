@@ -6,8 +6,7 @@ from amaranth.lib import data
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, RisingEdge, Timer, with_timeout
 
-from gateware.bitplane import pixel_layout
-from gateware.dlpc410.facts import DMDS
+from gateware.protocol.layouts import pixel_layout
 from gateware.store.layouts import SLOT_BITS, FrameInfo, PlaneRequest
 from gateware.store.slots import SlotCounters
 from sim.harness.cocotb_run import params
@@ -15,6 +14,7 @@ from sim.harness.cocotb_stream import StreamSink, StreamSource
 from sim.harness.layout import unpack
 from sim.models import bitplane, store_stim
 from sim.models.mcb import CocotbPort, McbModel
+from spec.facts import DMDS
 
 SYNC_NS, DMD_NS = 8, 5
 #: plain-number stream payloads, named for the layout helpers

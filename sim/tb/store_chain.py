@@ -4,7 +4,8 @@ from amaranth import Module
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In
 
-from gateware.bitplane import Serialiser, pixel_layout
+from gateware.bitplane import Serialiser
+from gateware.protocol.layouts import pixel_layout
 from gateware.store.store import Store
 
 __all__ = ["StoreChain"]

@@ -32,13 +32,10 @@ from scapy.layers.inet import IP, UDP
 from scapy.layers.l2 import Ether
 from scapy.packet import Raw
 
-from gateware.dlpc410.facts import DMDS
-from gateware.dlpc410.params import PlaneOrder
 from gateware.dlpc410.sequencer import Status as SequencerStatus
 from gateware.mac.gmii import TxPins
-from gateware.protocol import fields
 from gateware.store.slots import SlotCounters
-from host import records
+from host import codec
 from sim.harness.cocotb_run import params
 from sim.harness.layout import unpack
 from sim.models import gmii
@@ -48,6 +45,9 @@ from sim.models.mcb import CocotbPort, McbModel
 from sim.models.net import Model
 from sim.scene import default_scene
 from sim.system import plan as run_plan
+from spec import records, wire
+from spec.facts import DMDS
+from spec.registers import PlaneOrder
 
 SYNC_NS, GMII_NS, DMD_NS = 8.0, 8.0, 5.0
 HOST_MAC, HOST_IP, HOST_PORT = "02:00:00:00:00:99", "10.0.0.1", 40000
@@ -133,7 +133,7 @@ class System:
         return first
 
     def image(self, picture, frame):
-        encoded = records.image_records(picture, frame, sequence=self.sequence)
+        encoded = codec.image_records(picture, frame, sequence=self.sequence)
         self.sequence += len(encoded)
         return encoded
 
@@ -178,12 +178,12 @@ class System:
         """Ask for a status reply over GMII; its fields as a dict."""
         sequence = self.next_sequence()
         count = len(self.replies)
-        await self.send([self.datagram(records.status_query(sequence))])
+        await self.send([self.datagram(codec.status_query(sequence))])
         for _ in range(200):
             await ClockCycles(self.dut.clk, 100)
             for raw in self.replies[count:]:
-                head, body, _rest = records.decode(raw)
-                if head["type"] == fields.RecordType.STATUS_REPLY and head["sequence"] == sequence:
+                head, body, _rest = codec.decode(raw)
+                if head["type"] == records.RecordType.STATUS_REPLY and head["sequence"] == sequence:
                     return body
         raise AssertionError("no status reply on the transmit pins")
 
@@ -204,19 +204,19 @@ class System:
 
 def bad_records(system, picture):
     """One malformed record of each class the parser checks, with the counter it lands in."""
-    good_regs = fields.register_wire(system.plan.params.registers(system.dmd))
-    image = records.image_records(picture[:1], 0, rows=1)[0]
-    n = fields.size(fields.HEADER)
-    head = fields.unpack(fields.HEADER, image)
-    body = fields.unpack(fields.IMAGE, image[n:])
+    good_regs = records.register_wire(system.plan.params.registers(system.dmd))
+    image = codec.image_records(picture[:1], 0, rows=1)[0]
+    n = wire.size(records.HEADER)
+    head = wire.unpack(records.HEADER, image)
+    body = wire.unpack(records.IMAGE, image[n:])
     return [
-        records.sequencer_record({**good_regs, "lsb": good_regs["lsb"] + 1}, system.next_sequence()),
-        records.sequencer_record({**good_regs, "order": 3}, system.next_sequence()),
-        records.sequencer_record(good_regs, system.next_sequence())[:-1],          # a byte short
-        records.control_record(system.next_sequence(), armed=2),
-        records.control_record(system.next_sequence(), bit_depth=9),
-        fields.pack(fields.HEADER, {**head, "version": fields.VERSION + 1}) + image[n:],
-        image[:n] + fields.pack(fields.IMAGE, {**body, "first_row": system.dmd.rows}) + image[n + 8:],
+        codec.sequencer_record({**good_regs, "lsb": good_regs["lsb"] + 1}, system.next_sequence()),
+        codec.sequencer_record({**good_regs, "order": 3}, system.next_sequence()),
+        codec.sequencer_record(good_regs, system.next_sequence())[:-1],          # a byte short
+        codec.control_record(system.next_sequence(), armed=2),
+        codec.control_record(system.next_sequence(), bit_depth=9),
+        wire.pack(records.HEADER, {**head, "version": records.VERSION + 1}) + image[n:],
+        image[:n] + wire.pack(records.IMAGE, {**body, "first_row": system.dmd.rows}) + image[n + 8:],
     ]
 
 
@@ -286,15 +286,15 @@ async def frames_over_gmii_are_shown_exactly(dut):
             await system.delivered()
 
     # ---- configure through records, the first frame, a trigger while disarmed, then arm ----
-    configure = [records.sequencer_record(system.plan.params.registers(dmd), system.next_sequence(), dmd=dmd),
-                 records.control_record(system.next_sequence(), bit_depth=8, sequence_length=1)]
+    configure = [codec.sequencer_record(system.plan.params.registers(dmd), system.next_sequence(), dmd=dmd),
+                 codec.control_record(system.next_sequence(), bit_depth=8, sequence_length=1)]
     await system.records(configure)
     expect["registers_applied"] += 1
     await system.deliver(*encoded(0))
     pin = await system.trigger()
     await ClockCycles(dut.dmd_clk, 200)
     assert not system.pulses_after(pin), "a trigger reached the sequencer while disarmed"
-    await system.records([records.control_record(system.next_sequence(), armed=1)])
+    await system.records([codec.control_record(system.next_sequence(), armed=1)])
 
     # ---- streaming, as a renderer does it: each frame sent while the one before it is shown ----
     for index in range(p["frames"]):
@@ -308,7 +308,7 @@ async def frames_over_gmii_are_shown_exactly(dut):
         # with the next frame: the set is taken when the sequencer rests, and the next frame is
         # shown exactly under it
         later = run_plan(p, order=PlaneOrder.LSB_FIRST, exposure_s=2 * system.plan.params.lsb * DMD_NS * 1e-9)
-        reconfigure = system.datagram(records.sequencer_record(later.params.registers(dmd),
+        reconfigure = system.datagram(codec.sequencer_record(later.params.registers(dmd),
                                                                system.next_sequence(), dmd=dmd))
         frames, _ = encoded(n + 1, interleave=False)
         await show(n, system.plan, burst=3, sending=([reconfigure] + frames,))
@@ -324,7 +324,7 @@ async def frames_over_gmii_are_shown_exactly(dut):
     # ---- the status reply: every counter as the test's ledger and the reference model say ----
     status = await system.status()
     report["status"] = status
-    for name, _ in fields.NET_COUNTERS + fields.APP_COUNTERS:
+    for name, _ in records.NET_COUNTERS + records.APP_COUNTERS:
         assert status[name] == system.net.counters[name], (name, status[name], system.net.counters[name])
     for verdict in ("good", "bad_fcs"):
         assert status[f"mac_{verdict}"] == system.mac[verdict], (verdict, status[f"mac_{verdict}"])

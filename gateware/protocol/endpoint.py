@@ -1,35 +1,38 @@
-"""The ingest block: the network stack with the application protocol behind it.
+"""The projector's network endpoint: the network stack with the application protocol behind it.
 
-This is what sits between the MAC (a :class:`~gateware.mac.layouts.ByteBeat` stream each way)
-and the bit-plane serialiser, the sequencer and the status sources. All in ``sync``.
+What sits between the MAC (a :class:`~gateware.mac.layouts.ByteBeat` stream each way) and the
+bit-plane serialiser, the sequencer and the status sources; all in ``sync``. The
+:class:`~gateware.protocol.port.EthernetPort` puts the MACs around it.
 """
 
 from amaranth import Module
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out, connect
 
-from ..bitplane import pixel_layout
-from ..dlpc410.params import Registers
+from spec import records
+
 from ..mac.layouts import ByteBeat
-from ..protocol import fields
-from ..protocol.parser import CONFIG_LAYOUT, Parser, config_init
-from ..protocol.status import StatusReply
-from .stack import Stack
+from ..net.stack import Stack
+from ..registers import Registers
+from ..wire import layout
+from .layouts import pixel_layout
+from .parser import CONFIG_LAYOUT, Parser, config_init
+from .status import StatusReply
 
-__all__ = ["Ingest", "Config", "Status"]
+__all__ = ["Endpoint", "Config", "Status"]
 
-#: The run-time configuration the ingest block drives (fields: :data:`fields.CONFIG`).
+#: The run-time configuration the endpoint drives (fields: :data:`records.CONFIG`).
 Config = CONFIG_LAYOUT
-#: The figures the rest of the system reports through status replies (:data:`fields.SYSTEM_STATUS`).
-Status = fields.layout(fields.SYSTEM_STATUS)
+#: The figures the rest of the system reports through status replies (:data:`records.SYSTEM_STATUS`).
+Status = layout(records.SYSTEM_STATUS)
 
 
-class Ingest(wiring.Component):
+class Endpoint(wiring.Component):
     """Stack + protocol parser + status reply.
 
     Parameters
     ----------
-    dmd : :class:`gateware.dlpc410.facts.DmdType`
+    dmd : :class:`spec.facts.DmdType`
     mac, ip, port : int
         Addresses at reset (build parameters); a control record may change them.
     armed : bool
@@ -55,8 +58,8 @@ class Ingest(wiring.Component):
         The sequencer's register set of each valid sequencer record.
     status : In(Status)
         Figures from the rest of the system, reported in status replies.
-    net_counters : Out(fields.layout(fields.NET_COUNTERS))
-    app_counters : Out(fields.layout(fields.APP_COUNTERS))
+    net_counters : Out(layout(records.NET_COUNTERS))
+    app_counters : Out(layout(records.APP_COUNTERS))
     """
 
     def __init__(self, dmd, *, mac, ip, port, armed=False, frame_bits=4, buffer_depth=16384):
@@ -72,8 +75,8 @@ class Ingest(wiring.Component):
             "trigger": Out(1),
             "registers": Out(stream.Signature(Registers)),
             "status": In(Status),
-            "net_counters": Out(fields.layout(fields.NET_COUNTERS)),
-            "app_counters": Out(fields.layout(fields.APP_COUNTERS)),
+            "net_counters": Out(layout(records.NET_COUNTERS)),
+            "app_counters": Out(layout(records.APP_COUNTERS)),
         })
 
     def elaborate(self, platform):

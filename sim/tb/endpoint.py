@@ -1,4 +1,4 @@
-"""cocotb testbench of the ingest block's generated Verilog (stack + protocol parser + status).
+"""cocotb testbench of the endpoint's generated Verilog (stack + protocol parser + status).
 
 Frames are MAC byte beats fed with :class:`~sim.harness.cocotb_stream.StreamSource`; the
 expectations come from the reference model; replies are parsed by scapy.
@@ -13,19 +13,19 @@ from cocotb.triggers import ClockCycles, RisingEdge, with_timeout
 from scapy.layers.inet import ICMP, IP, UDP
 from scapy.layers.l2 import ARP, Ether
 
-from gateware.bitplane import pixel_layout
-from gateware.dlpc410 import schedule
-from gateware.dlpc410.facts import DMDS
-from gateware.dlpc410.params import PlaneOrder
 from gateware.mac.layouts import ByteBeat
-from gateware.protocol import fields
-from host import records
+from gateware.protocol.layouts import pixel_layout
+from gateware.wire import layout
+from host import codec
 from sim.harness.cocotb_run import params
 from sim.harness.cocotb_stream import StreamSink, StreamSource
 from sim.harness.layout import pack, unpack
 from sim.models import frames
-from sim.models.ingest_sim import assemble_rows
 from sim.models.net import Model
+from sim.tb.endpoint_sim import assemble_rows
+from spec import records, schedule
+from spec.facts import DMDS
+from spec.registers import PlaneOrder
 
 A = frames.Addresses()
 
@@ -77,22 +77,22 @@ class RegisterCollector:
 
 def control_traffic(dmd):
     """Control and sequencer records, good and bad (values the projector cannot obey)."""
-    wire = fields.register_wire(schedule.plan(dmd, 200e6, depth=6).params.registers(dmd))
+    wire = records.register_wire(schedule.plan(dmd, 200e6, depth=6).params.registers(dmd))
     return [
-        records.control_record(50, bit_depth=6, armed=1, software_trigger=True),
-        records.control_record(51, armed=3),
-        records.sequencer_record(wire, 52),
-        records.sequencer_record({**wire, "lsb": wire["lsb"] | 1}, 53),
-        records.sequencer_record({**wire, "order": 3}, 54),
-        records.sequencer_record({**wire, "row_period": 0}, 55),
-        records.sequencer_record({**wire, "order": PlaneOrder.LSB_FIRST.value}, 56),
-        records.sequencer_record(wire, 57)[:-2],
+        codec.control_record(50, bit_depth=6, armed=1, software_trigger=True),
+        codec.control_record(51, armed=3),
+        codec.sequencer_record(wire, 52),
+        codec.sequencer_record({**wire, "lsb": wire["lsb"] | 1}, 53),
+        codec.sequencer_record({**wire, "order": 3}, 54),
+        codec.sequencer_record({**wire, "row_period": 0}, 55),
+        codec.sequencer_record({**wire, "order": PlaneOrder.LSB_FIRST.value}, 56),
+        codec.sequencer_record(wire, 57)[:-2],
     ]
 
 
 def counters(dut):
-    net = unpack(fields.layout(fields.NET_COUNTERS), dut.net_counters.value.to_unsigned())
-    app = unpack(fields.layout(fields.APP_COUNTERS), dut.app_counters.value.to_unsigned())
+    net = unpack(layout(records.NET_COUNTERS), dut.net_counters.value.to_unsigned())
+    app = unpack(layout(records.APP_COUNTERS), dut.app_counters.value.to_unsigned())
     return net, app
 
 
@@ -125,7 +125,7 @@ def check_replies(tx, model):
             del reply[ICMP].chksum
             assert Ether(bytes(reply))[ICMP].chksum == icmp_sum, "ICMP checksum"
         else:
-            head, body, _ = records.decode(bytes(reply[UDP].payload))
+            head, body, _ = codec.decode(bytes(reply[UDP].payload))
             assert head["sequence"] == expect["sequence"] and body["clock_hz"] == 125_000_000
 
 
@@ -136,15 +136,15 @@ async def mixed_traffic(dut):
     await reset(dut)
     p = params()
     dmd = DMDS[p["dmd"]]
-    dut.status.value = pack(fields.layout(fields.SYSTEM_STATUS), {"clock_hz": 125_000_000})
+    dut.status.value = pack(layout(records.SYSTEM_STATUS), {"clock_hz": 125_000_000})
     rng = random.Random(4)
     image = np.random.default_rng(2).integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8)
     model = Model(dmd, A.mac, A.ip, A.port)
-    good = [frames.udp(A, r) for r in records.image_records(image, 6, rows=4)]
+    good = [frames.udp(A, r) for r in codec.image_records(image, 6, rows=4)]
     bad = [builder(A, good[0][42:]) for builder, _ in frames.BAD_FRAMES.values()]
     traffic = [(raw, False) for raw in good]
     for raw in bad + [frames.arp_request(A), frames.icmp_echo(A, b"abc" * 9),
-                      frames.udp(A, records.status_query(1000))] + [frames.udp(A, r) for r in control_traffic(dmd)]:
+                      frames.udp(A, codec.status_query(1000))] + [frames.udp(A, r) for r in control_traffic(dmd)]:
         traffic.insert(rng.randrange(len(traffic) + 1), (raw, False))
     traffic.insert(rng.randrange(len(traffic)), (good[3], True))
     for raw, flag in traffic:
@@ -161,12 +161,12 @@ async def mixed_traffic(dut):
     rows = assemble_rows([(t["frame"], t["row"], t["column"], t["pixels"][0]) for t in got], dmd.columns)
     assert rows == model.rows
     net, app = counters(dut)
-    assert net == {k: model.counters[k] for k, _ in fields.NET_COUNTERS}
-    assert app == {k: model.counters[k] for k, _ in fields.APP_COUNTERS}
+    assert net == {k: model.counters[k] for k, _ in records.NET_COUNTERS}
+    assert app == {k: model.counters[k] for k, _ in records.APP_COUNTERS}
     check_replies(tx.frames, model)
-    assert registers.sets == [fields.registers_bits(wire) for wire in model.registers]
+    assert registers.sets == [records.registers_bits(wire) for wire in model.registers]
     assert len(registers.sets) == 2
-    assert unpack(fields.layout(fields.CONFIG), dut.settings.value.to_unsigned()) == model.config
+    assert unpack(layout(records.CONFIG), dut.settings.value.to_unsigned()) == model.config
 
 
 @cocotb.test()
@@ -176,7 +176,7 @@ async def line_rate(dut):
     dmd = DMDS[params()["dmd"]]
     image = np.random.default_rng(3).integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8)
     before, _ = counters(dut)
-    encoded = records.image_records(image, 1)
+    encoded = codec.image_records(image, 1)
     source = StreamSource(dut, "rx", ByteBeat, dut.clk)
     pixels = StreamSink(dut, "pixels", pixel_layout(dmd), dut.clk)
     TxCollector(dut, stall=0.0, seed=5)

@@ -2,7 +2,7 @@
 
 ``build/spartan6/`` receives what Amaranth's Xilinx platform writes for ISE (``<top>.v``,
 ``<top>.ucf``, ``<top>.prj``, ``<top>.xst``, ``build_<top>.sh``) without running ISE, plus
-``blocks/<block>.v`` for every block in :data:`gateware.flow.blocks.BLOCKS`.
+``blocks/<block>.v`` for every block in :data:`flow.blocks.BLOCKS`.
 """
 
 import subprocess
@@ -10,7 +10,7 @@ from pathlib import Path
 
 from amaranth.back import verilog as amaranth_verilog
 
-from gateware.flow.blocks import BLOCKS
+from flow.blocks import BLOCKS
 
 __all__ = ["emit_blocks", "emit_platform", "lint", "main"]
 

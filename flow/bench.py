@@ -26,7 +26,7 @@ def collect(modules=None, *, resources=True, log=print):
             figures[key] = {"value": value, "unit": unit}
         log(f"bench: {name} done in {time.monotonic() - start:.1f} s")
     if resources:
-        from gateware.flow import resources as res
+        from flow import resources as res
         log("bench: resources (yosys synth_xilinx -family xc6s) ...")
         for key, (value, unit) in res.figures(res.report()).items():
             figures[key] = {"value": value, "unit": unit}

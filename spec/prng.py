@@ -34,7 +34,7 @@ def words(seed, count):
 
 
 def shown_patterns(dmd, commands, seed):
-    """Replay a command list (:func:`gateware.dlpc410.schedule.simulate`'s ``commands``) with
+    """Replay a command list (:func:`spec.schedule.simulate`'s ``commands``) with
     the source's words: the (rows, columns) 0/1 pattern each clocking pulse shows, in order."""
     n_rows = sum(1 for _t, kind, _a in commands if kind == "row")
     stream = iter(words(seed, n_rows * dmd.words_per_row))

@@ -6,6 +6,9 @@ the entry says so and callers take it as a run-time or build-time parameter.
 
 Sources
 -------
+802.3       IEEE 802.3 clause 22 (MDIO frame, MDC <= 2.5 MHz, basic registers)
+88E1111     Marvell 88E1111 PHY datasheet (register 17 "PHY specific status", reset timing)
+Atlys       Digilent Atlys reference manual (PHY strapping)
 DLPC410     DLPC410 datasheet (DLPS024), row addressing and command tables
 DLPU045A    DLPC410 programming note: DCLK, even idle cycles
 DLPA008B    DLPC410 application note: reset, settle, clears, phased operation
@@ -16,12 +19,10 @@ refHDL      TI's applications-FPGA reference HDL as quoted in public repositorie
 forum       TI E2E forum answers (quoting the datasheet); Mathews et al., IEEE QCE 2022 (measured)
 """
 
+import enum
 from dataclasses import dataclass
 
-from amaranth.lib import enum
-
-
-__all__ = ["Fact", "TIMING", "DmdType", "DMDS", "RowMode", "BlockMode", "TEST_DMD"]
+__all__ = ["Fact", "TIMING", "PHY", "DmdType", "DMDS", "RowMode", "BlockMode", "TEST_DMD", "TEST_DMD4"]
 
 
 @dataclass(frozen=True)
@@ -116,7 +117,7 @@ TEST_DMD4 = DmdType("test four-bus 256x80", 256, 80, 256, 5, 16, 4, 128, 2, None
 DMDS["test4"] = TEST_DMD4
 
 
-class RowMode(enum.Enum, shape=2):
+class RowMode(enum.IntEnum):
     """ROWMD(1:0) (DLPC410 for 00 and 10; DLPC910 and refHDL for 01 and 11)."""
     NOOP = 0b00
     NEXT = 0b01       # advance the row pointer and write (decrement with NS_FLIP)
@@ -124,9 +125,22 @@ class RowMode(enum.Enum, shape=2):
     FIRST = 0b11      # pointer to row 0 and write there
 
 
-class BlockMode(enum.Enum, shape=2):
-    """BLKMD(1:0) (refHDL; confidence medium). See :mod:`gateware.dlpc410.facts` table above."""
+class BlockMode(enum.IntEnum):
+    """BLKMD(1:0) (refHDL; confidence medium). """
     NOOP = 0b00
     CLEAR = 0b01      # clear block BLKAD
     RESET = 0b10      # mirror clocking pulse of block BLKAD
     MULTI = 0b11      # dual (RST2BLKZ=0), quad (RST2BLKZ=1, BLKAD=0qq0) or global (BLKAD=10xx)
+
+
+#: The Marvell 88E1111 PHY, as the management block (:mod:`gateware.mac.mdio`) needs it.
+PHY = {
+    "mdc_max": Fact(2.5e6, "Hz", "802.3 22.2.2.13", "high", "the 88E1111 accepts up to 8.3 MHz"),
+    "reset_low": Fact(10e-3, "s", "88E1111 reset timing", "high", "RESETn low at least 10 ms"),
+    "reset_to_mdio": Fact(5e-3, "s", "88E1111 reset timing", "medium", "wait after reset release"),
+    "phy_address": Fact(0b00111, "", "Atlys strapping", "medium", "PHYAD[4:0] as strapped on the board"),
+    "reg_status": Fact(17, "", "88E1111 register 17", "high", "PHY specific status"),
+    "status_link_bit": Fact(10, "", "88E1111 register 17.10", "high", "link (real time)"),
+    "status_speed_lsb": Fact(14, "", "88E1111 register 17.15:14", "high", "10 = 1000, 01 = 100, 00 = 10 Mb/s"),
+    "status_resolved_bit": Fact(11, "", "88E1111 register 17.11", "high", "speed and duplex resolved"),
+}

@@ -1,5 +1,5 @@
 import sys
 
-from gateware.cli import main
+from flow.cli import main
 
 sys.exit(main())

@@ -6,7 +6,7 @@ command stream must equal this model's, cycle for cycle). It runs the very algor
 
 The algorithm
 -------------
-Blocks are pulsed in *groups* (:func:`gateware.dlpc410.params.group_size`): one group of all
+Blocks are pulsed in *groups* (:func:`spec.registers.group_size`): one group of all
 blocks in global mode, groups of 4, 2 or 1 in the phased modes. Every group plays the same
 timeline; group ``g`` runs ``g * stagger`` cycles behind group 0.
 
@@ -52,13 +52,13 @@ may start at ``init_to_dvalid`` (64 clocks, DLPC910). Command cycles are decisio
 pins show each command one cycle later.
 """
 
-from dataclasses import dataclass, field, replace
 import math
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from .facts import TIMING, BlockMode
-from .params import PlaneOrder, ResetMode, Source, TriggerMode, group_size
+from .registers import PlaneOrder, ResetMode, Source, TriggerMode, group_size
 
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate",
            "plan", "bound", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS", "flush_rows",
@@ -98,7 +98,7 @@ def even(t):
 
 @dataclass
 class Params:
-    """Run-time parameters, as in :class:`gateware.dlpc410.params.Registers` (cycles)."""
+    """Run-time parameters, as in :class:`gateware.registers.Registers` (cycles)."""
     lsb: int
     t_rst: int
     t_settle: int
@@ -121,7 +121,7 @@ class Params:
     park: bool = False
 
     def registers(self, dmd):
-        """The values of :class:`~gateware.dlpc410.params.Registers`, as a dict."""
+        """The values of :class:`~gateware.registers.Registers`, as a dict."""
         regs = {k: getattr(self, k) for k in (
             "lsb", "t_rst", "t_settle", "hide", "dark_gap", "stagger", "period", "reload_lead",
             "camera_offset", "camera_width")}
@@ -638,7 +638,7 @@ def _frame_cycles(dmd, p, fr):
 def bound(dmd, dclk_hz, depth=8, *, t_rst_s=None, t_settle_s=None):
     """Upper bound on the continuous-light PWM frame rate, any schedule: the least significant
     plane lasts at least RST_ACTIVE + settle + one clear row cycle, and a frame is
-    ``2**depth - 1`` such units (DLPC410.md, "Derived bounds")."""
+    ``2**depth - 1`` such units (derivation: ``docs/bounds.md``)."""
     t_rst = (TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s) * dclk_hz
     t_settle = (TIMING["t_settle"].value if t_settle_s is None else t_settle_s) * dclk_hz
     t0 = t_rst + t_settle + dmd.clear_row_cycles * dmd.dclk_per_row

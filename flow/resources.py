@@ -56,7 +56,7 @@ def synthesise(verilog_path, top, *, iopads=False, blackboxes=(), flatten=False)
 
 def report(outdir="build/spartan6"):
     """Synthesise every block (and the platform top); returns {name: counts}."""
-    from gateware.flow.verilog import emit_blocks, emit_platform
+    from flow.verilog import emit_blocks, emit_platform
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     blocks = emit_blocks(outdir)

@@ -1,4 +1,4 @@
-"""Command line: ``python -m gateware <verilog|resources|bench|sim|waves>``."""
+"""Command line: ``python -m flow <verilog|resources|bench|sim|waves>``."""
 
 import argparse
 import sys
@@ -7,7 +7,7 @@ __all__ = ["main"]
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m gateware", description=__doc__)
+    parser = argparse.ArgumentParser(prog="python -m flow", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("verilog", help="write the Spartan-6 ISE tree and every block's Verilog to build/spartan6")
     sub.add_parser("resources", help="Yosys synth_xilinx -family xc6s: LUT/FF/BRAM/DSP per block and in total")
@@ -20,13 +20,13 @@ def main(argv=None):
     args = parser.parse_args(argv)
 
     if args.command == "verilog":
-        from gateware.flow.verilog import main as run
+        from flow.verilog import main as run
         return run()
     if args.command == "resources":
-        from gateware.flow.resources import main as run
+        from flow.resources import main as run
         return run()
     if args.command == "bench":
-        from gateware.flow.bench import main as run
+        from flow.bench import main as run
         return run(args.only, resources=not args.no_resources)
     if args.command == "sim":
         from sim.system import main as run

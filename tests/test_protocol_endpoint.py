@@ -1,4 +1,4 @@
-"""The ingest block (network stack + protocol parser + status reply) in the Amaranth simulator.
+"""The endpoint (network stack + protocol parser + status reply) in the Amaranth simulator.
 
 Frames are built by scapy and the host encoder; expectations come from the reference model in
 :mod:`sim.models.net`; replies are parsed back by scapy.
@@ -12,14 +12,14 @@ from scapy.layers.inet import ICMP, IP, UDP
 from scapy.layers.l2 import ARP, Ether
 
 import host
-from gateware.dlpc410 import schedule
-from gateware.dlpc410.facts import TEST_DMD
-from gateware.dlpc410.params import PlaneOrder, ResetMode, TriggerMode
-from gateware.protocol import fields
-from host import records
-from sim.models import frames, ingest_sim
+from host import codec
+from sim.models import frames
 from sim.models.frames import Addresses
 from sim.models.net import Model
+from sim.tb import endpoint_sim
+from spec import records, schedule, wire
+from spec.facts import TEST_DMD
+from spec.registers import PlaneOrder, ResetMode, TriggerMode
 
 A = Addresses()
 COLUMNS = TEST_DMD.columns
@@ -27,35 +27,35 @@ IMAGE = np.random.default_rng(5).integers(0, 256, (TEST_DMD.rows, COLUMNS), dtyp
 
 
 def image_frame(first_row, rows=1, frame=1, sequence=0):
-    record = records.image_records(IMAGE[first_row:first_row + rows], frame, sequence=sequence, rows=rows)[0]
+    record = codec.image_records(IMAGE[first_row:first_row + rows], frame, sequence=sequence, rows=rows)[0]
     # image_records numbers rows from 0: rewrite first_row through the same field table
-    head, body, pixels = records.decode(record)
+    head, body, pixels = codec.decode(record)
     body["first_row"] = first_row
-    return frames.udp(A, record[:10] + fields.pack(fields.IMAGE, body) + pixels)
+    return frames.udp(A, record[:10] + wire.pack(records.IMAGE, body) + pixels)
 
 
 def app_frame(record):
     return frames.udp(A, record)
 
 
-def _record(record_type=fields.RecordType.IMAGE, length=None, body=b"", **head):
-    values = {"magic": fields.MAGIC, "version": fields.VERSION, "type": record_type,
+def _record(record_type=records.RecordType.IMAGE, length=None, body=b"", **head):
+    values = {"magic": records.MAGIC, "version": records.VERSION, "type": record_type,
               "length": 10 + len(body) if length is None else length, "sequence": 0, **head}
-    return fields.pack(fields.HEADER, values) + body
+    return wire.pack(records.HEADER, values) + body
 
 
 def _image_body(first_row=0, row_count=1, row_bytes=COLUMNS):
-    return fields.pack(fields.IMAGE, {"frame": 2, "first_row": first_row, "row_count": row_count,
+    return wire.pack(records.IMAGE, {"frame": 2, "first_row": first_row, "row_count": row_count,
                                       "row_bytes": row_bytes}) + bytes(row_count * COLUMNS)
 
 
 #: A register set the sequencer can obey (a plan for the test DMD), as the record's wire values.
 PLAN = schedule.plan(TEST_DMD, 200e6, t_rst_s=200e-9, t_settle_s=300e-9, reset_mode=ResetMode.DUAL)
-GOOD_WIRE = fields.register_wire(PLAN.params.registers(TEST_DMD))
+GOOD_WIRE = records.register_wire(PLAN.params.registers(TEST_DMD))
 
 
 def sequencer_record(sequence=0, **changes):
-    return records.sequencer_record({**GOOD_WIRE, **changes}, sequence)
+    return codec.sequencer_record({**GOOD_WIRE, **changes}, sequence)
 
 
 #: Sequencer records the sequencer could not obey: ``name -> changes to a good set``.
@@ -74,7 +74,7 @@ BAD_REGISTERS = {
 #: Malformed records: ``name -> (record bytes, counter)``.
 BAD_RECORDS = {
     "bad_magic": (_record(body=_image_body(), magic=0x1234), "drop_app_magic"),
-    "unknown_version": (_record(body=_image_body(), version=fields.VERSION + 1), "drop_app_version"),
+    "unknown_version": (_record(body=_image_body(), version=records.VERSION + 1), "drop_app_version"),
     "unknown_type": (_record(record_type=9), "drop_app_type"),
     "zero_length": (_record(body=_image_body(), length=0), "drop_app_empty"),
     "zero_rows": (_record(body=_image_body(row_count=0)), "drop_app_empty"),
@@ -84,18 +84,18 @@ BAD_RECORDS = {
     "rows_beyond_frame": (_record(body=_image_body(first_row=TEST_DMD.rows - 1, row_count=2)),
                           "drop_app_rows"),
     "row_bytes_not_dmd": (_record(body=_image_body(row_bytes=COLUMNS * 2)), "drop_app_rows"),
-    "bit_depth_out_of_range": (records.control_record(bit_depth=9, armed=1), "drop_app_value"),
-    "armed_not_a_bit": (records.control_record(armed=2), "drop_app_value"),
-    "sequence_length_zero": (records.control_record(sequence_length=0), "drop_app_value"),
-    "control_too_long": (records.control_record(armed=1) + b"\0", "drop_app_length"),
+    "bit_depth_out_of_range": (codec.control_record(bit_depth=9, armed=1), "drop_app_value"),
+    "armed_not_a_bit": (codec.control_record(armed=2), "drop_app_value"),
+    "sequence_length_zero": (codec.control_record(sequence_length=0), "drop_app_value"),
+    "control_too_long": (codec.control_record(armed=1) + b"\0", "drop_app_length"),
     "sequencer_too_long": (sequencer_record() + b"\0", "drop_app_length"),
-    "sequencer_truncated": (_record(fields.RecordType.SEQUENCER, body=sequencer_record()[10:-1]),
+    "sequencer_truncated": (_record(records.RecordType.SEQUENCER, body=sequencer_record()[10:-1]),
                             "drop_app_length"),
     **{f"sequencer_{name}": (sequencer_record(**changes), "drop_app_value")
        for name, changes in BAD_REGISTERS.items()},
 }
 
-PAYLOAD = records.image_records(IMAGE[:1], 1)[0]
+PAYLOAD = codec.image_records(IMAGE[:1], 1)[0]
 BAD_CASES = {name: (builder(A, PAYLOAD), False, counter)
              for name, (builder, counter) in frames.BAD_FRAMES.items()}
 BAD_CASES["mac_verdict_bad"] = (frames.udp(A, PAYLOAD), True, "drop_mac")
@@ -109,7 +109,7 @@ def one_by_one():
     sequence = [(image_frame(0), False)]
     sequence += [(raw, bad) for raw, bad, _counter in BAD_CASES.values()]
     sequence.append((image_frame(1, frame=1), False))
-    out = ingest_sim.run(sequence, name="ingest_bad_one_by_one", settle_each=200, gap=(0, 20))
+    out = endpoint_sim.run(sequence, name="endpoint_bad_one_by_one", settle_each=200, gap=(0, 20))
     return sequence, out
 
 
@@ -123,13 +123,13 @@ def test_bad_frame_dropped_and_counted(case, one_by_one):
     index = 1 + list(BAD_CASES).index(case)
     before, after = out["snapshots"][index - 1], out["snapshots"][index]
     counter = BAD_CASES[case][2]
-    table = fields.NET_COUNTERS if counter in dict(fields.NET_COUNTERS) else fields.APP_COUNTERS
-    other = fields.APP_COUNTERS if table is fields.NET_COUNTERS else fields.NET_COUNTERS
-    delta = _delta(before["net" if table is fields.NET_COUNTERS else "app"],
-                   after["net" if table is fields.NET_COUNTERS else "app"], table)
+    table = records.NET_COUNTERS if counter in dict(records.NET_COUNTERS) else records.APP_COUNTERS
+    other = records.APP_COUNTERS if table is records.NET_COUNTERS else records.NET_COUNTERS
+    delta = _delta(before["net" if table is records.NET_COUNTERS else "app"],
+                   after["net" if table is records.NET_COUNTERS else "app"], table)
     expected = {name: 0 for name, _ in table}
     expected[counter] = 1
-    if table is fields.NET_COUNTERS:
+    if table is records.NET_COUNTERS:
         expected["frames"] = 1
         other_delta = _delta(before["app"], after["app"], other)
         assert not any(other_delta.values()), f"a dropped frame reached the protocol: {other_delta}"
@@ -160,9 +160,9 @@ def test_good_frames_around_bad_ones_arrive(one_by_one):
 def replies():
     """ARP, ICMP echo, a status query and control records, in one run."""
     new_ip, new_port = 0x0A_00_00_33, 6001
-    control = records.control_record(1, bit_depth=6, armed=1, sequence_length=5, software_trigger=True)
+    control = codec.control_record(1, bit_depth=6, armed=1, sequence_length=5, software_trigger=True)
     registers = [sequencer_record(5), sequencer_record(6, order=PlaneOrder.LSB_FIRST.value, chain=1)]
-    readdress = records.control_record(2, ip=new_ip, port=new_port)
+    readdress = codec.control_record(2, ip=new_ip, port=new_port)
     moved = Addresses(ip=new_ip, port=new_port)
     status = {"uptime_cycles": 123456789, "clock_hz": 125_000_000, "triggers": 7,
               "trigger_overruns": 1, "frames_shown": 6, "dlpc410_state": 0b101}
@@ -170,16 +170,16 @@ def replies():
         (frames.arp_request(A), False),
         (frames.icmp_echo(A, bytes(range(40)), ident=0x4242, seq=9), False),
         (frames.udp(A, control), False),
-        (frames.udp(A, records.status_query(77)), False),
+        (frames.udp(A, codec.status_query(77)), False),
         (frames.udp(A, readdress), False),
         (frames.arp_request(moved), False),
-        (frames.udp(A, records.status_query(3)), False),         # old address: dropped
-        (frames.udp(Addresses(ip=new_ip), records.status_query(4)), False),  # old port: dropped
-        (frames.udp(moved, records.status_query(78)), False),
+        (frames.udp(A, codec.status_query(3)), False),         # old address: dropped
+        (frames.udp(Addresses(ip=new_ip), codec.status_query(4)), False),  # old port: dropped
+        (frames.udp(moved, codec.status_query(78)), False),
         (frames.udp(moved, registers[0]), False),
         (frames.udp(moved, registers[1]), False),
     ]
-    out = ingest_sim.run(sequence, name="ingest_replies", settle_each=80, gap=(5, 5),
+    out = endpoint_sim.run(sequence, name="endpoint_replies", settle_each=80, gap=(5, 5),
                          status=status)
     return out, status, moved
 
@@ -220,7 +220,7 @@ def test_sequencer_records_handed_on_whole(replies):
     """Each valid sequencer record leaves as one register set, every field as sent."""
     out = replies[0]
     second = {**GOOD_WIRE, "order": PlaneOrder.LSB_FIRST.value, "chain": 1}
-    assert out["registers"] == [fields.registers_bits(GOOD_WIRE), fields.registers_bits(second)]
+    assert out["registers"] == [records.registers_bits(GOOD_WIRE), records.registers_bits(second)]
     assert out["app"]["records_sequencer"] == 2
 
 
@@ -235,11 +235,11 @@ def test_status_query_answered(replies):
         ip_sum = reply[IP].chksum
         del reply[IP].chksum
         assert Ether(bytes(reply))[IP].chksum == ip_sum
-        head, body, rest = records.decode(bytes(reply[UDP].payload))
-        assert head["type"] == fields.RecordType.STATUS_REPLY and head["sequence"] == sequence
+        head, body, rest = codec.decode(bytes(reply[UDP].payload))
+        assert head["type"] == records.RecordType.STATUS_REPLY and head["sequence"] == sequence
         assert rest == b""
         assert {k: body[k] for k in status} == status
-    first = records.decode(bytes(Ether(out["tx"][2])[UDP].payload))[1]
+    first = codec.decode(bytes(Ether(out["tx"][2])[UDP].payload))[1]
     assert first["records_control"] == 1 and first["records_status"] == 1
     assert first["arp_replies"] == 1 and first["icmp_replies"] == 1
     assert out["net"]["drop_ip_dst"] == 1 and out["net"]["drop_udp_port"] == 1
@@ -258,21 +258,21 @@ def test_randomized_mix_ledger(test_name):
         if roll < 0.5:
             rows = rng.choice([1, 2, 4])
             first = rng.randrange(0, TEST_DMD.rows - rows + 1)
-            record = records.image_records(IMAGE[first:first + rows], rng.randrange(16), sequence=seq,
+            record = codec.image_records(IMAGE[first:first + rows], rng.randrange(16), sequence=seq,
                                            rows=rows)[0]
-            head, body, pixels = records.decode(record)
+            head, body, pixels = codec.decode(record)
             body["first_row"] = first
-            raw, bad = frames.udp(A, record[:10] + fields.pack(fields.IMAGE, body) + pixels), False
+            raw, bad = frames.udp(A, record[:10] + wire.pack(records.IMAGE, body) + pixels), False
             seq += 1 if rng.random() < 0.95 else 2
         elif roll < 0.56:
             raw, bad = frames.arp_request(A), False
         elif roll < 0.62:
             raw, bad = frames.icmp_echo(A, rng.randbytes(rng.randrange(0, 64))), False
         elif roll < 0.65:
-            raw, bad = frames.udp(A, records.status_query(seq)), False
+            raw, bad = frames.udp(A, codec.status_query(seq)), False
             seq += 1
         elif roll < 0.69:
-            control = records.control_record(seq, bit_depth=rng.randrange(0, 10),
+            control = codec.control_record(seq, bit_depth=rng.randrange(0, 10),
                                              sequence_length=rng.randrange(0, 3),
                                              software_trigger=rng.random() < 0.7)
             raw, bad = frames.udp(A, control), False
@@ -285,14 +285,14 @@ def test_randomized_mix_ledger(test_name):
             raw, bad, _ = rng.choice(bad_cases)
         sequence.append((raw, bad))
         model.frame(raw, bad)
-    out = ingest_sim.run(sequence, name=test_name, gap=(0, 30), seed=3, pixel_stall=0.2,
+    out = endpoint_sim.run(sequence, name=test_name, gap=(0, 30), seed=3, pixel_stall=0.2,
                          tx_stall=0.2, waves=False)
-    assert out["net"] == {name: model.counters[name] for name, _ in fields.NET_COUNTERS}
-    assert out["app"] == {name: model.counters[name] for name, _ in fields.APP_COUNTERS}
+    assert out["net"] == {name: model.counters[name] for name, _ in records.NET_COUNTERS}
+    assert out["app"] == {name: model.counters[name] for name, _ in records.APP_COUNTERS}
     assert out["rows"] == model.rows
     assert out["triggers"] == model.triggers > 0
     assert out["config"] == model.config
-    assert out["registers"] == [fields.registers_bits(wire) for wire in model.registers] and model.registers
+    assert out["registers"] == [records.registers_bits(wire) for wire in model.registers] and model.registers
     # Status replies and ARP/ICMP replies come from two sources that take turns: the kinds
     # match one for one, the order between the two sources may differ.
     sent = sorted("arp" if ARP in Ether(raw) else "icmp" if ICMP in Ether(raw) else "status"
@@ -307,7 +307,7 @@ def test_line_rate_jumbo_no_drops(test_name):
     encoded = host.image_records(IMAGE, 4)
     assert len(encoded[0]) > 8000
     sequence = [(frames.udp(A, record), False) for record in encoded]
-    out = ingest_sim.run(sequence, name=test_name, gap=(24, 24), waves=False)
+    out = endpoint_sim.run(sequence, name=test_name, gap=(24, 24), waves=False)
     assert out["net"]["accepted"] == len(sequence) and out["net"]["drop_overflow"] == 0
     assert out["rx_stalls"] == 0
     assert [r for _f, r, _d in out["rows"]] == list(range(TEST_DMD.rows))
@@ -318,7 +318,7 @@ def test_buffer_overflow_drops_whole_frames(test_name):
     """A consumer far slower than the line: frames that find no room are dropped whole and
     counted; every row that does come out is complete and belongs to an accepted record."""
     sequence = [(image_frame(r, rows=2, sequence=r), False) for r in range(0, 24, 2)]
-    out = ingest_sim.run(sequence, name=test_name, gap=(0, 0), pixel_stall=0.9, buffer_depth=1024,
+    out = endpoint_sim.run(sequence, name=test_name, gap=(0, 0), pixel_stall=0.9, buffer_depth=1024,
                          waves=False)
     net = out["net"]
     assert net["drop_overflow"] > 0

@@ -13,7 +13,7 @@ from amaranth import Module, Signal
 from amaranth.lib import fifo, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from gateware.dlpc410.params import Registers
+from gateware.registers import Registers
 
 __all__ = ["RegisterCrossing"]
 

@@ -1,4 +1,4 @@
-"""Running the ingest block (:class:`gateware.net.ingest.Ingest`) in the Amaranth simulator.
+"""Running the endpoint (:class:`gateware.protocol.endpoint.Endpoint`) in the Amaranth simulator.
 
 Frames go in as MAC byte beats with chosen gaps; everything that comes out is collected: image
 rows, transmitted frames, trigger pulses, sequencer register sets, the counters and the configuration at the end. Shared
@@ -7,12 +7,11 @@ by the unit tests and the benchmark.
 
 import random
 
-from gateware.dlpc410.facts import TEST_DMD
-from gateware.net.ingest import Ingest
-from gateware.protocol import fields
+from gateware.protocol.endpoint import Endpoint
 from sim.harness.amaranth_sim import simulate
-
-from .frames import Addresses, byte_beats
+from sim.models.frames import Addresses, byte_beats
+from spec import records
+from spec.facts import TEST_DMD
 
 __all__ = ["run", "plain", "assemble_rows"]
 
@@ -47,7 +46,7 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
     and record a snapshot (counters, pixels and frames sent so far) in ``snapshots``: the
     effects of each frame, one by one."""
     a = addresses or Addresses()
-    dut = Ingest(dmd, mac=a.mac, ip=a.ip, port=a.port, buffer_depth=buffer_depth)
+    dut = Endpoint(dmd, mac=a.mac, ip=a.ip, port=a.port, buffer_depth=buffer_depth)
     rng = random.Random(seed)
     out = {"pixels": [], "tx": [], "triggers": 0, "registers": [], "cycle": 0, "activity": 0, "last_in": [],
            "first_pixel": [], "snapshots": [], "rx_stalls": 0}
@@ -80,9 +79,9 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
             await ctx.tick()
 
     def snapshot(ctx):
-        return {"net": plain(ctx.get(dut.net_counters), fields.NET_COUNTERS),
-                "app": plain(ctx.get(dut.app_counters), fields.APP_COUNTERS),
-                "config": plain(ctx.get(dut.settings), fields.CONFIG),
+        return {"net": plain(ctx.get(dut.net_counters), records.NET_COUNTERS),
+                "app": plain(ctx.get(dut.app_counters), records.APP_COUNTERS),
+                "config": plain(ctx.get(dut.settings), records.CONFIG),
                 "pixel_count": len(out["pixels"]), "tx_count": len(out["tx"]),
                 "triggers": out["triggers"], "register_count": len(out["registers"])}
 

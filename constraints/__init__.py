@@ -1,1 +1,0 @@
-"""Pin and clock constraints of the boards the projector builds for (see README.md here)."""

@@ -1,0 +1,204 @@
+"""The application protocol's records: the one definition both ends speak.
+
+Every record is a sequence of big-endian fields. Each table below lists ``(name, width in bits)``
+in wire order (:mod:`spec.wire` packs and unpacks them). The gateware's parser and status reply
+are built from these tables (:mod:`gateware.wire` gives their Amaranth views), and so are the
+host's encoder and decoder (:mod:`host.codec`); ``docs/protocol.md`` describes the meaning of
+each field, the widths live only here. Plain Python: the host needs no HDL toolchain.
+
+One authority per setting: the sequencer's run-time registers (:data:`spec.registers.FIELDS`:
+trigger mode, plane durations, reset mode, ...) are set only by the sequencer record
+(:data:`SEQUENCER`, derived from that table, so that a register added there is on the wire with
+no edit here); the control record (:data:`CONFIG`) sets what the rest of the projector uses: the
+store's bit depth and sequence, arming, the network addresses.
+"""
+
+__all__ = [
+    "MAGIC", "VERSION", "RecordType", "Action",
+    "HEADER", "IMAGE", "CONTROL", "CONFIG", "SEQUENCER", "NET_COUNTERS", "APP_COUNTERS",
+    "SYSTEM_STATUS", "STATUS_REPLY", "image_record_length", "MAX_RECORD",
+    "register_wire", "registers_bits", "register_faults",
+]
+
+import enum as _enum
+import functools as _functools
+import operator as _operator
+
+from . import registers as _registers
+from .wire import size
+
+#: ``"DM"``: first two bytes of every record.
+MAGIC = 0x444D
+#: Protocol version this tree speaks; records with any other version are dropped and counted.
+VERSION = 2
+#: Largest record: a UDP payload inside a 9000-byte IP MTU (9000 - 20 IPv4 - 8 UDP).
+MAX_RECORD = 8972
+
+
+class RecordType(_enum.IntEnum):
+    IMAGE = 1
+    CONTROL = 2
+    STATUS_QUERY = 3
+    STATUS_REPLY = 4
+    SEQUENCER = 5
+
+
+class Action(_enum.IntFlag):
+    SOFTWARE_TRIGGER = 1
+
+
+#: Common header of every record.
+HEADER = [
+    ("magic", 16),
+    ("version", 8),
+    ("type", 8),
+    ("length", 16),      # whole record in bytes, this header included
+    ("sequence", 32),    # sender's record counter; gaps are counted as loss
+]
+
+#: Image record body (after :data:`HEADER`), followed by ``row_count * row_bytes`` pixel bytes.
+IMAGE = [
+    ("frame", 16),       # frame id; its low bits select the store's frame slot
+    ("first_row", 16),
+    ("row_count", 16),
+    ("row_bytes", 16),   # must equal the DMD's columns (8-bit pixels)
+]
+
+#: Run-time configuration: the registers a control record sets (the gateware's ``Config``).
+CONFIG = [
+    ("bit_depth", 8),        # 1..8 planes stored per frame
+    ("armed", 8),            # 1: triggers reach the sequencer; 0: every trigger source is ignored
+    ("sequence_length", 16), # frame slots in the sequence (1 = a single frame, streamed)
+    ("mac", 48),             # our MAC address
+    ("ip", 32),              # our IPv4 address
+    ("port", 16),            # our UDP port
+]
+
+#: Control record body: ``apply`` bit i makes CONFIG field i take the record's value; the others
+#: keep theirs. ``action`` bits are one-shot commands (:class:`Action`).
+CONTROL = [("apply", 16), ("action", 8)] + CONFIG
+
+#: Sequencer record body: every register of :data:`spec.registers.FIELDS`, in that order, each
+#: widened to whole bytes (the high bits must be zero). An enum field carries its value;
+#: ``order_table`` carries entry ``j`` in bits ``3j..3j+2``.
+SEQUENCER = [(f.name, -(-f.bits // 8) * 8) for f in _registers.FIELDS]
+
+#: Counters kept by the network stack (frames, by outcome).
+NET_COUNTERS = [
+    ("frames", 32),          # frames seen from the MAC
+    ("accepted", 32),        # frames committed (UDP, ICMP echo, ARP request for us)
+    ("drop_mac", 32),        # the MAC's verdict was bad (FCS, rx_er, runt, oversize)
+    ("drop_overflow", 32),   # no room in the receive buffer
+    ("drop_dst_mac", 32),
+    ("drop_vlan", 32),
+    ("drop_ethertype", 32),
+    ("drop_arp", 32),        # ARP that is not a request for our address
+    ("drop_ip_version", 32),
+    ("drop_ip_options", 32),
+    ("drop_ip_length", 32),  # total length against the frame
+    ("drop_ip_checksum", 32),
+    ("drop_ip_fragment", 32),
+    ("drop_ip_dst", 32),
+    ("drop_ip_protocol", 32),
+    ("drop_icmp", 32),       # not an echo request, or bad ICMP checksum
+    ("drop_udp_length", 32),
+    ("drop_udp_port", 32),
+    ("drop_udp_checksum", 32),
+    ("arp_replies", 32),
+    ("icmp_replies", 32),
+]
+
+#: Counters kept by the protocol parser (records, by outcome).
+APP_COUNTERS = [
+    ("records_image", 32),
+    ("records_control", 32),   # control records applied
+    ("records_sequencer", 32), # sequencer records passed on (applied when the sequencer rests)
+    ("records_status", 32),
+    ("drop_app_magic", 32),    # not a record of this protocol
+    ("drop_app_version", 32),
+    ("drop_app_type", 32),
+    ("drop_app_empty", 32),    # zero length or zero rows
+    ("drop_app_length", 32),   # length field against datagram, or against the rows it carries
+    ("drop_app_rows", 32),     # rows beyond the frame geometry, or row_bytes not the DMD's
+    ("drop_app_value", 32),    # a control or sequencer record with a value it cannot obey
+    ("sequence_gaps", 32),     # records whose sequence number was not the previous + 1
+    ("rows", 32),              # image rows handed to the serialiser
+    ("payload_bytes", 48),     # image bytes handed on
+    ("last_frame", 16),
+    ("last_row", 16),
+]
+
+#: Figures the rest of the system supplies (the gateware's ``Status`` input).
+SYSTEM_STATUS = [
+    ("uptime_cycles", 48),     # system clock cycles since reset
+    ("clock_hz", 32),
+    ("triggers", 32),          # triggers obeyed
+    ("trigger_overruns", 32),  # triggers that came while a frame was still showing
+    ("frames_shown", 32),
+    ("dlpc410_state", 16),     # bits: 0 INIT_ACTIVE, 1 RST_ACTIVE, 2 ECP2_FINISHED, 3 DDR2 calibrated, 4-6 link
+    ("triggers_early", 32),    # triggers before the DLPC410 finished initialising
+    ("pulses_late", 32),       # clocking pulses made after their time
+    ("row_underruns", 32),     # row loads that waited for the store
+    ("frames_bad_depth", 32),  # frames offered with a bit depth outside 1..8
+    ("registers_applied", 32), # sequencer register sets taken by the sequencer
+    ("registers_superseded", 32),  # register sets replaced by a newer one before the sequencer took them
+    ("mac_good", 32),          # frames on the receive pins, by the MAC's verdict
+    ("mac_bad_fcs", 32),
+    ("mac_rx_er", 32),
+    ("mac_runt", 32),
+    ("mac_oversize", 32),
+    ("mac_preamble", 32),
+    ("mac_rx_dropped", 32),    # dropped whole: no room in the receive FIFO
+    ("mac_tx_underruns", 32),  # replies aborted on the transmit pins
+    ("store_frames_complete", 32),   # frames whose every row arrived
+    ("store_frames_replaced", 32),   # complete, replaced unshown by a newer one
+    ("store_frames_abandoned", 32),  # incomplete, abandoned for a newer frame (a lost record)
+    ("store_rows_refused", 32),      # rows the store refused (outside, stale, shown, duplicate, no slot)
+]
+
+#: Status reply body (after :data:`HEADER`).
+STATUS_REPLY = NET_COUNTERS + APP_COUNTERS + SYSTEM_STATUS
+
+
+def register_wire(values):
+    """Register values (a dict of ints, enum members and the ``order_table`` list) -> the
+    sequencer record's field values (ints)."""
+    bits = _registers.pack(values)
+    return {name: (bits >> offset) & ((1 << width) - 1)
+            for name, (offset, width) in _registers.layout_bits().items()}
+
+
+def registers_bits(wire):
+    """The sequencer record's fields as ints -> the packed register set (an int) the gateware
+    hands on: each field's bits beyond the register's width are dropped."""
+    return sum((wire[name] & ((1 << width) - 1)) << offset
+               for name, (offset, width) in _registers.layout_bits().items())
+
+
+def _any(terms):
+    return _functools.reduce(_operator.or_, terms)
+
+
+def register_faults(wire, row_cycles):
+    """Why the sequencer could not obey a register set: ``{check: condition}``, each condition
+    true when the set fails the check. ``wire`` maps the :data:`SEQUENCER` field names to ints
+    (the host, the reference model) or to Amaranth values (the parser); the conditions are built
+    with operators only, so both get the same checks. ``row_cycles``: the DMD's DCLK cycles per
+    row, the shortest row period."""
+    faults = {}
+    for f, (_, wire_width) in zip(_registers.FIELDS, SEQUENCER, strict=True):
+        if wire_width > f.bits:
+            faults[f"{f.name}_fits"] = (wire[f.name] >> f.bits) != 0
+        if f.enum is not None and len(f.enum) < (1 << f.width):
+            faults[f"{f.name}_known"] = _any([wire[f.name] == member.value for member in f.enum]) == 0
+    faults["lsb_even_nonzero"] = (wire["lsb"] == 0) | ((wire["lsb"] & 1) != 0)
+    faults["dark_gap_even"] = (wire["dark_gap"] & 1) != 0
+    faults["stagger_even"] = (wire["stagger"] & 1) != 0
+    faults["row_period"] = wire["row_period"] < row_cycles
+    faults["period_nonzero"] = ((wire["trigger"] == _registers.TriggerMode.PERIODIC.value)
+                                & (wire["period"] == 0))
+    return faults
+
+
+def image_record_length(row_count, row_bytes):
+    return size(HEADER) + size(IMAGE) + row_count * row_bytes
