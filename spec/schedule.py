@@ -199,7 +199,246 @@ class _Group:
         self.writable = INIT_TO_DVALID
         self.rst_free = 0
         self.pos = None           # ("plane", frame_index, j) or ("dark", frame_index, j)
-        self.frame = None
+
+
+class _Frames:
+    """The frames offered, in turn from their ``ready`` cycle (the store's answers), and the
+    frames taken (``shown``). A frame with a bad bit depth is dropped the cycle it is offered."""
+
+    def __init__(self, frames, result):
+        self.offered = list(frames)
+        self.shown = result.shown
+        self.result = result
+        self.offer_from = 0
+
+    def offer(self):
+        """(bad frames before it, cycle it is offered from) of the next good frame, or None."""
+        at = self.offer_from
+        for k, f in enumerate(self.offered):
+            at = max(at, f.ready)
+            if 1 <= f.depth <= 8:
+                return k, at
+            at += 1
+        return None
+
+    def take(self, t, repeat=True):
+        """Take the frame offered at ``t``, if any: its index in ``shown``; else the last one
+        taken (``repeat``) or None."""
+        nxt = self.offer()
+        if nxt is not None and nxt[1] <= t:
+            del self.offered[:nxt[0]]
+            self.result.bad_frames += nxt[0]
+            self.shown.append(self.offered.pop(0))
+            self.offer_from = t + 1
+        elif not repeat:
+            return None
+        assert self.shown, "no frame offered before it was needed"
+        return len(self.shown) - 1
+
+
+class _Model:
+    """The sequencer's algorithm, its parts as in the gateware: the planner (:meth:`enqueue`,
+    :meth:`after_pulse`), the frame control (:meth:`take_while_waiting`, :meth:`strobe`) and the
+    bus (:meth:`decide`), run event by event (:meth:`run`)."""
+
+    def __init__(self, dmd, p, frames, strobes):
+        self.dmd, self.p = dmd, p
+        self.R = dmd.dclk_per_row
+        self.row_period = p.row_period or self.R
+        self.grp = groups(dmd, p.reset_mode)
+        self.G = len(self.grp)
+        self.st = [_Group() for _ in range(self.G)]
+        self.res = Result([], [])
+        self.res.groups = self.st
+        self.queue = []                     # [group, ops, index]
+        self.frames = _Frames([Frame(0, 1)] if p.source == Source.PRNG else frames, self.res)
+        self.strobes = sorted(strobes)
+        self.si = 0                         # strobes handled
+        self.next_row = 0
+        self.rst_any = 0
+        self.next_frame = None
+        self.queued_at = self.G + 1         # the first planes are queued one group a cycle
+        self.bus_free = 0
+        self.t = 0
+        self.idle_take = not p.chain and p.source != Source.PRNG
+
+    # -- the planner -------------------------------------------------------------------------
+
+    def exps_of(self, fi):
+        return exponents(self.p.order, self.p.order_table, self.res.shown[fi].depth)
+
+    def enqueue(self, g, fi, j):
+        """Queue the load of frame ``fi``'s display position ``j`` (None: clears) for group g."""
+        dmd, frame = self.dmd, self.res.shown[fi]
+        ops = []
+        for b in self.grp[g]:
+            if j is not None:
+                plane = 8 - frame.depth + self.exps_of(fi)[j]
+                if self.p.source == Source.PRNG or frame.occupied(plane, b):
+                    ops += [("row", r) for r in range(b * dmd.rows_per_block, (b + 1) * dmd.rows_per_block)]
+                    continue
+            ops.append(("clear", b))
+        self.queue.append([g, ops, 0])
+        self.st[g].loaded_at = None
+
+    def next_frame_for(self, g):
+        if g == 0:
+            self.next_frame = self.frames.take(self.t)
+        return self.next_frame
+
+    def after_pulse(self, g, t):
+        p, s = self.p, self.st[g]
+        kind, fi, j = s.pos
+        exps = self.exps_of(fi)
+        last = j == len(exps) - 1
+        if kind == "plane":
+            d = p.lsb << exps[j]
+            s.pulse_at = t + d
+            if d >= p.hide and (not last or p.chain):
+                nfi, nj = (fi, j + 1) if not last else (self.next_frame_for(g), 0)
+                s.pos = ("plane", nfi, nj)
+                self.enqueue(g, nfi, nj)
+            else:
+                s.pos = ("dark", fi, j)
+                self.enqueue(g, fi, None)
+        else:
+            s.pulse_at = t + p.dark_gap
+            nfi, nj = (fi, j + 1) if not last else (self.next_frame_for(g), 0)
+            s.pos = ("plane", nfi, nj)
+            if last and not p.chain:
+                s.pending = False
+            self.enqueue(g, nfi, nj)
+
+    def waiting(self, t):
+        return all(not s.pending and s.loaded_at is not None and s.loaded_at <= t for s in self.st)
+
+    def playing(self):
+        return any(s.pending for s in self.st)
+
+    # -- the frame control -------------------------------------------------------------------
+
+    def start(self):
+        fi = self.next_frame = self.frames.take(self.t)
+        for g in range(self.G):
+            self.st[g].pos = ("plane", fi, 0)
+            self.enqueue(g, fi, 0)
+
+    def take_while_waiting(self, t):
+        """A newer frame offered while no group plays: load its first plane, abandoning the
+        stale loads still queued (their words are discarded for ``flush_rows`` row periods)."""
+        wait = 0 if self.waiting(t) else flush_rows(self.dmd) * self.row_period
+        fi = self.next_frame = self.frames.take(t, repeat=False)
+        self.queued_at = t + wait + self.G + 1
+        self.queue.clear()
+        for g in range(self.G):
+            self.st[g].pos = ("plane", fi, 0)
+            self.st[g].writable = max(self.st[g].writable, t + self.p.reload_lead + wait)
+            self.enqueue(g, fi, 0)
+
+    def strobe(self, s_t):
+        """A trigger strobe at ``s_t`` (reads the state before this cycle's decision)."""
+        if self.waiting(s_t):
+            self.res.accepted.append(s_t)
+            start = even(s_t + 1)
+            for g, s in enumerate(self.st):
+                s.pending = True
+                s.pulse_at = start + g * self.p.stagger
+        else:
+            self.res.overruns += 1
+
+    # -- the bus -----------------------------------------------------------------------------
+
+    def decide(self, t):
+        """The bus's decision at an even free cycle: a due pulse, else the next load operation,
+        else nothing. Returns True when a pulse was made."""
+        p, st, res, R = self.p, self.st, self.res, self.R
+        rst_ok = [t - (self.rst_any if p.strict_rst else st[g].rst_free) >= 0 for g in range(self.G)]
+        due = [g for g in range(self.G) if st[g].pending and st[g].loaded_at is not None
+               and st[g].loaded_at <= t and st[g].pulse_at <= t and rst_ok[g]]
+        if due:
+            g = due[0]
+            s = st[g]
+            if s.pulse_at < t:
+                res.late += 1
+            kind, fi, j = s.pos
+            res.commands.append((t, "pulse", tuple(self.grp[g])))
+            res.pulses.append((t, g, kind, fi, self.exps_of(fi)[j] if kind == "plane" else None))
+            if kind == "plane" and j == 0 and g == 0:
+                res.frame_starts.append(t)
+            s.rst_free = t + p.t_rst
+            self.rst_any = t + p.t_rst
+            s.writable = t + p.t_rst + p.t_settle
+            self.bus_free = t + R
+            self.after_pulse(g, t)
+            return True
+        if self.queue:
+            g, ops, i = self.queue[0]
+            op, arg = ops[i]
+            length = R if op == "row" else self.dmd.clear_row_cycles * R
+            imminent = any(st[h].pending and st[h].loaded_at is not None and st[h].loaded_at <= t
+                           and st[h].pulse_at < t + length for h in range(self.G))
+            if t >= st[g].writable and not imminent and (op != "row" or t >= self.next_row):
+                res.commands.append((t, op, arg))
+                for k in range(1, self.dmd.clear_row_cycles if op == "clear" else 1):
+                    res.commands.append((t + k * R, "noop", None))
+                if op == "row":
+                    self.next_row = t + self.row_period
+                self.bus_free = t + length
+                self.queue[0][2] += 1
+                if self.queue[0][2] == len(ops):
+                    self.queue.pop(0)
+                    st[g].loaded_at = t + length
+        return False
+
+    # -- time --------------------------------------------------------------------------------
+
+    def next_time(self):
+        """The next cycle at which anything can happen, and the cycle a waiting frame is taken
+        (None if none)."""
+        t, p, st = self.t, self.p, self.st
+        cands = []
+        if self.si < len(self.strobes):
+            cands.append(self.strobes[self.si])
+        for s in st:
+            if s.pending and s.loaded_at is not None:
+                cands.append(max(s.pulse_at, s.rst_free if not p.strict_rst else self.rst_any))
+        if self.queue:
+            g, ops, i = self.queue[0]
+            cands.append(max(st[g].writable, self.next_row) if ops[i][0] == "row" else st[g].writable)
+        nxt = self.frames.offer()
+        take_at = None
+        if self.idle_take and nxt is not None and not self.playing():
+            take_at = max(nxt[1], self.queued_at, t + 1)
+            cands.append(take_at)
+        if not cands:
+            return None
+        nt = max(t + 1, min(cands), self.bus_free)
+        if take_at is not None and t < take_at < nt:
+            nt = take_at
+        if nt % 2 and not (self.si < len(self.strobes) and self.strobes[self.si] == nt) and nt != take_at:
+            nt += 1
+        return nt
+
+    def run(self, until=None, max_frames=None):
+        self.start()
+        while True:
+            t = self.t
+            nxt = self.frames.offer()
+            take_now = (self.idle_take and nxt is not None and nxt[1] <= t and t >= self.queued_at
+                        and not self.playing())
+            if t % 2 == 0 and t >= self.bus_free and self.decide(t):
+                if max_frames is not None and len(self.res.frame_starts) > max_frames:
+                    break
+            if take_now:
+                self.take_while_waiting(t)
+            while self.si < len(self.strobes) and self.strobes[self.si] <= t:
+                self.si += 1
+                self.strobe(self.strobes[self.si - 1])
+            nt = self.next_time()
+            if nt is None or (until is not None and nt >= until):
+                break
+            self.t = nt
+        return self.res
 
 
 def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
@@ -215,206 +454,13 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
         it takes the offered one, else shows the current one again; triggered and not chained,
         one offered while every group waits loaded for a trigger is taken at once.
     strobes : iterable of int
-        Cycles at which the trigger block signals a trigger (see :mod:`.trigger`).
+        Cycles at which the trigger block signals a trigger (see :mod:`gateware.dlpc410.trigger`).
     until : int
         Stop at this cycle (default: when nothing is left to do).
+    max_frames : int
+        Stop once this many frames have started (and one more pulse).
     """
-    R = dmd.dclk_per_row
-    row_period = p.row_period or R
-    clear_len = dmd.clear_row_cycles * R
-    grp = groups(dmd, p.reset_mode)
-    G = len(grp)
-    st = [_Group() for _ in range(G)]
-    res = Result([], [])
-    res.groups = st
-    queue = []                     # [group, ops, index]
-    offered = list(frames)
-    shown = res.shown              # frames taken, by index
-    strobes = sorted(strobes)
-    state = {"next_row": 0, "rst_any": 0, "next_frame": None, "offer_from": 0, "queued_at": G + 1}
-    if p.source == Source.PRNG:
-        offered = [Frame(0, 1)]
-
-    def offer():
-        """(bad frames before it, cycle it is offered from) of the next good frame, or None."""
-        at = state["offer_from"]
-        for k, f in enumerate(offered):
-            at = max(at, f.ready)
-            if 1 <= f.depth <= 8:
-                return k, at
-            at += 1
-        return None
-
-    def take_frame(repeat=True):
-        # frames with a bit depth outside 1..8 are dropped (and counted) as soon as offered
-        nxt = offer()
-        if nxt is not None and nxt[1] <= t_now[0]:
-            del offered[:nxt[0]]
-            res.bad_frames += nxt[0]
-            shown.append(offered.pop(0))
-            state["offer_from"] = t_now[0] + 1
-        elif not repeat:
-            return None
-        assert shown, "no frame offered before it was needed"
-        return len(shown) - 1
-
-    def exps_of(fi):
-        return exponents(p.order, p.order_table, shown[fi].depth)
-
-    def enqueue(g, fi, j):
-        """Queue the load of frame ``fi``'s display position ``j`` (None: clears) for group g."""
-        ops = []
-        for b in grp[g]:
-            if j is not None:
-                plane = 8 - shown[fi].depth + exps_of(fi)[j]
-                if p.source == Source.PRNG or shown[fi].occupied(plane, b):
-                    ops += [("row", r) for r in range(b * dmd.rows_per_block, (b + 1) * dmd.rows_per_block)]
-                    continue
-            ops.append(("clear", b))
-        queue.append([g, ops, 0])
-        st[g].loaded_at = None
-
-    def next_frame_for(g):
-        if g == 0:
-            state["next_frame"] = take_frame()
-        return state["next_frame"]
-
-    def after_pulse(g, t):
-        s = st[g]
-        kind, fi, j = s.pos
-        exps = exps_of(fi)
-        last = j == len(exps) - 1
-        if kind == "plane":
-            d = p.lsb << exps[j]
-            s.pulse_at = t + d
-            if d >= p.hide and (not last or p.chain):
-                nfi, nj = (fi, j + 1) if not last else (next_frame_for(g), 0)
-                s.pos = ("plane", nfi, nj)
-                enqueue(g, nfi, nj)
-            else:
-                s.pos = ("dark", fi, j)
-                enqueue(g, fi, None)
-        else:
-            s.pulse_at = t + p.dark_gap
-            nfi, nj = (fi, j + 1) if not last else (next_frame_for(g), 0)
-            s.pos = ("plane", nfi, nj)
-            if last and not p.chain:
-                s.pending = False
-            enqueue(g, nfi, nj)
-
-    def waiting(t):
-        return all(not s.pending and s.loaded_at is not None and s.loaded_at <= t for s in st)
-
-    def playing():
-        return any(s.pending for s in st)
-
-    def take_while_waiting(t):
-        """A newer frame offered while no group plays: load its first plane, abandoning the
-        stale loads still queued (their words are discarded for ``flush_rows`` row periods)."""
-        wait = 0 if waiting(t) else flush_rows(dmd) * row_period
-        fi = take_frame(repeat=False)
-        state["next_frame"] = fi
-        state["queued_at"] = t + wait + G + 1
-        queue.clear()
-        for g in range(G):
-            st[g].pos = ("plane", fi, 0)
-            st[g].writable = max(st[g].writable, t + p.reload_lead + wait)
-            enqueue(g, fi, 0)
-
-    idle_take = not p.chain and p.source != Source.PRNG
-    t_now = [0]
-    fi0 = take_frame()
-    state["next_frame"] = fi0
-    for g in range(G):
-        st[g].pos = ("plane", fi0, 0)
-        enqueue(g, fi0, 0)
-
-    t = 0
-    bus_free = 0
-    si = 0
-    while True:
-        t_now[0] = t
-        nxt = offer()
-        take_now = idle_take and nxt is not None and nxt[1] <= t and t >= state["queued_at"] and not playing()
-        # --- decision at t ---
-        if t % 2 == 0 and t >= bus_free:
-            rst_ok = [t - (state["rst_any"] if p.strict_rst else st[g].rst_free) >= 0 for g in range(G)]
-            due = [g for g in range(G) if st[g].pending and st[g].loaded_at is not None
-                   and st[g].loaded_at <= t and st[g].pulse_at <= t and rst_ok[g]]
-            if due:
-                g = due[0]
-                s = st[g]
-                if s.pulse_at < t:
-                    res.late += 1
-                kind, fi, j = s.pos
-                res.commands.append((t, "pulse", tuple(grp[g])))
-                res.pulses.append((t, g, kind, fi, exps_of(fi)[j] if kind == "plane" else None))
-                if kind == "plane" and j == 0 and g == 0:
-                    res.frame_starts.append(t)
-                s.rst_free = t + p.t_rst
-                state["rst_any"] = t + p.t_rst
-                s.writable = t + p.t_rst + p.t_settle
-                bus_free = t + R
-                after_pulse(g, t)
-                if max_frames is not None and len(res.frame_starts) > max_frames:
-                    break
-            elif queue:
-                g, ops, i = queue[0]
-                op, arg = ops[i]
-                length = R if op == "row" else clear_len
-                imminent = any(st[h].pending and st[h].loaded_at is not None and st[h].loaded_at <= t
-                               and st[h].pulse_at < t + length for h in range(G))
-                if t >= st[g].writable and not imminent and (op != "row" or t >= state["next_row"]):
-                    res.commands.append((t, op, arg))
-                    for k in range(1, dmd.clear_row_cycles if op == "clear" else 1):
-                        res.commands.append((t + k * R, "noop", None))
-                    if op == "row":
-                        state["next_row"] = t + row_period
-                    bus_free = t + length
-                    queue[0][2] += 1
-                    if queue[0][2] == len(ops):
-                        queue.pop(0)
-                        st[g].loaded_at = t + length
-        if take_now:
-            take_while_waiting(t)
-        # --- trigger strobe at t (reads the state before this cycle's decision) ---
-        while si < len(strobes) and strobes[si] <= t:
-            s_t = strobes[si]
-            si += 1
-            if waiting(s_t):
-                res.accepted.append(s_t)
-                start = even(s_t + 1)
-                for g, s in enumerate(st):
-                    s.pending = True
-                    s.pulse_at = start + g * p.stagger
-            else:
-                res.overruns += 1
-        # --- next interesting cycle ---
-        cands = []
-        if si < len(strobes):
-            cands.append(strobes[si])
-        for s in st:
-            if s.pending and s.loaded_at is not None:
-                cands.append(max(s.pulse_at, s.rst_free if not p.strict_rst else state["rst_any"]))
-        if queue:
-            g, ops, i = queue[0]
-            cands.append(max(st[g].writable, state["next_row"]) if ops[i][0] == "row" else st[g].writable)
-        nxt = offer()
-        take_at = None
-        if idle_take and nxt is not None and not playing():
-            take_at = max(nxt[1], state["queued_at"], t + 1)
-            cands.append(take_at)
-        if not cands:
-            break
-        nt = max(t + 1, min(cands), bus_free)
-        if take_at is not None and t < take_at < nt:
-            nt = take_at
-        if nt % 2 and not (si < len(strobes) and strobes[si] == nt) and nt != take_at:
-            nt += 1
-        if until is not None and nt >= until:
-            break
-        t = nt
-    return res
+    return _Model(dmd, p, frames, strobes).run(until=until, max_frames=max_frames)
 
 
 def level_light(dmd, p, result, images):

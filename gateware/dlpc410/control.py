@@ -1,0 +1,157 @@
+"""The frame control: when the groups start, take a newer frame, reload, and obey a trigger.
+
+States: ``WAIT`` for the first frame (or the pattern source), ``QUEUE`` every group's first
+plane, ``RUN``; a newer frame offered while no group plays (or new registers at rest) is taken at
+once and every group's first plane loaded again from it (``RELOAD``), after ``FLUSH`` when stale
+loads were under way: they are dropped, the words already asked of the store discarded, and the
+new loads start exactly ``flush_rows * row_period`` cycles after the frame was taken (the
+schedule model uses the same time). A trigger is obeyed when every group is loaded and waits;
+otherwise it is an overrun (or early, before the groups run).
+"""
+
+from amaranth import Module, Mux, Signal
+from amaranth.lib import data, wiring
+from amaranth.lib.wiring import In, Out
+
+from spec.schedule import flush_rows
+
+from ..registers import DURATION_BITS, TIME_BITS, Registers, Source
+from ..store.layouts import SLOT_BITS
+from .layouts import COUNTER_BITS, event, group_bits
+from .planner import Offer
+from .timebase import diff
+
+__all__ = ["FrameControl"]
+
+
+class FrameControl(wiring.Component):
+    """Starts, reloads and triggers the planner's groups.
+
+    Parameters
+    ----------
+    dmd : :class:`spec.facts.DmdType`
+
+    Members
+    -------
+    regs : In(Registers)
+    now : In(TIME_BITS)
+    n_groups : In(range(blocks + 1))
+    initialised : In(1)
+        The DLPC410 has finished initialising.
+    strobe : In(1)
+        A trigger (from :class:`~gateware.dlpc410.trigger.Trigger`).
+    reload : In(1)
+        New registers this cycle (only while ``at_rest``): load every group's first plane again.
+    at_rest : Out(1)
+        No frame plays and no load is under way: before the first frame, or every group loaded
+        and waiting for a trigger.
+    offer : In(:class:`~gateware.dlpc410.planner.Offer`)
+        The frame the store offers.
+    all_ready, playing : In(1)
+        From the planner.
+    drained : In(1)
+        No load job queued or looked up, and no word owed by the store.
+    start, retake, trigger, queue_first : Out(event)
+        The planner's commands (see :class:`~gateware.dlpc410.planner.Planner`).
+    running : Out(1)
+        The groups run (pulses and loads may be made).
+    flushing : Out(1)
+        Stale loads are being dropped.
+    triggers, overruns, early : Out(COUNTER_BITS)
+        Triggers obeyed; ignored because a frame played or was not loaded yet; before the groups
+        ran.
+    """
+
+    def __init__(self, dmd):
+        self._dmd = dmd
+        gb = group_bits(dmd)
+        super().__init__({
+            "regs": In(Registers),
+            "now": In(TIME_BITS),
+            "n_groups": In(range(dmd.blocks + 1)),
+            "initialised": In(1),
+            "strobe": In(1),
+            "reload": In(1),
+            "at_rest": Out(1),
+            "offer": In(Offer),
+            "all_ready": In(1),
+            "playing": In(1),
+            "drained": In(1),
+            "start": Out(event(data.StructLayout({"slot": SLOT_BITS, "depth": 4, "take": 1}))),
+            "retake": Out(event(data.StructLayout({"newer": 1, "lead": TIME_BITS}))),
+            "trigger": Out(event(TIME_BITS)),
+            "queue_first": Out(event(gb)),
+            "running": Out(1),
+            "flushing": Out(1),
+            "triggers": Out(COUNTER_BITS),
+            "overruns": Out(COUNTER_BITS),
+            "early": Out(COUNTER_BITS),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        regs, now = self.regs, self.now
+        use_prng = regs.source == Source.PRNG
+        take_idle = Signal()
+        flush_until = Signal(TIME_BITS)
+        flush_cycles = Signal(DURATION_BITS)
+        m.d.comb += flush_cycles.eq(flush_rows(self._dmd) * regs.row_period)
+        start_group = Signal(group_bits(self._dmd) + 1)
+
+        def queue_first_planes():
+            m.d.comb += [self.queue_first.valid.eq(1), self.queue_first.payload.eq(start_group)]
+            m.d.sync += start_group.eq(start_group + 1)
+            with m.If(start_group == self.n_groups - 1):
+                m.next = "RUN"
+
+        with m.FSM(name="start") as fsm:
+            with m.State("WAIT"):
+                with m.If(self.initialised & (self.offer.valid | use_prng)):
+                    begin = self.start.payload
+                    m.d.comb += [self.start.valid.eq(1), begin.take.eq(~use_prng),
+                                 begin.slot.eq(Mux(use_prng, 0, self.offer.slot)),
+                                 begin.depth.eq(Mux(use_prng, 1, self.offer.depth))]
+                    m.next = "QUEUE"
+            with m.State("QUEUE"):
+                queue_first_planes()
+            with m.State("RUN"):
+                m.d.comb += self.running.eq(1)
+                with m.If(take_idle):
+                    m.next = "RELOAD"
+                    with m.If(~self.all_ready):
+                        m.next = "FLUSH"
+            with m.State("FLUSH"):
+                # queued loads are dropped by the requester, looked-up ones by the bus, the words
+                # asked for are discarded; then the first planes are queued, exactly
+                # ``flush_cycles`` after the frame was taken
+                m.d.comb += [self.running.eq(1), self.flushing.eq(1)]
+                with m.If(self.drained & (diff(flush_until, now) <= 0)):
+                    m.next = "RELOAD"
+            with m.State("RELOAD"):
+                m.d.comb += self.running.eq(1)
+                queue_first_planes()
+
+        # A newer frame offered while no group plays replaces the preloaded first planes; nothing
+        # abandoned is pulsed (no trigger is obeyed before every group is loaded again), and the
+        # settle times of the last pulses still hold. With ``reload`` at rest, the same frame is
+        # loaded again under new registers.
+        newer = ~use_prng & ~regs.chain & self.offer.valid
+        idle = fsm.ongoing("RUN") & ~self.playing
+        resting = fsm.ongoing("RUN") & self.all_ready
+        m.d.comb += [take_idle.eq((idle & newer) | (resting & self.reload)),
+                     self.at_rest.eq(fsm.ongoing("WAIT") | resting)]
+        with m.If(take_idle):
+            wait = Mux(self.all_ready, 0, flush_cycles)
+            m.d.comb += [self.retake.valid.eq(1), self.retake.payload.newer.eq(newer),
+                         self.retake.payload.lead.eq(now + regs.reload_lead + wait)]
+            m.d.sync += [start_group.eq(0), flush_until.eq(now + wait)]
+
+        with m.If(self.strobe):
+            with m.If(~self.running):
+                m.d.sync += self.early.eq(self.early + 1)
+            with m.Elif(self.all_ready & ~take_idle):
+                m.d.comb += [self.trigger.valid.eq(1), self.trigger.payload.eq((now + 2) & ~1)]
+                m.d.sync += self.triggers.eq(self.triggers + 1)
+            with m.Else():
+                m.d.sync += self.overruns.eq(self.overruns + 1)
+        return m

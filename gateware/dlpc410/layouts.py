@@ -1,0 +1,71 @@
+"""What the sequencer's parts hand each other (all in the ``dmd`` domain).
+
+The parts (:mod:`.planner`, :mod:`.control`, :mod:`.requester`, :mod:`.row_source`, :mod:`.bus`)
+are joined by streams; an *event* is a stream that is always ready (it happens, it is not
+offered), for example a clocking pulse made this cycle.
+"""
+
+from amaranth.lib import data, stream
+from amaranth.utils import ceil_log2
+
+from ..registers import TIME_BITS
+from ..store.layouts import SLOT_BITS
+from .interface import BlockMode, RowMode
+
+__all__ = ["group_bits", "block_bits", "load_job", "ready_load", "event", "Command", "Status", "COUNTER_BITS"]
+
+COUNTER_BITS = 16
+
+
+def group_bits(dmd):
+    return max(1, ceil_log2(dmd.blocks))
+
+
+block_bits = group_bits
+
+
+def load_job(dmd):
+    """What a group must be loaded with next: display position ``pos`` of the frame in ``slot``
+    (of ``depth`` planes), or clears (``clear``)."""
+    return data.StructLayout({"group": group_bits(dmd), "slot": SLOT_BITS, "depth": 4, "pos": 3, "clear": 1})
+
+
+def ready_load(dmd):
+    """A load job with its blocks looked up: ``mask`` bit b set when block b's rows are loaded
+    (else it is cleared), for the blocks ``first`` .. ``last`` of the group."""
+    return data.StructLayout({"group": group_bits(dmd), "mask": dmd.blocks,
+                              "first": block_bits(dmd), "last": block_bits(dmd)})
+
+
+def event(shape):
+    """An event port: a stream that is always ready."""
+    return stream.Signature(shape, always_ready=True)
+
+
+class Command(data.Struct):
+    """The command pins of a row cycle, held through it."""
+    rowmd: RowMode
+    rowad: 11
+    blkmd: BlockMode
+    blkad: 4
+    rst2blkz: 1
+
+
+class Status(data.Struct):
+    """Counters and the time base, for the status reply.
+
+    ``now`` counts ``dmd`` cycles from the end of initialisation; ``frames`` frames started;
+    ``triggers`` triggers obeyed; ``overruns`` triggers ignored because a frame was playing or
+    the next one was not loaded yet; ``early`` triggers before initialisation ended; ``late``
+    pulses made after their time (a parameter set the schedule model rejects); ``underruns``
+    bus decisions that waited for row data from the store; ``bad_frames`` frames offered with
+    a bit depth outside 1..8, dropped.
+    """
+    now: TIME_BITS
+    frames: COUNTER_BITS
+    triggers: COUNTER_BITS
+    overruns: COUNTER_BITS
+    early: COUNTER_BITS
+    late: COUNTER_BITS
+    underruns: COUNTER_BITS
+    bad_frames: COUNTER_BITS

@@ -1,0 +1,248 @@
+"""The planner: every pulse group's timeline, and what each group must be loaded with next.
+
+Each group (:func:`spec.registers.group_size` blocks pulsed together) keeps its place in the
+frame (display position, dark or not), the frame slot and bit depth it shows, and four times:
+when its next pulse falls due, when its memory may change again (``t_rst + t_settle`` after its
+last pulse), when RST_ACTIVE allows its next pulse, and whether it is loaded. When the bus makes
+a pulse, the planner sets the group's next pulse time and queues its next load job: the next
+plane (a plane long enough to hide the load, ``hide``), or clears ended by a dark pulse. At the
+last plane of a frame group 0 takes the newest complete frame, if one is offered (else the frame
+repeats). The frame control starts, reloads and triggers the groups through command events.
+"""
+
+from amaranth import Array, Cat, Module, Mux, Signal
+from amaranth.lib import data, stream, wiring
+from amaranth.lib.wiring import In, Out
+
+from spec.schedule import INIT_TO_DVALID
+
+from ..registers import TIME_BITS, Registers, Source
+from ..store.layouts import SLOT_BITS, FrameInfo
+from .layouts import COUNTER_BITS, event, group_bits, load_job
+from .timebase import diff, exponent
+
+__all__ = ["Planner", "Offer"]
+
+
+class Offer(data.Struct):
+    """The frame the store offers now: ``valid`` when it has a bit depth the sequencer plays."""
+    valid: 1
+    slot: SLOT_BITS
+    depth: 4
+
+
+class Planner(wiring.Component):
+    """Per-group timelines and load jobs.
+
+    Parameters
+    ----------
+    dmd : :class:`spec.facts.DmdType`
+
+    Members
+    -------
+    regs : In(:class:`~gateware.registers.Registers`)
+    now : In(TIME_BITS)
+        The time base.
+    n_groups : In(range(blocks + 1))
+        Groups of the reset mode.
+    rst_active : In(1)
+        RST_ACTIVE, synchronised: no group's pulse is due while it is high.
+    frames : In(stream.Signature(FrameInfo))
+        The newest complete frame. A bit depth outside 1..8 is dropped when offered, and counted.
+    offer : Out(Offer)
+        The frame offered now, for the frame control.
+    pulse : In(event(group))
+        The bus made this group's pulse this cycle.
+    loaded : In(event(group))
+        The bus finished this group's load this cycle.
+    start : In(event(slot, depth, take))
+        Every group begins the frame ``slot`` of ``depth`` planes at its first plane; ``take``:
+        that frame is the one offered, taken now.
+    retake : In(event(newer, lead))
+        A newer frame (``newer``: the one offered, taken now) or the same frame under new
+        registers replaces what every group holds; each group's memory may change no sooner than
+        ``lead``.
+    trigger : In(event(TIME_BITS))
+        A trigger obeyed: group ``g``'s first pulse falls due at ``payload + g * stagger``.
+    queue_first : In(event(group))
+        Queue the group's first plane of the current frame.
+    jobs : Out(event(load_job))
+        Load jobs, in the order of the pulses that freed the groups (the queue always has room).
+    due : Out(blocks)
+        Bit g: group g is loaded, its pulse time has come and RST_ACTIVE allows it.
+    imminent, imminent_clear : Out(1)
+        A loaded group's pulse falls due within a row cycle, within a clear (and its no-op rows).
+    writable : Out(blocks)
+        Bit g: group g's memory may change (its settle time is over).
+    all_ready : Out(1)
+        Every group is loaded and waits for a trigger.
+    playing : Out(1)
+        Some group plays a frame.
+    frame_start : Out(1)
+        This cycle's pulse is the first of a frame.
+    sync_out : Out(1)
+        High while a frame is shown (first pulse to the last group's final dark pulse).
+    frames_started, late, bad_frames : Out(COUNTER_BITS)
+        Frames started; pulses made after their time; frames dropped for their bit depth.
+    """
+
+    def __init__(self, dmd):
+        self._dmd = dmd
+        groups = dmd.blocks
+        gb = group_bits(dmd)
+        super().__init__({
+            "regs": In(Registers),
+            "now": In(TIME_BITS),
+            "n_groups": In(range(groups + 1)),
+            "rst_active": In(1),
+            "frames": In(stream.Signature(FrameInfo)),
+            "offer": Out(Offer),
+            "pulse": In(event(gb)),
+            "loaded": In(event(gb)),
+            "start": In(event(data.StructLayout({"slot": SLOT_BITS, "depth": 4, "take": 1}))),
+            "retake": In(event(data.StructLayout({"newer": 1, "lead": TIME_BITS}))),
+            "trigger": In(event(TIME_BITS)),
+            "queue_first": In(event(gb)),
+            "jobs": Out(event(load_job(dmd))),
+            "due": Out(groups),
+            "imminent": Out(1),
+            "imminent_clear": Out(1),
+            "writable": Out(groups),
+            "all_ready": Out(1),
+            "playing": Out(1),
+            "frame_start": Out(1),
+            "sync_out": Out(1),
+            "frames_started": Out(COUNTER_BITS),
+            "late": Out(COUNTER_BITS),
+            "bad_frames": Out(COUNTER_BITS),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        dmd, regs, now = self._dmd, self.regs, self.now
+        R = dmd.dclk_per_row
+        G = dmd.blocks
+        use_prng = regs.source == Source.PRNG
+
+        def per_group(shape, name, init=0):
+            return Array(Signal(shape, name=f"{name}{g}", init=init) for g in range(G))
+        pending = per_group(1, "pending")
+        loaded = per_group(1, "loaded")
+        pulse_at = per_group(TIME_BITS, "pulse_at")
+        writable = per_group(TIME_BITS, "writable", INIT_TO_DVALID)
+        rst_free = per_group(TIME_BITS, "rst_free")
+        pos = per_group(3, "pos")
+        dark = per_group(1, "dark")
+        slot = per_group(SLOT_BITS, "slot")
+        depth = per_group(4, "depth")
+        rst_any = Signal(TIME_BITS)
+        next_slot = Signal(SLOT_BITS)          # the newest frame taken
+        next_depth = Signal(4)
+        active = [Signal(name=f"active{g}") for g in range(G)]
+        for g in range(G):
+            m.d.comb += active[g].eq(g < self.n_groups)
+
+        # ---- what the bus may do ----
+        armed = [Signal(name=f"armed{g}") for g in range(G)]
+        for g in range(G):
+            rst_ok = Mux(regs.strict_rst, diff(rst_any, now) <= 0, diff(rst_free[g], now) <= 0) & ~self.rst_active
+            m.d.comb += [
+                armed[g].eq(active[g] & pending[g] & loaded[g]),
+                self.due[g].eq(armed[g] & (diff(pulse_at[g], now) <= 0) & rst_ok),
+                self.writable[g].eq(diff(writable[g], now) <= 0),
+            ]
+        clear_len = dmd.clear_row_cycles * R
+        m.d.comb += [
+            self.imminent.eq(Cat(armed[g] & (diff(pulse_at[g], now) < R) for g in range(G)).any()),
+            self.imminent_clear.eq(Cat(armed[g] & (diff(pulse_at[g], now) < clear_len) for g in range(G)).any()),
+            self.all_ready.eq(Cat(~active[g] | (~pending[g] & loaded[g]) for g in range(G)).all()),
+            self.playing.eq(Cat(active[g] & pending[g] for g in range(G)).any()),
+        ]
+
+        # ---- the frame offered ----
+        depth_in = self.frames.payload.bit_depth
+        frame_ok = (depth_in != 0) & (depth_in <= 8)
+        m.d.comb += [self.offer.valid.eq(self.frames.valid & frame_ok),
+                     self.offer.slot.eq(self.frames.payload.slot), self.offer.depth.eq(depth_in)]
+        with m.If(self.frames.valid & ~frame_ok):
+            m.d.comb += self.frames.ready.eq(1)
+            m.d.sync += self.bad_frames.eq(self.bad_frames + 1)
+
+        # ---- a load finished ----
+        with m.If(self.loaded.valid):
+            m.d.sync += loaded[self.loaded.payload].eq(1)
+
+        # ---- a pulse: what follows it ----
+        p = self.pulse.payload
+        pj, pdark, pdepth = pos[p], dark[p], depth[p]
+        pe = exponent(m, regs, pj, pdepth, "pulse_exp")
+        last = pj == pdepth - 1
+        plane_len = Signal.like(regs.hide)
+        m.d.comb += plane_len.eq(regs.lsb << pe)
+        hidden = ~pdark & (plane_len >= regs.hide) & (~last | regs.chain)
+        new_frame = last & (pdark | hidden)
+        take = Signal()
+        n_slot = Mux(take, self.frames.payload.slot, next_slot)
+        n_depth = Mux(take, depth_in, next_depth)
+        m.d.comb += take.eq(self.pulse.valid & new_frame & (p == 0) & self.offer.valid & ~use_prng)
+        with m.If(take):
+            m.d.comb += self.frames.ready.eq(1)
+        job = self.jobs.payload
+        with m.If(self.pulse.valid):
+            with m.If(diff(pulse_at[p], now) < 0):
+                m.d.sync += self.late.eq(self.late + 1)
+            m.d.sync += [
+                writable[p].eq(now + regs.t_rst + regs.t_settle),
+                rst_free[p].eq(now + regs.t_rst),
+                rst_any.eq(now + regs.t_rst),
+                loaded[p].eq(0),
+                pulse_at[p].eq(now + Mux(pdark, regs.dark_gap, plane_len)),
+            ]
+            with m.If(p == 0):
+                m.d.sync += [next_slot.eq(n_slot), next_depth.eq(n_depth)]
+            m.d.comb += [self.jobs.valid.eq(1), job.group.eq(p), job.slot.eq(slot[p]),
+                         job.depth.eq(pdepth), job.pos.eq(pj + 1)]
+            with m.If(pdark | hidden):
+                m.d.sync += [dark[p].eq(0), pos[p].eq(Mux(last, 0, pj + 1))]
+                with m.If(last):
+                    m.d.sync += [slot[p].eq(n_slot), depth[p].eq(n_depth)]
+                    m.d.comb += [job.slot.eq(n_slot), job.depth.eq(n_depth), job.pos.eq(0)]
+                    with m.If(pdark & ~regs.chain):
+                        m.d.sync += pending[p].eq(0)
+            with m.Else():
+                m.d.sync += dark[p].eq(1)
+                m.d.comb += job.clear.eq(1)
+            # frame boundaries: sync out, the frame counter
+            with m.If((p == 0) & ~pdark & (pj == 0)):
+                m.d.comb += self.frame_start.eq(1)
+                m.d.sync += [self.sync_out.eq(1), self.frames_started.eq(self.frames_started + 1)]
+            with m.If((p == self.n_groups - 1) & pdark & last & ~regs.chain):
+                m.d.sync += self.sync_out.eq(0)
+
+        # ---- commands of the frame control ----
+        with m.If(self.start.valid):
+            begin = self.start.payload
+            with m.If(begin.take):
+                m.d.comb += self.frames.ready.eq(1)
+            m.d.sync += [next_slot.eq(begin.slot), next_depth.eq(begin.depth)]
+            for g in range(G):
+                m.d.sync += [slot[g].eq(begin.slot), depth[g].eq(begin.depth), pos[g].eq(0), dark[g].eq(0)]
+        with m.If(self.queue_first.valid):
+            m.d.comb += [self.jobs.valid.eq(1), job.group.eq(self.queue_first.payload),
+                         job.slot.eq(next_slot), job.depth.eq(next_depth), job.pos.eq(0), job.clear.eq(0)]
+        with m.If(self.retake.valid):
+            newer = self.retake.payload.newer
+            lead = self.retake.payload.lead
+            with m.If(newer):
+                m.d.comb += self.frames.ready.eq(1)
+            r_slot = Mux(newer, self.frames.payload.slot, next_slot)
+            r_depth = Mux(newer, depth_in, next_depth)
+            m.d.sync += [next_slot.eq(r_slot), next_depth.eq(r_depth)]
+            for g in range(G):
+                m.d.sync += [slot[g].eq(r_slot), depth[g].eq(r_depth), loaded[g].eq(0),
+                             writable[g].eq(Mux(diff(writable[g], lead) < 0, lead, writable[g]))]
+        with m.If(self.trigger.valid):
+            for g in range(G):
+                with m.If(active[g]):
+                    m.d.sync += [pending[g].eq(1), pulse_at[g].eq(self.trigger.payload + regs.stagger * g)]
+        return m

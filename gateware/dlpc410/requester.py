@@ -1,0 +1,160 @@
+"""The requester: turns load jobs into row requests to the store and ready loads for the bus.
+
+For each job it looks up the occupancy map of the job's frame slot (one cycle), so that an
+empty block is cleared instead of loaded; it hands the bus the job with its block mask first (so
+the bus can drain one block's words while the next block's request waits for the store), then
+asks the store for the rows of each occupied block, one request per block. It also hands slots
+back: when the last group's first load comes from a new slot, no group reads the old one again.
+While the frame control flushes, jobs are dropped here (through the same slot accounting) and a
+request already offered is held until taken (its words are discarded by the row source).
+"""
+
+from amaranth import Cat, Const, Module, Mux, Signal
+from amaranth.lib import data, fifo, stream, wiring
+from amaranth.lib.wiring import In, Out
+
+from ..registers import Registers, ResetMode, Source
+from ..store.layouts import SLOT_BITS, PlaneRequest
+from .layouts import block_bits, load_job, ready_load
+from .timebase import exponent
+
+__all__ = ["Requester"]
+
+
+class Requester(wiring.Component):
+    """Load jobs to plane requests.
+
+    Parameters
+    ----------
+    dmd : :class:`spec.facts.DmdType`
+
+    Members
+    -------
+    regs : In(Registers)
+    n_groups : In(range(blocks + 1))
+    size_log2 : In(3)
+        Blocks per group, log2 (phased modes).
+    flushing : In(1)
+        Drop jobs; end a request once it is taken.
+    jobs : In(stream.Signature(load_job))
+        Load jobs in order.
+    occ_slot : Out(SLOT_BITS); occupancy : In(ArrayLayout(8, blocks))
+        The occupancy read port (bit k of block b: stored plane k has a bit set in block b), for
+        slot ``occ_slot`` as it was one cycle earlier.
+    loads : Out(stream.Signature(ready_load))
+        Each job with its block mask, to the bus.
+    requests : Out(stream.Signature(PlaneRequest))
+        One block of one plane per request, in load order.
+    release : Out(stream.Signature(SLOT_BITS))
+        Slots no group reads again.
+    idle : Out(1)
+        No job is being looked up or requested.
+    """
+
+    def __init__(self, dmd):
+        self._dmd = dmd
+        super().__init__({
+            "regs": In(Registers),
+            "n_groups": In(range(dmd.blocks + 1)),
+            "size_log2": In(3),
+            "flushing": In(1),
+            "jobs": In(stream.Signature(load_job(dmd))),
+            "occ_slot": Out(SLOT_BITS),
+            "occupancy": In(data.ArrayLayout(8, dmd.blocks)),
+            "loads": Out(stream.Signature(ready_load(dmd))),
+            "requests": Out(stream.Signature(PlaneRequest)),
+            "release": Out(stream.Signature(SLOT_BITS)),
+            "idle": Out(1),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        dmd, regs, n_groups = self._dmd, self.regs, self.n_groups
+        rpb = dmd.rows_per_block
+        bb = block_bits(dmd)
+        use_prng = regs.source == Source.PRNG
+        flushing = self.flushing
+
+        entry = Signal(load_job(dmd))          # the job being requested
+        mask = Signal(dmd.blocks)
+        block = Signal(bb + 1)
+        first = Signal(bb)
+        last = Signal(bb)
+        head = self.jobs.payload
+        m.d.comb += self.occ_slot.eq(head.slot)
+        plane = Signal(3)
+        m.d.comb += plane.eq(8 - entry.depth + exponent(m, regs, entry.pos, entry.depth, "req_exp"))
+
+        # the job's group's blocks: all of them in global mode, else 2**size_log2 from
+        # group << size_log2, cut at the last block (the DLP9500's 15 blocks)
+        span_first = Signal(bb)
+        span_last = Signal(bb)
+        g_first = (entry.group << self.size_log2)[:bb + 1]
+        g_end = g_first + (Const(1, 4) << self.size_log2) - 1
+        with m.If(regs.reset_mode == ResetMode.GLOBAL):
+            m.d.comb += [span_first.eq(0), span_last.eq(dmd.blocks - 1)]
+        with m.Else():
+            m.d.comb += [span_first.eq(g_first), span_last.eq(Mux(g_end > dmd.blocks - 1, dmd.blocks - 1, g_end))]
+
+        m.d.comb += [
+            self.loads.payload.group.eq(entry.group), self.loads.payload.mask.eq(mask),
+            self.loads.payload.first.eq(first), self.loads.payload.last.eq(last),
+            self.requests.payload.slot.eq(entry.slot),
+            self.requests.payload.plane.eq(plane),
+            self.requests.payload.first_row.eq(block * rpb),
+            self.requests.payload.row_count.eq(rpb),
+        ]
+
+        # slots handed back, in order
+        m.submodules.releases = releases = fifo.SyncFIFOBuffered(width=SLOT_BITS, depth=4)
+        wiring.connect(m, releases.r_stream, wiring.flipped(self.release))
+        last_slot = Signal(SLOT_BITS)
+        seen_slot = Signal()
+        m.d.comb += releases.w_stream.payload.eq(last_slot)
+
+        with m.FSM(name="requester") as fsm:
+            with m.State("IDLE"):
+                # the last group's first load from a new slot: no group reads the old one again
+                leaves = (head.group == n_groups - 1) & ~head.clear & seen_slot & (head.slot != last_slot)
+                m.d.comb += [self.jobs.ready.eq(~leaves | releases.w_stream.ready),
+                             releases.w_stream.valid.eq(self.jobs.valid & leaves)]
+                # flushing: stale jobs are dropped here, through the same slot accounting
+                with m.If(self.jobs.valid & self.jobs.ready):
+                    m.d.sync += entry.eq(head)
+                    with m.If((head.group == n_groups - 1) & ~head.clear):
+                        m.d.sync += [last_slot.eq(head.slot), seen_slot.eq(1)]
+                    with m.If(~flushing):
+                        m.next = "LOOK"
+            with m.State("LOOK"):
+                looked = Cat(
+                    (b >= span_first) & (b <= span_last) & ~entry.clear
+                    & (use_prng | self.occupancy[b].bit_select(plane, 1))
+                    for b in range(dmd.blocks))
+                m.d.sync += [mask.eq(looked), block.eq(span_first), first.eq(span_first), last.eq(span_last)]
+                m.next = "PUSH"
+                with m.If(flushing):
+                    m.next = "IDLE"
+            with m.State("PUSH"):
+                # the bus learns the mask first, so it drains the words of one block while the
+                # next block's request waits for the store
+                with m.If(flushing):
+                    m.next = "IDLE"
+                with m.Else():
+                    m.d.comb += self.loads.valid.eq(1)
+                    with m.If(self.loads.ready):
+                        m.next = "REQUEST"
+            with m.State("REQUEST"):
+                wanted = mask.bit_select(block, 1) & ~use_prng
+                # flushing: a request offered is held until taken (its words are discarded)
+                with m.If((block > last) | (flushing & ~wanted)):
+                    m.next = "IDLE"
+                with m.Elif(wanted):
+                    m.d.comb += self.requests.valid.eq(1)
+                    with m.If(self.requests.ready):
+                        m.d.sync += block.eq(block + 1)
+                        with m.If(flushing):
+                            m.next = "IDLE"
+                with m.Else():
+                    m.d.sync += block.eq(block + 1)
+        m.d.comb += self.idle.eq(fsm.ongoing("IDLE"))
+        return m
