@@ -80,3 +80,10 @@ BLOCKS = {
     "sequencer_dlp9500": lambda: _sequencer("dlp9500"),
     "register_crossing": _register_crossing,
 }
+
+
+def core(dmd="dlp7000"):
+    """The projector's core as the board builds it (:func:`gateware.top.platform.core`)."""
+    from gateware.platform.clocks import Spartan6Clocks
+    from gateware.top.platform import core as board_core
+    return board_core(DMDS[dmd], Spartan6Clocks.frequencies())

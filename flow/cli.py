@@ -1,4 +1,4 @@
-"""Command line: ``python -m flow <verilog|resources|bench|sim|waves>``."""
+"""Command line: ``python -m flow <verilog|resources|timing|bench|sim|waves>``."""
 
 import argparse
 import sys
@@ -11,6 +11,7 @@ def main(argv=None):
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("verilog", help="write the Spartan-6 ISE tree and every block's Verilog to build/spartan6")
     sub.add_parser("resources", help="Yosys synth_xilinx -family xc6s: LUT/FF/BRAM/DSP per block and in total")
+    sub.add_parser("timing", help="logic depth between flip-flops per clock domain (Yosys, xc6s)")
     bench = sub.add_parser("bench", help="run the benchmarks and write build/bench.json")
     bench.add_argument("--only", action="append", help="run only this benchmark module (repeatable)")
     bench.add_argument("--no-resources", action="store_true", help="skip the synthesis figures")
@@ -24,6 +25,9 @@ def main(argv=None):
         return run()
     if args.command == "resources":
         from flow.resources import main as run
+        return run()
+    if args.command == "timing":
+        from flow.timing import main as run
         return run()
     if args.command == "bench":
         from flow.bench import main as run

@@ -126,9 +126,13 @@ class Requester(wiring.Component):
                     with m.If(~flushing):
                         m.next = "LOOK"
             with m.State("LOOK"):
+                # (comparisons that cannot fail are left out: Verilator rejects them)
+                def in_span(b):
+                    after_first = (span_first <= b) if b < (1 << bb) - 1 else 1
+                    before_last = (span_last >= b) if b else 1
+                    return after_first & before_last
                 looked = Cat(
-                    (b >= span_first) & (b <= span_last) & ~entry.clear
-                    & (use_prng | self.occupancy[b].bit_select(plane, 1))
+                    in_span(b) & ~entry.clear & (use_prng | self.occupancy[b].bit_select(plane, 1))
                     for b in range(dmd.blocks))
                 m.d.sync += [mask.eq(looked), block.eq(span_first), first.eq(span_first), last.eq(span_last)]
                 m.next = "PUSH"

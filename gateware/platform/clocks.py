@@ -50,7 +50,9 @@ class Spartan6Clocks(Elaboratable):
         """The clock domains this block drives; the top that owns them adds them."""
         return [ClockDomain(name) for name in PLL_PLAN["outputs"]]
 
-    def frequencies(self):
+    @staticmethod
+    def frequencies():
+        """``{domain: Hz}`` of the plan."""
         vco = PLL_PLAN["input_mhz"] * PLL_PLAN["mult"]
         return {name: vco / div * 1e6 for name, div in PLL_PLAN["outputs"].items()}
 

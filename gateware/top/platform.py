@@ -16,7 +16,7 @@ from spec.facts import DMDS
 
 from .system import Projector
 
-__all__ = ["PlatformTop", "ADDRESSES", "UCF_EXTRA"]
+__all__ = ["PlatformTop", "core", "ADDRESSES", "UCF_EXTRA"]
 
 #: Network addresses at power-up; a control record changes them at run time.
 ADDRESSES = dict(mac=0x02_44_4D_00_00_01, ip=0xC0_A8_01_0A, port=5000)
@@ -27,6 +27,15 @@ UCF_EXTRA = """
 INST "*stage0*" TNM = "cdc_first_stages";
 TIMESPEC "TS_cdc_first_stages" = TO "cdc_first_stages" TIG;
 """
+
+
+def core(dmd, frequencies):
+    """The projector's core as the board builds it: disarmed, with power-up sequencer registers
+    of the shortest legal 8-bit global schedule at the facts' timing (the host replaces them with
+    sequencer records, and arms the triggers). ``frequencies``: ``{domain: Hz}``."""
+    plan = schedule.plan(dmd, frequencies["dmd"], depth=8)
+    return Projector(dmd, sync_hz=frequencies["sync"], regs=Registers.const(plan.params.registers(dmd)),
+                     armed=False, **ADDRESSES)
 
 
 class PlatformTop(Elaboratable):
@@ -59,12 +68,7 @@ class PlatformTop(Elaboratable):
         m.submodules.trigger = trigger = TriggerPins()
 
         # ---- The core ------------------------------------------------------------------------
-        # Power-up sequencer registers: the shortest legal 8-bit global schedule at the facts'
-        # timing; the host replaces them with sequencer records, and arms the triggers.
-        plan = schedule.plan(dmd, clocks.frequencies()["dmd"], depth=8)
-        m.submodules.core = core = Projector(dmd, sync_hz=clocks.frequencies()["sync"],
-                                             regs=Registers.const(plan.params.registers(dmd)),
-                                             armed=False, **ADDRESSES)
+        m.submodules.core = core = core(dmd, clocks.frequencies())
         m.d.comb += [core.gmii_rx.eq(gmii.rx), gmii.tx.eq(core.gmii_tx)]
         m.d.comb += [
             gmii.phy_reset_n.eq(core.phy_reset_n), gmii.mdc.eq(core.mdc),

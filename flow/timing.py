@@ -1,0 +1,219 @@
+"""Logic depth between flip-flops, per clock domain, from Yosys ``synth_xilinx -family xc6s``.
+
+Nothing here can run ISE's timing analysis, so this is the best evidence we can give without
+it: the mapped netlist's deepest register-to-register paths, counted in the units a Spartan-6
+path is made of.
+
+* **LUT levels**: LUT1..LUT6 cells on the path (a MUXF7/MUXF8 sits in the same slice as the
+  LUTs it joins and is not counted; a LUT-RAM read counts as a LUT).
+* **Carry chain**: the longest CARRY4 chain on the path, in bits (4 per CARRY4), and how many
+  separate chains the path goes through.
+
+A path starts at a flip-flop output, a block RAM or DSP output, a shift-register LUT or a top
+input, and ends at a flip-flop, block RAM, DSP or shift-register input; it belongs to the clock
+domain of the cell it ends at. The budget for 200 MHz on a -3 Spartan-6 that the ``dmd`` domain
+is pipelined to: at most 4 LUT levels and one carry chain of at most 16 bits on any path.
+
+``python -m flow timing`` prints the figures and the deepest paths of the projector's core.
+"""
+
+import json
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+
+__all__ = ["Depth", "analyse", "netlist", "report", "figures", "BUDGET", "main"]
+
+#: The ``dmd`` domain's budget: LUT levels, carry bits, carry chains per path.
+BUDGET = {"lut_levels_max": 4, "carry_max": 16, "carry_chains_max": 1}
+
+_LUTS = {f"LUT{n}" for n in range(1, 7)} | {"LUT6_2", "INV", "RAM32M", "RAM64M", "RAM32X1D", "RAM64X1D",
+                                            "RAM128X1D", "RAM32X1S", "RAM64X1S", "RAM128X1S"}
+_FREE = {"MUXF7", "MUXF8", "BUFG", "BUF", "IBUF", "OBUF", "VCC", "GND"}
+#: Cells whose outputs are registered: a path ends at their inputs and starts at their outputs.
+_SEQUENTIAL_PREFIXES = ("FD", "LD", "RAMB", "SRL", "DSP48A1_REGISTERED")
+#: A DSP48A1 used without its pipeline registers is a combinational multiplier: counted as this
+#: many LUT levels (about 4 ns on a -3 part).
+_DSP_LEVELS = 3
+_DSP_REGISTERS = ("A0REG", "A1REG", "B0REG", "B1REG", "CREG", "DREG", "MREG", "PREG")
+#: Clock pins of the sequential cells.
+_CLOCK_PINS = ("C", "CLK", "CLKA", "CLKB", "CLKAWRCLK", "CLKBRDCLK", "WCLK")
+#: LUT-RAM write ports: registered inputs.
+_LUTRAM_WRITE = {"WE", "WCLK"}
+
+
+@dataclass
+class Depth:
+    """The deepest path found to one net: LUTs on it, the longest carry chain on it (bits),
+    the carry chains it goes through, the bits of the chain it is in now (0: none), and where
+    its deepest LUT path starts."""
+    luts: int = 0
+    carry: int = 0
+    chains: int = 0
+    run: int = 0
+    start: str = ""
+
+
+def netlist(verilog, top, *, workdir):
+    """Synthesise ``verilog`` for XC6S and return the flattened module's JSON netlist."""
+    from flow.resources import _yosys
+    workdir = Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    source = workdir / f"{top}.v"
+    source.write_text(verilog)
+    out = workdir / f"{top}.netlist.json"
+    script = (f"read_verilog {source.name}; synth_xilinx -family xc6s -top {top} -flatten -noiopad -noclkbuf; "
+              f"write_json {out.name}")
+    proc = subprocess.run([_yosys(), "-q", "-p", script], capture_output=True, text=True, cwd=workdir)
+    if proc.returncode != 0:
+        raise RuntimeError(f"yosys failed on {top}:\n{proc.stdout[-2000:]}{proc.stderr[-2000:]}")
+    return json.loads(out.read_text())["modules"][top]
+
+
+def _registered_dsp(cell):
+    return cell["type"] == "DSP48A1" and any(int(str(cell["parameters"].get(p, "0")), 2) == 1
+                                             for p in ("MREG", "PREG"))
+
+
+def _sequential(kind):
+    return kind.startswith(_SEQUENTIAL_PREFIXES)
+
+
+def analyse(module):
+    """Per clock domain (named after the net on the clock pins): ``{"lut_levels_max",
+    "carry_max", "carry_chains_max", "paths"}``, ``paths`` the five deepest, deepest first, as
+    ``(luts, carry bits, chains, start, end)``."""
+    names = {}
+    for name, net in module["netnames"].items():
+        for bit in net["bits"]:
+            if isinstance(bit, int) and (bit not in names or len(name) < len(names[bit])):
+                names[bit] = name
+    cells = module["cells"]
+    drivers = {}
+    for cname, cell in cells.items():
+        for pin, direction in cell["port_directions"].items():
+            if direction == "output":
+                for bit in cell["connections"][pin]:
+                    if isinstance(bit, int):
+                        drivers[bit] = cname
+
+    def inputs(cell):
+        return [(pin, bit) for pin, d in cell["port_directions"].items()
+                if d == "input" and pin not in _LUTRAM_WRITE and pin not in _CLOCK_PINS
+                for bit in cell["connections"][pin]]
+
+    # combinational cells in topological order
+    for cell in cells.values():
+        if _registered_dsp(cell):
+            cell["type"] = "DSP48A1_REGISTERED"
+    comb = [c for c, cell in cells.items() if not _sequential(cell["type"])]
+    deps = {c: {drivers[b] for _, b in inputs(cells[c]) if isinstance(b, int) and b in drivers
+                and not _sequential(cells[drivers[b]]["type"])} for c in comb}
+    users = {c: [] for c in comb}
+    for c, ds in deps.items():
+        for d in ds:
+            users[d].append(c)
+    waiting = {c: len(ds) for c, ds in deps.items()}
+    order = [c for c in comb if waiting[c] == 0]
+    for c in order:
+        for u in users[c]:
+            waiting[u] -= 1
+            if waiting[u] == 0:
+                order.append(u)
+    if len(order) != len(comb):
+        raise RuntimeError("combinational loop in the netlist")
+
+    state = {}
+
+    def of(bit):
+        if isinstance(bit, int) and bit in state:
+            return state[bit]
+        return Depth(start=names.get(bit, "input") if isinstance(bit, int) else "constant")
+
+    for cname in order:
+        cell = cells[cname]
+        kind = cell["type"]
+        ins = [(pin, of(bit)) for pin, bit in inputs(cell)]
+        deepest = max((d for _, d in ins), key=lambda d: d.luts, default=Depth(start=cname))
+        luts = deepest.luts + (1 if kind in _LUTS else _DSP_LEVELS if kind == "DSP48A1" else 0)
+        carry = max((d.carry for _, d in ins), default=0)
+        chains = max((d.chains for _, d in ins), default=0)
+        run = 0
+        if kind == "CARRY4":
+            ci = [d for pin, d in ins if pin == "CI"]
+            run = (ci[0].run if ci else 0) + 4
+            carry = max(carry, run)
+            chains = max([d.chains + 1 for pin, d in ins if pin != "CI"]
+                         + [d.chains + (0 if d.run else 1) for pin, d in ins if pin == "CI"])
+        out = Depth(luts, carry, chains, run, deepest.start)
+        for pin, direction in cell["port_directions"].items():
+            if direction == "output":
+                for bit in cell["connections"][pin]:
+                    if isinstance(bit, int):
+                        state[bit] = out
+
+    domains = {}
+    for cname, cell in cells.items():
+        if not _sequential(cell["type"]):
+            continue
+        clocks = [cell["connections"][p][0] for p in _CLOCK_PINS if p in cell["connections"]]
+        domain = names.get(clocks[0], "?") if clocks else "?"
+        entry = domains.setdefault(domain, {"lut_levels_max": 0, "carry_max": 0, "carry_chains_max": 0,
+                                            "paths": []})
+        for pin, bit in inputs(cell):
+            d = of(bit)
+            entry["lut_levels_max"] = max(entry["lut_levels_max"], d.luts)
+            entry["carry_max"] = max(entry["carry_max"], d.carry)
+            entry["carry_chains_max"] = max(entry["carry_chains_max"], d.chains)
+            entry["paths"].append((d.luts, d.carry, d.chains, d.start, f"{names.get(cell['connections'].get('Q', [None])[0], cname)}"))
+    for entry in domains.values():
+        seen, paths = set(), []
+        for path in sorted(entry["paths"], key=lambda p: (p[0], p[1], p[2]), reverse=True):
+            if (path[3], path[4]) not in seen:
+                seen.add((path[3], path[4]))
+                paths.append(path)
+            if len(paths) == 5:
+                break
+        entry["paths"] = paths
+    return domains
+
+
+def _domain_of(net):
+    """``dmd_clk`` -> ``dmd``; Amaranth names the ``sync`` domain's clock ``clk``."""
+    return "sync" if net == "clk" else net[:-len("_clk")] if net.endswith("_clk") else net
+
+
+def report(component=None, *, name="projector", workdir="build/timing"):
+    """Synthesise the projector's core (or ``component``) and analyse it: ``{domain: ...}``."""
+    from amaranth.back import verilog
+    if component is None:
+        from flow.blocks import core
+        component = core()
+    text = verilog.convert(component, name=name, emit_src=False, strip_internal_attrs=True)
+    result = analyse(netlist(text, name, workdir=workdir))
+    return {_domain_of(domain): entry for domain, entry in result.items()}
+
+
+def figures(result):
+    out = {}
+    for domain, entry in result.items():
+        for key in ("lut_levels_max", "carry_max", "carry_chains_max"):
+            out[f"timing.{domain}.{key}"] = (entry[key], "LUT levels" if key == "lut_levels_max" else
+                                             "bits" if key == "carry_max" else "chains")
+    return out
+
+
+def print_report(result):
+    for domain in sorted(result):
+        entry = result[domain]
+        budget = " (budget: 4 LUT levels, one carry chain of 16 bits)" if domain == "dmd" else ""
+        print(f"{domain}: {entry['lut_levels_max']} LUT levels, carry chains up to {entry['carry_max']} bits, "
+              f"{entry['carry_chains_max']} chain(s) on a path{budget}")
+        for luts, carry, chains, start, end in entry["paths"]:
+            print(f"    {luts} LUT, carry {carry} bits ({chains} chain(s)): {start} -> {end}")
+
+
+def main():
+    result = report()
+    print_report(result)
+    return 0
