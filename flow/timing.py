@@ -160,12 +160,13 @@ def analyse(module):
         domain = names.get(clocks[0], "?") if clocks else "?"
         entry = domains.setdefault(domain, {"lut_levels_max": 0, "carry_max": 0, "carry_chains_max": 0,
                                             "paths": []})
-        for pin, bit in inputs(cell):
+        end = names.get(cell["connections"].get("Q", [None])[0], cname)
+        for _pin, bit in inputs(cell):
             d = of(bit)
             entry["lut_levels_max"] = max(entry["lut_levels_max"], d.luts)
             entry["carry_max"] = max(entry["carry_max"], d.carry)
             entry["carry_chains_max"] = max(entry["carry_chains_max"], d.chains)
-            entry["paths"].append((d.luts, d.carry, d.chains, d.start, f"{names.get(cell['connections'].get('Q', [None])[0], cname)}"))
+            entry["paths"].append((d.luts, d.carry, d.chains, d.start, end))
     for entry in domains.values():
         seen, paths = set(), []
         for path in sorted(entry["paths"], key=lambda p: (p[0], p[1], p[2]), reverse=True):

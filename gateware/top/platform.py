@@ -68,21 +68,21 @@ class PlatformTop(Elaboratable):
         m.submodules.trigger = trigger = TriggerPins()
 
         # ---- The core ------------------------------------------------------------------------
-        m.submodules.core = core = core(dmd, clocks.frequencies())
-        m.d.comb += [core.gmii_rx.eq(gmii.rx), gmii.tx.eq(core.gmii_tx)]
+        m.submodules.core = projector = core(dmd, clocks.frequencies())
+        m.d.comb += [projector.gmii_rx.eq(gmii.rx), gmii.tx.eq(projector.gmii_tx)]
         m.d.comb += [
-            gmii.phy_reset_n.eq(core.phy_reset_n), gmii.mdc.eq(core.mdc),
-            gmii.mdio_o.eq(core.mdio_o), gmii.mdio_oe.eq(core.mdio_oe), core.mdio_i.eq(gmii.mdio_i),
+            gmii.phy_reset_n.eq(projector.phy_reset_n), gmii.mdc.eq(projector.mdc),
+            gmii.mdio_o.eq(projector.mdio_o), gmii.mdio_oe.eq(projector.mdio_oe), projector.mdio_i.eq(gmii.mdio_i),
         ]
-        wiring.connect(m, core.dlpc, dlpc.bus)
+        wiring.connect(m, projector.dlpc, dlpc.bus)
         m.d.comb += [
-            core.trigger_in.eq(trigger.trigger),
-            trigger.sync.eq(core.sync_out),
-            trigger.camera.eq(core.camera_out),
+            projector.trigger_in.eq(trigger.trigger),
+            trigger.sync.eq(projector.sync_out),
+            trigger.camera.eq(projector.camera_out),
         ]
         # ---- DDR2 through the memory controller ----------------------------------------------
         m.submodules.mcb = mcb = McbInstance(port0_domain="sync", port1_domain="dmd")
-        wiring.connect(m, core.mcb_write, mcb.port0)
-        wiring.connect(m, core.mcb_read, mcb.port1)
+        wiring.connect(m, projector.mcb_write, mcb.port0)
+        wiring.connect(m, projector.mcb_read, mcb.port1)
         m.d.comb += [mcb.sys_clk.eq(clk_buf.i), mcb.sys_rst.eq(rst_buf.i)]
         return m
