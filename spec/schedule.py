@@ -60,9 +60,30 @@ import numpy as np
 from .facts import TIMING, BlockMode
 from .registers import PlaneOrder, ResetMode, Source, TriggerMode, group_size
 
-__all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate",
+__all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate", "FABRIC_HZ",
+           "beats_at", "row_cycles",
            "plan", "bound", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS", "flush_rows",
            "RST_MARGIN", "even", "ready_cycle"]
+
+#: The ``dmd`` domain's clock: every cycle count of the model and the sequencer is in its cycles.
+#: DCLK is this (one beat per cycle) or twice this (two beats per cycle: 400 MHz through the
+#: platform's 4:1 serialisers).
+FABRIC_HZ = 200e6
+
+
+def beats_at(dclk_hz):
+    """DCLK beats per ``dmd`` cycle at DCLK ``dclk_hz``: 1 at 200 MHz, 2 at 400 MHz."""
+    beats = round(dclk_hz / FABRIC_HZ)
+    if beats not in (1, 2) or abs(beats * FABRIC_HZ - dclk_hz) > 1:
+        raise ValueError(f"DCLK {dclk_hz / 1e6:g} MHz is not 1 or 2 beats per {FABRIC_HZ / 1e6:g} MHz cycle")
+    return beats
+
+
+def row_cycles(dmd, beats=1):
+    """``dmd`` cycles of one row cycle: the DMD's DCLK cycles per row over the beats per cycle."""
+    assert dmd.dclk_per_row % beats == 0
+    return dmd.dclk_per_row // beats
+
 
 #: First load this many cycles after INIT_ACTIVE falls (DLPC910: first DVALID >= 64 clocks).
 INIT_TO_DVALID = int(TIMING["init_to_dvalid_clocks"].value)
@@ -119,6 +140,7 @@ class Params:
     camera_width: int = 1
     ns_flip: bool = False
     park: bool = False
+    beats: int = 1               # DCLK beats per dmd cycle: the sequencer's build, not a register
 
     def registers(self, dmd):
         """The values of :class:`~gateware.registers.Registers`, as a dict."""
@@ -127,7 +149,7 @@ class Params:
             "camera_offset", "camera_width")}
         regs.update(reset_mode=self.reset_mode, order=self.order, order_table=list(self.order_table),
                     chain=int(self.chain), strict_rst=int(self.strict_rst), trigger=self.trigger,
-                    source=self.source, row_period=self.row_period or dmd.dclk_per_row,
+                    source=self.source, row_period=self.row_period or row_cycles(dmd, self.beats),
                     ns_flip=int(self.ns_flip), park=int(self.park))
         return regs
 
@@ -243,7 +265,7 @@ class _Model:
 
     def __init__(self, dmd, p, frames, strobes):
         self.dmd, self.p = dmd, p
-        self.R = dmd.dclk_per_row
+        self.R = row_cycles(dmd, p.beats)
         self.row_period = p.row_period or self.R
         self.grp = groups(dmd, p.reset_mode)
         self.G = len(self.grp)
@@ -499,11 +521,11 @@ class Plan:
 
     @property
     def rate_hz(self):
-        return self.dclk_hz / self.frame_cycles
+        return FABRIC_HZ / self.frame_cycles
 
 
-def _cycles(seconds, dclk_hz):
-    return even(math.ceil(seconds * dclk_hz - 1e-9))
+def _cycles(seconds):
+    return even(math.ceil(seconds * FABRIC_HZ - 1e-9))
 
 
 def _lattice_ok(M, s, G, sep):
@@ -523,7 +545,7 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     """A parameter set that shows every plane exactly on time, and the rate it reaches.
 
     ``exposure_s`` asks for a least significant plane at least that long (0: the shortest legal
-    one). ``words_per_cycle`` is the store's read bandwidth in 64-bit words per DCLK cycle; it
+    one). ``words_per_cycle`` is the store's read bandwidth in 64-bit words per ``dmd`` cycle; it
     sets the row pacing. The plan is checked by simulating one frame (all blocks full unless
     ``frame`` is given): no pulse may be late.
 
@@ -535,9 +557,10 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     instead when it is faster; ``binds`` then names the load queue order.
     ``reload_lead``: the store's latency to a row's first words, in cycles (see :class:`Params`).
     """
-    R = dmd.dclk_per_row
-    t_rst = even(_cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s, dclk_hz) + RST_MARGIN)
-    t_settle = _cycles(TIMING["t_settle"].value if t_settle_s is None else t_settle_s, dclk_hz)
+    beats = beats_at(dclk_hz)
+    R = row_cycles(dmd, beats)
+    t_rst = even(_cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s) + RST_MARGIN)
+    t_settle = _cycles(TIMING["t_settle"].value if t_settle_s is None else t_settle_s)
     words = dmd.words_per_row
     # the on-chip source needs no memory bandwidth: one row per row cycle on any bus width
     row_period = R if source == Source.PRNG else even(max(R, math.ceil(words / words_per_cycle - 1e-9)))
@@ -556,7 +579,7 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
         lsb_min = max(t_rst + t_settle + load_g, bus_path, 2)
         binds = "bus (row loads)" if G > 1 and bus_path >= t_rst + t_settle + load_g \
             else "settle + load (a pulse freezes its group's memory)"
-    want = _cycles(exposure_s, dclk_hz)
+    want = _cycles(exposure_s)
     if want > lsb_min:
         lsb_min, binds = want, "requested exposure"
     # slack for other groups' pulses stealing row cycles during a load
@@ -571,7 +594,7 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
             p = Params(lsb=lsb, t_rst=t_rst, t_settle=t_settle, hide=hide, dark_gap=dark_gap,
                        reset_mode=reset_mode, order=order, order_table=order_table, chain=chain,
                        strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period,
-                       reload_lead=reload_lead)
+                       reload_lead=reload_lead, beats=beats)
             fr = frame or Frame(0, depth)
             r = simulate(dmd, p, [replace(fr, ready=0)] * (3 if chain else 1), [ready_cycle(dmd, p, fr)],
                          max_frames=2)
@@ -606,7 +629,7 @@ def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
     :func:`simulate`. Returns (params, frame cycles) if faster than ``beat`` cycles, else None."""
     G = len(groups(dmd, p.reset_mode))
     frozen = p.t_rst + p.t_settle
-    margin = 2 * dmd.dclk_per_row * G           # other groups' pulses taking row cycles
+    margin = 2 * row_cycles(dmd, p.beats) * G   # other groups' pulses taking row cycles
     exps = exponents(p.order, p.order_table, fr.depth)
     best = None
     step = max(2, even(lsb_min // 64))
@@ -685,7 +708,7 @@ def bound(dmd, dclk_hz, depth=8, *, t_rst_s=None, t_settle_s=None):
     """Upper bound on the continuous-light PWM frame rate, any schedule: the least significant
     plane lasts at least RST_ACTIVE + settle + one clear row cycle, and a frame is
     ``2**depth - 1`` such units (derivation: ``docs/bounds.md``)."""
-    t_rst = (TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s) * dclk_hz
-    t_settle = (TIMING["t_settle"].value if t_settle_s is None else t_settle_s) * dclk_hz
-    t0 = t_rst + t_settle + dmd.clear_row_cycles * dmd.dclk_per_row
-    return dclk_hz / ((2 ** depth - 1) * t0)
+    t_rst = TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s
+    t_settle = TIMING["t_settle"].value if t_settle_s is None else t_settle_s
+    t0 = t_rst + t_settle + dmd.clear_row_cycles * dmd.dclk_per_row / dclk_hz
+    return 1 / ((2 ** depth - 1) * t0)
