@@ -18,10 +18,9 @@ def _gray(value):
 
 
 def _from_gray(gray):
-    bits = [gray[-1]]
-    for i in reversed(range(len(gray) - 1)):
-        bits.insert(0, bits[0] ^ gray[i])
-    return bits
+    """Binary bit ``i`` is the XOR of Gray bits ``i`` and up: each one a balanced tree (two LUT
+    levels for 32 bits), not a chain through the bits above it."""
+    return [gray[i:].xor() for i in range(len(gray))]
 
 
 class CountSynchronizer(wiring.Component):
