@@ -79,9 +79,9 @@ def _sequential(kind):
     return kind.startswith(_SEQUENTIAL_PREFIXES)
 
 
-def analyse(module):
+def analyse(module, *, keep=5):
     """Per clock domain (named after the net on the clock pins): ``{"lut_levels_max",
-    "carry_max", "carry_chains_max", "paths"}``, ``paths`` the five deepest, deepest first, as
+    "carry_max", "carry_chains_max", "paths"}``, ``paths`` the ``keep`` deepest, deepest first, as
     ``(luts, carry bits, chains, start, end)``."""
     names = {}
     for name, net in module["netnames"].items():
@@ -173,7 +173,7 @@ def analyse(module):
             if (path[3], path[4]) not in seen:
                 seen.add((path[3], path[4]))
                 paths.append(path)
-            if len(paths) == 5:
+            if len(paths) == keep:
                 break
         entry["paths"] = paths
     return domains

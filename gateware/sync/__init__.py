@@ -1,0 +1,1 @@
+"""Tiled projectors: the sync master that starts every board's frame together."""
