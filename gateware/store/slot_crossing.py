@@ -4,7 +4,7 @@ Asks and releases share one FIFO, so that the slot table sees them in the order 
 gave them (a release behind an ask that cannot be answered yet waits for it).
 """
 
-from amaranth import Module
+from amaranth import Module, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.wiring import In, Out
@@ -63,14 +63,20 @@ class SlotCrossing(wiring.Component):
         wiring.connect(m, wiring.flipped(self.answers), answers.w_stream)
         wiring.connect(m, answers.r_stream, wiring.flipped(self.frames))
 
-        # releases go first
+        # Releases go first, but an ask offered to the full FIFO stays offered until it is taken
+        # (a stream's payload does not change before its transfer).
         merged = stream.Signature(Command).create()
+        ask_offered = Signal()
+        release_first = Signal()
         m.d.comb += [
+            release_first.eq(self.release.valid & ~ask_offered),
             merged.valid.eq(self.ask.valid | self.release.valid),
-            merged.payload.release.eq(self.release.valid),
-            merged.payload.slot.eq(self.release.payload),
-            self.release.ready.eq(merged.ready),
-            self.ask.ready.eq(merged.ready & ~self.release.valid),
+            merged.payload.release.eq(release_first),
+            self.release.ready.eq(merged.ready & ~ask_offered),
+            self.ask.ready.eq(merged.ready & ~release_first),
         ]
+        with m.If(release_first):
+            m.d.comb += merged.payload.slot.eq(self.release.payload)
+        m.d.dmd += ask_offered.eq(merged.valid & ~merged.ready & ~release_first)
         wiring.connect(m, merged, commands.w_stream)
         return m

@@ -180,15 +180,18 @@ class SlotTable(wiring.Component):
             self.answers.payload.bit_depth.eq(depth[answer_slot]),
         ]
 
-        # -- housekeeping: one event per cycle
+        # -- housekeeping: one event per cycle. An answer offered and not taken (the answer FIFO
+        # full) stays offered, unchanged: nothing else happens until it is taken.
+        offered = Signal()
+        m.d.sync += offered.eq(self.answers.valid & ~self.answers.ready)
         command = self.commands.payload
-        with m.If(mode_pending & self.placement.between_rows):
+        with m.If(mode_pending & self.placement.between_rows & ~offered):
             m.d.sync += [seq_len.eq(wanted_len), play.eq(0), t.recv_active.eq(0), t.last_valid.eq(0)]
             for s in range(n_slots):
                 with m.If(state[s] != SlotState.SHOWN):
                     m.d.sync += state[s].eq(SlotState.FREE)
                 m.d.sync += in_sequence[s].eq(0)
-        with m.Elif(self.written.valid):
+        with m.Elif(self.written.valid & ~offered):
             m.d.comb += self.written.ready.eq(1)
             done = self.written.payload
             with m.If(state[done] == SlotState.WRITING):
@@ -207,13 +210,15 @@ class SlotTable(wiring.Component):
                 m.d.sync += state[command.slot].eq(SlotState.READY)
             with m.Else():
                 m.d.sync += state[command.slot].eq(SlotState.FREE)
-        with m.Elif(self.commands.valid & can_answer & self.answers.ready):
-            m.d.comb += [self.commands.ready.eq(1), self.answers.valid.eq(1)]
-            m.d.sync += state[answer_slot].eq(SlotState.SHOWN)
-            with m.If(sequence):
-                m.d.sync += play.eq(play + 1)
-                with m.If(play == seq_len - 1):
-                    m.d.sync += play.eq(0)
+        with m.Elif(self.commands.valid & can_answer):
+            m.d.comb += self.answers.valid.eq(1)
+            with m.If(self.answers.ready):
+                m.d.comb += self.commands.ready.eq(1)
+                m.d.sync += state[answer_slot].eq(SlotState.SHOWN)
+                with m.If(sequence):
+                    m.d.sync += play.eq(play + 1)
+                    with m.If(play == seq_len - 1):
+                        m.d.sync += play.eq(0)
         return m
 
     def _place(self, m, t, seq_len, mode_pending, sequence):
