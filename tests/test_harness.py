@@ -1,7 +1,9 @@
 """The harnesses themselves: layouts round-trip, and a failing cocotb test fails pytest."""
 
+import random
+
 import pytest
-from amaranth import Module
+from amaranth import Module, signed
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import Out
 
@@ -17,6 +19,21 @@ def test_layout_round_trip():
     assert unpack(layout, pack(layout, value)) == value
     nested = data.StructLayout({"a": data.ArrayLayout(8, 3), "b": 4})
     assert unpack(nested, pack(nested, {"a": [1, 2, 255], "b": 7})) == {"a": [1, 2, 255], "b": 7}
+
+
+def test_pack_and_unpack_agree_with_amaranth():
+    """The shifts and masks give the bits of the layout's own ``const`` (values truncated to
+    their fields, signed fields in two's complement), and read them back as ``data.Const`` does."""
+    layout = data.StructLayout({"a": data.ArrayLayout(signed(5), 3), "b": 7, "c": data.StructLayout({"d": 1, "e": 9})})
+    rng = random.Random(5)
+    for _ in range(200):
+        value = {"a": [rng.randrange(-40, 40) for _ in range(3)], "b": rng.randrange(1000),
+                 "c": {"d": rng.randrange(3), "e": rng.randrange(600)}}
+        bits = pack(layout, value)
+        assert bits == layout.const(value).as_value().value
+        const = data.Const(layout, bits)
+        assert unpack(layout, bits) == {"a": [const.a[i] for i in range(3)], "b": const.b,
+                                        "c": {"d": const.c.d, "e": const.c.e}}
 
 
 class Counter(wiring.Component):

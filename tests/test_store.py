@@ -1,5 +1,7 @@
 """The bit-plane store (slots, writer, reader) with the serialiser in front and the MCB model
-behind, in the Amaranth simulator on the test geometry, against numpy."""
+behind, in the Amaranth simulator, against numpy: the layout and traffic on the test geometry,
+the slot policy (which slot, which frame, which counter; nothing there depends on the size of a
+frame) on its short variant."""
 
 import random
 
@@ -8,19 +10,22 @@ import numpy as np
 from sim.harness.amaranth_sim import simulate, stream_feed
 from sim.models import store_stim
 from sim.models.mcb import McbModel, McbTiming, amaranth_process
+from sim.models.store_stim import SHORT_DMD
 from sim.tb.store_chain import StoreChain
 from spec.facts import TEST_DMD
 
 DMD = TEST_DMD
 SYNC_HZ, DMD_HZ = 125e6, 200e6
+#: Row numbers the short geometry's row field holds (rows 24 to 31 lie beyond the frame).
+FIELD_ROWS = 1 << (SHORT_DMD.rows - 1).bit_length()
 
 
 class Bench:
     """A StoreChain with the MCB model on both ports and sequencer-side helpers (``dmd``)."""
 
-    def __init__(self, *, slots=4, timing=None):
-        self.slots = slots
-        self.dut = StoreChain(DMD, slots=slots)
+    def __init__(self, dmd=DMD, *, slots=4, timing=None):
+        self.dmd, self.slots = dmd, slots
+        self.dut = StoreChain(dmd, slots=slots)
         self.model = McbModel(64 * 1024, timing=timing)
         self.processes = [
             amaranth_process(self.model.ports[0], self.dut.mcb_write, domain="sync", frequency=SYNC_HZ),
@@ -30,6 +35,15 @@ class Bench:
     def run(self, testbenches, name, deadline=3e-4):
         simulate(self.dut, testbenches, name=name, clocks={"sync": SYNC_HZ, "dmd": DMD_HZ},
                  processes=self.processes, deadline=deadline)
+
+    async def settle(self, ctx):
+        """Wait until the store has done all it will with the pixels it took: its memory port
+        calibrated and idle for longer than the last row can take to reach it (a slot's clear,
+        one row per cycle, and the row's words)."""
+        port, quiet = self.model.ports[0], 0
+        while quiet < self.dmd.rows + 64:
+            await ctx.tick()
+            quiet = quiet + 1 if port.outputs["calib_done"] and port.idle() else 0
 
     async def feed(self, ctx, image, frame_id, rows=None, idle=0.0):
         await stream_feed(ctx, self.dut.pixels, store_stim.frame_beats(image, frame_id, rows=rows),
@@ -52,15 +66,16 @@ class Bench:
         await ctx.tick("dmd").until(self.dut.release.ready)
         ctx.set(self.dut.release.valid, 0)
 
-    async def read(self, ctx, slot, plane, first_row=0, row_count=DMD.rows, stall=0.0, rng=None):
+    async def read(self, ctx, slot, plane, first_row=0, row_count=None, stall=0.0, rng=None):
         dut = self.dut
+        row_count = self.dmd.rows if row_count is None else row_count
         ctx.set(dut.requests.payload, {"slot": slot, "plane": plane, "first_row": first_row,
                                        "row_count": row_count})
         ctx.set(dut.requests.valid, 1)
         await ctx.tick("dmd").until(dut.requests.ready)
         ctx.set(dut.requests.valid, 0)
         words = []
-        while len(words) < row_count * DMD.words_per_row:
+        while len(words) < row_count * self.dmd.words_per_row:
             ready = not (stall and rng.random() < stall)
             ctx.set(dut.planes.ready, ready)
             _, _, valid, payload = await ctx.tick("dmd").sample(dut.planes.valid, dut.planes.payload)
@@ -71,7 +86,7 @@ class Bench:
 
     async def occupancy(self, ctx, slot):
         got = []
-        for block in range(DMD.blocks):
+        for block in range(self.dmd.blocks):
             ctx.set(self.dut.occupancy.slot, slot)
             ctx.set(self.dut.occupancy.block, block)
             await ctx.tick("dmd")
@@ -83,8 +98,8 @@ class Bench:
         rng = random.Random(slot)
         for plane in store_stim.stored_planes(depth):
             words = await self.read(ctx, slot, plane, stall=stall, rng=rng)
-            store_stim.check_plane(DMD, image, plane, words, what=what)
-        store_stim.check_occupancy(DMD, image, depth, await self.occupancy(ctx, slot), what=what)
+            store_stim.check_plane(self.dmd, image, plane, words, what=what)
+        store_stim.check_occupancy(self.dmd, image, depth, await self.occupancy(ctx, slot), what=what)
 
     def counters(self, ctx):
         c = ctx.get(self.dut.counters)
@@ -174,17 +189,16 @@ def test_stalled_memory(test_name):
 def test_fast_producer_slow_consumer(test_name):
     """Frames arrive while the sequencer holds one: when it asks again it gets the newest
     complete frame, the ones in between are replaced (counted), and what it gets reads back whole."""
-    bench = Bench()
+    bench = Bench(SHORT_DMD)
     dut = bench.dut
-    images = {f: store_stim.random_image(DMD, 200 + f) for f in range(1, 5)}
+    images = {f: store_stim.random_image(SHORT_DMD, 200 + f) for f in range(1, 5)}
     got, sent = [], []
 
     async def producer(ctx):
         ctx.set(dut.bit_depth, 1)
         for f, image in images.items():
             await bench.feed(ctx, image, f)
-        for _ in range(300):
-            await ctx.tick()
+        await bench.settle(ctx)
         sent.append(True)
 
     async def consumer(ctx):
@@ -206,9 +220,9 @@ def test_fast_producer_slow_consumer(test_name):
 
 def test_slow_producer_fast_consumer(test_name):
     """The consumer keeps an ask outstanding: it gets every frame, in order, none replaced."""
-    bench = Bench()
+    bench = Bench(SHORT_DMD)
     dut = bench.dut
-    images = {f: store_stim.random_image(DMD, 300 + f) for f in (65535, 0, 1)}  # id wraps
+    images = {f: store_stim.random_image(SHORT_DMD, 300 + f) for f in (65535, 0, 1)}  # id wraps
     got = []
 
     async def producer(ctx):
@@ -235,17 +249,16 @@ def test_slow_producer_fast_consumer(test_name):
 def test_missing_row_never_shown(test_name):
     """A frame with one row missing is never given out; the next complete one is, and the
     incomplete one is counted as abandoned."""
-    bench = Bench()
+    bench = Bench(SHORT_DMD)
     dut = bench.dut
-    incomplete = store_stim.random_image(DMD, 1)
-    complete = store_stim.random_image(DMD, 2)
+    incomplete = store_stim.random_image(SHORT_DMD, 1)
+    complete = store_stim.random_image(SHORT_DMD, 2)
     got = []
 
     async def producer(ctx):
         ctx.set(dut.bit_depth, 2)
-        await bench.feed(ctx, incomplete, 10, rows=[r for r in range(DMD.rows) if r != 37])
-        for _ in range(500):
-            await ctx.tick()
+        await bench.feed(ctx, incomplete, 10, rows=[r for r in range(SHORT_DMD.rows) if r != 13])
+        await bench.settle(ctx)                      # the consumer's ask waits throughout
         await bench.feed(ctx, complete, 11)
 
     async def consumer(ctx):
@@ -263,13 +276,13 @@ def test_shown_slot_never_written_and_hostile_headers(test_name):
     """While frame 20 is shown: records with its id are refused, rows beyond the frame and
     duplicated rows are refused, each counted; no word lands outside the receiving slots; the
     shown frame reads back unchanged at the end."""
-    bench = Bench()
+    bench = Bench(SHORT_DMD)
     dut = bench.dut
     amap_slots = bench.slots
-    first = store_stim.random_image(DMD, 5)
-    second = store_stim.random_image(DMD, 6)
-    hostile = store_stim.random_image(DMD, 7)
-    beyond = np.zeros((128, DMD.columns), np.uint8)     # rows 96..127 fit the row field
+    first = store_stim.random_image(SHORT_DMD, 5)
+    second = store_stim.random_image(SHORT_DMD, 6)
+    hostile = store_stim.random_image(SHORT_DMD, 7)
+    beyond = np.zeros((FIELD_ROWS, SHORT_DMD.columns), np.uint8)
     phase = {"shown": None}
 
     async def producer(ctx):
@@ -278,9 +291,9 @@ def test_shown_slot_never_written_and_hostile_headers(test_name):
         await wait_until(ctx, lambda: phase["shown"] is not None)
         since = len(bench.model.write_log)
         await bench.feed(ctx, hostile, 20, rows=range(0, 10))                       # shown frame id
-        await bench.feed(ctx, beyond, 21, rows=range(DMD.rows, 128))               # rows outside
-        order = list(range(DMD.rows))
-        order[50:50] = [3, 4, 90]                                                   # overlapping
+        await bench.feed(ctx, beyond, 21, rows=range(SHORT_DMD.rows, FIELD_ROWS))   # rows outside
+        order = list(range(SHORT_DMD.rows))
+        order[12:12] = [3, 4, 20]                                                   # overlapping
         await bench.feed(ctx, second, 21, rows=order)
         await bench.feed(ctx, hostile, 19, rows=range(0, 2))                        # stale frame id
         phase["since"] = since
@@ -298,10 +311,10 @@ def test_shown_slot_never_written_and_hostile_headers(test_name):
         await bench.check_frame(ctx, slot, first, 1, what="shown frame 20")
         counters = bench.counters(ctx)
         assert counters["rows_shown"] == 10
-        assert counters["rows_outside"] == 128 - DMD.rows
+        assert counters["rows_outside"] == FIELD_ROWS - SHORT_DMD.rows
         assert counters["rows_duplicate"] == 3
         assert counters["rows_stale"] == 2
-        store_stim.check_writes_inside(bench.model, DMD, amap_slots,
+        store_stim.check_writes_inside(bench.model, SHORT_DMD, amap_slots,
                                        set(range(amap_slots)) - {slot}, since=phase["since"])
 
     bench.run([producer, consumer], test_name, deadline=6e-4)
@@ -309,9 +322,9 @@ def test_shown_slot_never_written_and_hostile_headers(test_name):
 
 def test_sequence_mode(test_name):
     """Sequence of 3 frames sent out of order: played 0, 1, 2, 0, 1, 2, 0 with their ids."""
-    bench = Bench()
+    bench = Bench(SHORT_DMD)
     dut = bench.dut
-    images = {f: store_stim.random_image(DMD, 400 + f) for f in range(3)}
+    images = {f: store_stim.random_image(SHORT_DMD, 400 + f) for f in range(3)}
     got = []
 
     async def producer(ctx):
@@ -375,9 +388,9 @@ def test_no_free_slot_and_bad_release(test_name):
     """Three slots, the sequencer holding two: a complete frame waits in the third; a newer
     frame finds no slot and is refused row by row (counted), the waiting one is still given;
     releasing a slot that is not shown is counted and changes nothing."""
-    bench = Bench(slots=3)
+    bench = Bench(SHORT_DMD, slots=3)
     dut = bench.dut
-    images = {f: store_stim.random_image(DMD, 600 + f) for f in range(1, 5)}
+    images = {f: store_stim.random_image(SHORT_DMD, 600 + f) for f in range(1, 5)}
     phase = {}
 
     async def producer(ctx):
@@ -400,7 +413,7 @@ def test_no_free_slot_and_bad_release(test_name):
         for _ in range(100):
             await ctx.tick("dmd")
         counters = bench.counters(ctx)
-        assert counters["rows_no_slot"] == DMD.rows and counters["frames_complete"] == 3
+        assert counters["rows_no_slot"] == SHORT_DMD.rows and counters["frames_complete"] == 3
         ready_slot = ({0, 1, 2} - set(held)).pop()
         await bench.release(ctx, ready_slot)                 # not shown: refused
         for _ in range(20):
@@ -429,11 +442,12 @@ def test_random_events_against_policy_model(test_name):
     from sim.models.slots import SlotPolicy
 
     rng = random.Random(14)
-    bench = Bench(slots=4)
+    bench = Bench(SHORT_DMD, slots=4)
     dut = bench.dut
-    policy = SlotPolicy(DMD.rows, 4)
-    image = store_stim.random_image(DMD, 77)
-    tall = np.vstack([image, image[:32]])                       # rows 96..127 exist for hostile records
+    rows = SHORT_DMD.rows
+    policy = SlotPolicy(rows, 4)
+    image = store_stim.random_image(SHORT_DMD, 77)
+    tall = np.vstack([image, image[:FIELD_ROWS - rows]])        # rows beyond the frame, for hostile records
     held = {}                                                   # gateware slot -> frame id
     checked = {"events": 0}
     state = {"turn": "producer", "event": None}
@@ -445,41 +459,40 @@ def test_random_events_against_policy_model(test_name):
                            "release"])
         if kind == "full":
             newest += rng.choice([1, 1, 2])
-            events.append(("rows", newest, list(range(DMD.rows))))
+            events.append(("rows", newest, list(range(rows))))
         elif kind == "newpart":
             newest += 1
-            events.append(("rows", newest, list(range(rng.randrange(40), 60))))
+            events.append(("rows", newest, list(range(rng.randrange(rows // 2), rows * 2 // 3))))
         elif kind == "part":
-            first = rng.randrange(DMD.rows)
-            events.append(("rows", newest, list(range(first, min(DMD.rows, first + rng.randrange(1, 30))))))
+            first = rng.randrange(rows)
+            events.append(("rows", newest, list(range(first, min(rows, first + rng.randrange(1, rows // 3))))))
         elif kind == "rest":
             events.append(("rest", newest, None))
         elif kind == "old":
-            events.append(("rows", newest - rng.randrange(1, 4), list(range(rng.randrange(8), 12))))
+            events.append(("rows", newest - rng.randrange(1, 4), list(range(rng.randrange(rows // 12), rows // 8))))
         elif kind == "beyond":
-            events.append(("rows", newest, list(range(DMD.rows - 2, DMD.rows + rng.randrange(1, 20)))))
+            events.append(("rows", newest, list(range(rows - 2, rng.randrange(rows + 1, FIELD_ROWS + 1)))))
         else:
             events.append((kind, None, None))
     # then for certain: overlapping records, and a sequencer holding three of the four slots
     n = newest
-    events += [("release_all", None, None), ("rows", n + 1, list(range(20))),
-               ("rows", n + 1, list(range(10, 30)))]
+    events += [("release_all", None, None), ("rows", n + 1, list(range(rows // 5))),
+               ("rows", n + 1, list(range(rows // 10, rows * 3 // 10)))]
     for k in range(2, 5):
-        events += [("rows", n + k, list(range(DMD.rows))), ("ask", None, None)]
-    events += [("rows", n + 5, list(range(DMD.rows))), ("rows", n + 6, list(range(4)))]
+        events += [("rows", n + k, list(range(rows))), ("ask", None, None)]
+    events += [("rows", n + 5, list(range(rows))), ("rows", n + 6, list(range(4)))]
 
     async def producer(ctx):
         ctx.set(dut.bit_depth, 1)
-        for kind, frame, rows in events:
+        for kind, frame, record in events:
             if kind == "rest":
                 have = policy.frames.get(frame, {"rows": set()})["rows"]
-                kind, rows = "rows", [r for r in range(DMD.rows) if r not in have]
+                kind, record = "rows", [r for r in range(rows) if r not in have]
             if kind == "rows":
-                for row in rows:
+                for row in record:
                     policy.row(frame & 0xFFFF, row, 1)
-                await bench.feed(ctx, tall, frame & 0xFFFF, rows=rows)
-                for _ in range(400):                            # the last rows reach memory
-                    await ctx.tick()
+                await bench.feed(ctx, tall, frame & 0xFFFF, rows=record)
+                await bench.settle(ctx)
             else:
                 state["event"] = kind
                 state["turn"] = "consumer"
@@ -500,7 +513,7 @@ def test_random_events_against_policy_model(test_name):
                 held[slot] = frame
                 if len(held) == 1:
                     words = await bench.read(ctx, slot, 7, 0, 8)
-                    store_stim.check_plane(DMD, image, 7, words, 0, 8, what=f"frame {frame}")
+                    store_stim.check_plane(SHORT_DMD, image, 7, words, 0, 8, what=f"frame {frame}")
             elif state["event"] in ("release", "release_all") and held:
                 for slot in ([rng.choice(sorted(held))] if state["event"] == "release" else sorted(held)):
                     policy.release(held.pop(slot))
@@ -518,10 +531,10 @@ def test_random_events_against_policy_model(test_name):
 def test_mode_change_keeps_the_shown_frame(test_name):
     """Streaming, then sequence mode while a streamed frame is shown: that slot is kept (records
     for it are refused) until released, then the sequence loads and plays in order."""
-    bench = Bench()
+    bench = Bench(SHORT_DMD)
     dut = bench.dut
-    streamed = store_stim.random_image(DMD, 800)
-    images = {f: store_stim.random_image(DMD, 810 + f) for f in range(2)}
+    streamed = store_stim.random_image(SHORT_DMD, 800)
+    images = {f: store_stim.random_image(SHORT_DMD, 810 + f) for f in range(2)}
     phase = {}
 
     async def producer(ctx):

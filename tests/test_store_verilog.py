@@ -12,7 +12,7 @@ from spec.facts import DMDS
 @pytest.mark.verilog
 @pytest.mark.parametrize("dmd, depths, extremes", [
     ("test", list(range(1, 9)), True),
-    pytest.param("dlp7000", [2], False, marks=pytest.mark.slow),    # a full XGA frame: ~90 s
+    pytest.param("dlp7000", [2], False, marks=pytest.mark.slow),    # one full XGA frame
 ])
 def test_store_verilog(dmd, depths, extremes):
     slots = 4

@@ -44,7 +44,7 @@ class Reader(wiring.Component):
     -------
     requests : In(stream.Signature(PlaneRequest))
         What to read.
-    words : Out(stream.Signature(64))
+    planes : Out(stream.Signature(64))
         The rows' words in order, ``words_per_row`` per row, word 0 first.
     mcb : Out(mcb.PortSignature())
         MCB port 1; only the read half is used.
@@ -59,7 +59,7 @@ class Reader(wiring.Component):
         self._fifo_depth, self._domain = fifo_depth, domain
         super().__init__({
             "requests": In(stream.Signature(PlaneRequest)),
-            "words": Out(stream.Signature(64)),
+            "planes": Out(stream.Signature(64)),
             "mcb": Out(mcb.PortSignature()),
             "bad_requests": Out(16),
         })
@@ -70,7 +70,7 @@ class Reader(wiring.Component):
         port = self.mcb
 
         m.submodules.fifo = fifo = SyncFIFOBuffered(width=64, depth=depth)
-        wiring.connect(m, wiring.flipped(self.words), fifo.r_stream)
+        wiring.connect(m, fifo.r_stream, wiring.flipped(self.planes))
 
         address = Signal(30)
         remaining = Signal(range(dmd.words_per_plane + 1))
@@ -80,14 +80,15 @@ class Reader(wiring.Component):
 
         issue = Signal()
         handed = Signal()
-        m.d.comb += handed.eq(self.words.valid & self.words.ready)
+        m.d.comb += handed.eq(self.planes.valid & self.planes.ready)
         m.d.sync += reserved.eq(reserved + Mux(issue, burst, 0) - handed)
 
-        # every word in the read FIFO has room in ours (reserved covers it)
+        # every word in the read FIFO has room in ours (reserved covers it): take it at once
+        arriving = fifo.w_stream
         m.d.comb += [
             port.rd_en.eq(port.calib_done & ~port.rd_empty),
-            fifo.w_en.eq(port.rd_en),
-            fifo.w_data.eq(port.rd_data),
+            arriving.valid.eq(port.rd_en),
+            arriving.payload.eq(port.rd_data),
             port.cmd_instr.eq(mcb.Instr.READ),
             port.cmd_bl.eq(burst - 1),
             port.cmd_byte_addr.eq(address),

@@ -70,10 +70,10 @@ def read_rate(dmd="dlp7000", timing=None):
             await ctx.tick("dmd")
         ctx.set(dut.requests.payload, {"slot": 1, "plane": 5, "first_row": 0, "row_count": geometry.rows})
         ctx.set(dut.requests.valid, 1)
-        ctx.set(dut.words.ready, 1)
+        ctx.set(dut.planes.ready, 1)
         words = 0
         while words < n_words:
-            _, _, valid, ready = await ctx.tick("dmd").sample(dut.words.valid, dut.requests.ready)
+            _, _, valid, ready = await ctx.tick("dmd").sample(dut.planes.valid, dut.requests.ready)
             if ready:
                 ctx.set(dut.requests.valid, 0)
             cycles += 1

@@ -4,11 +4,20 @@ What the store must hold, by numpy: the planes of an image at a bit depth, the o
 and the address ranges a run may write (:class:`gateware.store.addresses.AddressMap`).
 """
 
+import dataclasses
+
 import numpy as np
 
 from gateware.store.addresses import PLANES, AddressMap
+from spec.facts import TEST_DMD
 
 from . import bitplane, serialiser_stim
+
+#: The test geometry cut to 24 rows in 2 blocks, for the store's policy tests (which slot, which
+#: frame, which counter): a quarter of the cycles per frame. Its 5-bit row field leaves rows 24 to
+#: 31 beyond the frame.
+SHORT_DMD = dataclasses.replace(TEST_DMD, name="test 128x24", rows=24, blocks=2, rows_per_block=12,
+                                source="test geometry, short frames")
 
 
 def stored_planes(depth):

@@ -5,6 +5,7 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In
 
 from gateware.bitplane import Serialiser
+from gateware.compose import forward, members
 from gateware.protocol.layouts import pixel_layout
 from gateware.store.store import Store
 
@@ -20,8 +21,8 @@ class StoreChain(wiring.Component):
     def __init__(self, dmd, *, lanes=8, slots=4, frame_bits=16, fifo_depth=256):
         self._serialiser = Serialiser(dmd, lanes=lanes, frame_bits=frame_bits)
         self._store = Store(dmd, slots=slots, frame_bits=frame_bits, fifo_depth=fifo_depth)
-        members = {name: member for name, member in self._store.signature.members.items() if name not in FED}
-        super().__init__({"pixels": In(stream.Signature(pixel_layout(dmd, lanes, frame_bits))), **members})
+        super().__init__({"pixels": In(stream.Signature(pixel_layout(dmd, lanes, frame_bits))),
+                          **members(self._store, exclude=FED)})
 
     def elaborate(self, platform):
         m = Module()
@@ -30,14 +31,5 @@ class StoreChain(wiring.Component):
         wiring.connect(m, wiring.flipped(self.pixels), ser.pixels)
         for name in FED:
             wiring.connect(m, getattr(ser, name), getattr(store, name))
-        for name, member in self.signature.members.items():
-            if name == "pixels":
-                continue
-            ours, theirs = getattr(self, name), getattr(store, name)
-            if member.is_signature:
-                wiring.connect(m, wiring.flipped(ours), theirs)
-            elif member.flow == In:
-                m.d.comb += theirs.eq(ours)
-            else:
-                m.d.comb += ours.eq(theirs)
+        forward(m, self, store)
         return m

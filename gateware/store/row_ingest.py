@@ -1,0 +1,221 @@
+"""The row ingest: each row of the serialiser is stored whole in the slot the table gives it, or
+dropped whole and counted (``sync`` domain).
+
+At a row's first word the ingest asks the slot table where the row goes
+(:class:`~gateware.store.slot_table.Placement`). A slot taken for a new frame first has its row
+bitmap and occupancy map cleared (one row per cycle), then the row's bit in the bitmap is read: a
+row that arrived before is refused. An accepted row's words of the stored planes go to the writer
+with the slot (so a row can only ever be written inside the slot chosen here, whatever its header
+said); with the row's last word come its row flags, which set the row's bit in the bitmap and its
+block's planes in the occupancy map. The row that completes the frame is marked for the writer and
+reported to the table.
+"""
+
+from amaranth import Array, Cat, Const, Module, Signal
+from amaranth.lib import data, stream, wiring
+from amaranth.lib.wiring import In, Out
+from amaranth.utils import ceil_log2
+
+from gateware.bitplane.serialiser import row_flags_layout, word_layout
+
+from .addresses import PLANES
+from .layouts import BLOCK_BITS, SLOT_BITS
+from .slot_maps import RowLookupSignature, map_write_layout
+from .slot_table import Placement, PlacementSignature, opening_layout
+from .writer import write_word_layout
+
+__all__ = ["RowIngest", "IngestCounters"]
+
+
+class IngestCounters(data.Struct):
+    """The ingest's counters (16 bits, wrapping); see :class:`~gateware.store.slots.SlotCounters`."""
+    frames_complete: 16
+    frames_abandoned: 16
+    rows_outside: 16
+    rows_stale: 16
+    rows_shown: 16
+    rows_duplicate: 16
+    rows_no_slot: 16
+
+
+#: The placements that refuse a row, and the counter each one counts.
+_REFUSALS = {
+    Placement.STALE: "rows_stale",
+    Placement.SHOWN: "rows_shown",
+    Placement.DUPLICATE: "rows_duplicate",
+    Placement.NO_SLOT: "rows_no_slot",
+}
+
+
+class RowIngest(wiring.Component):
+    """Admit or drop whole rows of the serialiser's words.
+
+    Parameters
+    ----------
+    dmd : :class:`spec.facts.DmdType`
+    slots : int
+        Frame slots.
+    frame_bits : int
+        Width of the serialiser's frame tag.
+
+    Members
+    -------
+    words : In(stream.Signature(serialiser.word_layout(dmd, frame_bits)))
+        The serialiser's words.
+    rows : In(stream.Signature(serialiser.row_flags_layout(dmd, frame_bits)))
+        The serialiser's row flags; taken together with the last word of each row.
+    store : Out(stream.Signature(writer.write_word_layout(dmd)))
+        Accepted words of the stored planes, to the writer.
+    bit_depth : In(4)
+        Planes to store for frames that start from now on, 1..8 (others mean 8).
+    placement : Out(PlacementSignature(frame_bits))
+        Where a row goes, from the slot table.
+    opened : Out(stream.Signature(opening_layout(frame_bits), always_ready=True))
+        A slot taken and cleared for a new frame, to the slot table.
+    completed : Out(stream.Signature(SLOT_BITS, always_ready=True))
+        The slot whose last missing row has arrived, to the slot table.
+    map_writes : Out(stream.Signature(slot_maps.map_write_layout(dmd), always_ready=True))
+        Clearing and setting the row bitmap and the occupancy map.
+    bitmap : Out(RowLookupSignature(dmd))
+        Whether a row arrived before.
+    counters : Out(IngestCounters)
+    """
+
+    def __init__(self, dmd, *, slots=4, frame_bits=16):
+        self._dmd, self._slots = dmd, slots
+        super().__init__({
+            "words": In(stream.Signature(word_layout(dmd, frame_bits))),
+            "rows": In(stream.Signature(row_flags_layout(dmd, frame_bits))),
+            "store": Out(stream.Signature(write_word_layout(dmd))),
+            "bit_depth": In(4),
+            "placement": Out(PlacementSignature(frame_bits)),
+            "opened": Out(stream.Signature(opening_layout(frame_bits), always_ready=True)),
+            "completed": Out(stream.Signature(SLOT_BITS, always_ready=True)),
+            "map_writes": Out(stream.Signature(map_write_layout(dmd), always_ready=True)),
+            "bitmap": Out(RowLookupSignature(dmd)),
+            "counters": Out(IngestCounters),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        dmd, count = self._dmd, self.counters
+        received = Array(Signal(range(dmd.rows + 1), name=f"received{s}") for s in range(self._slots))
+        head = self.words.payload
+        flags = self.rows.payload
+        place = self.placement
+        is_last = (head.plane == PLANES - 1) & (head.word == dmd.words_per_row - 1)
+        cur_slot = Signal(SLOT_BITS)
+        cur_depth = Signal(4)
+        clear_index = Signal(ceil_log2(dmd.rows))
+        depth_in = Signal(4)
+        m.d.comb += depth_in.eq(self.bit_depth)
+        with m.If((self.bit_depth == 0) | (self.bit_depth > PLANES)):
+            m.d.comb += depth_in.eq(PLANES)
+        stored_mask = Signal(PLANES)            # planes a frame of depth cur_depth stores
+        m.d.comb += [
+            stored_mask.eq(Const(0xFF00, 2 * PLANES) >> cur_depth),
+            place.frame.eq(head.frame),
+            self.bitmap.slot.eq(cur_slot),
+            self.bitmap.row.eq(head.row),
+            self.opened.payload.slot.eq(cur_slot),
+            self.opened.payload.frame.eq(head.frame),
+            self.opened.payload.depth.eq(depth_in),
+            self.completed.payload.eq(cur_slot),
+            self.map_writes.payload.slot.eq(cur_slot),
+        ]
+
+        def take(*, abandon=False):
+            m.d.sync += [cur_slot.eq(place.slot), clear_index.eq(0)]
+            if abandon:
+                m.d.sync += count.frames_abandoned.eq(count.frames_abandoned + 1)
+            m.next = "CLEAR"
+
+        def refuse(counter):
+            m.d.sync += counter.eq(counter + 1)
+            m.next = "DROP"
+
+        # the store payload follows the head word
+        m.d.comb += [
+            self.store.payload.data.eq(head.data),
+            self.store.payload.slot.eq(cur_slot),
+            self.store.payload.plane.eq(head.plane),
+            self.store.payload.row.eq(head.row),
+            self.store.payload.word.eq(head.word),
+            self.store.payload.last.eq(is_last),
+            self.store.payload.completes.eq(received[cur_slot] == dmd.rows - 1),
+        ]
+
+        with m.FSM(name="ingest") as ingest:
+            m.d.comb += place.between_rows.eq(ingest.ongoing("ROW_START"))
+            with m.State("ROW_START"):
+                with m.If(self.words.valid & (place.verdict != Placement.HOLD)):
+                    with m.If(head.row >= dmd.rows):
+                        refuse(count.rows_outside)
+                    with m.Elif(place.verdict == Placement.JOIN):
+                        m.d.sync += [cur_slot.eq(place.slot), cur_depth.eq(place.depth)]
+                        m.next = "LOOKUP"
+                    with m.Elif(place.verdict == Placement.TAKE):
+                        take()
+                    with m.Elif(place.verdict == Placement.ABANDON):
+                        take(abandon=True)
+                    for verdict, name in _REFUSALS.items():
+                        with m.Elif(place.verdict == verdict):
+                            refuse(count[name])
+                    # WAIT: a slot frees when the frame being written becomes ready
+
+            with m.State("CLEAR"):
+                m.d.comb += [
+                    self.map_writes.valid.eq(1),
+                    self.map_writes.payload.row.eq(clear_index),
+                    self.map_writes.payload.block.eq(clear_index[:BLOCK_BITS]),
+                    self.map_writes.payload.planes.eq(Cat((clear_index < 2**BLOCK_BITS) for _ in range(PLANES))),
+                ]
+                m.d.sync += clear_index.eq(clear_index + 1)
+                with m.If(clear_index == dmd.rows - 1):
+                    m.d.comb += self.opened.valid.eq(1)
+                    m.d.sync += [received[cur_slot].eq(0), cur_depth.eq(depth_in)]
+                    m.next = "LOOKUP"
+
+            with m.State("LOOKUP"):
+                m.next = "DECIDE"                           # the bitmap bit of the row is read
+
+            with m.State("DECIDE"):
+                with m.If(self.bitmap.stored):
+                    refuse(count.rows_duplicate)
+                with m.Else():
+                    m.next = "PASS"
+
+            with m.State("DROP"):
+                with m.If(is_last):
+                    m.d.comb += [self.words.ready.eq(self.rows.valid), self.rows.ready.eq(self.words.valid)]
+                    with m.If(self.words.valid & self.rows.valid):
+                        m.next = "ROW_START"
+                with m.Else():
+                    m.d.comb += self.words.ready.eq(1)
+
+            with m.State("PASS"):
+                with m.If(is_last):
+                    both = self.words.valid & self.rows.valid
+                    m.d.comb += [
+                        self.store.valid.eq(both),
+                        self.words.ready.eq(self.store.ready & self.rows.valid),
+                        self.rows.ready.eq(self.store.ready & self.words.valid),
+                    ]
+                    with m.If(both & self.store.ready):
+                        m.d.comb += [
+                            self.map_writes.valid.eq(1),
+                            self.map_writes.payload.row.eq(head.row),
+                            self.map_writes.payload.block.eq(flags.block),
+                            self.map_writes.payload.planes.eq(flags.planes & stored_mask),
+                            self.map_writes.payload.set.eq(1),
+                        ]
+                        m.d.sync += received[cur_slot].eq(received[cur_slot] + 1)
+                        with m.If(received[cur_slot] == dmd.rows - 1):
+                            m.d.comb += self.completed.valid.eq(1)
+                            m.d.sync += count.frames_complete.eq(count.frames_complete + 1)
+                        m.next = "ROW_START"
+                with m.Elif(head.plane + cur_depth >= PLANES):
+                    m.d.comb += [self.store.valid.eq(self.words.valid), self.words.ready.eq(self.store.ready)]
+                with m.Else():
+                    m.d.comb += self.words.ready.eq(1)  # a plane below the frame's bit depth
+        return m

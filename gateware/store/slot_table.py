@@ -1,0 +1,296 @@
+"""The slot table: the state of every frame slot, where a row goes, and the slot events.
+
+It answers the row ingest's question "where does a row of frame f go?" with a :class:`Placement`
+(the policy of :mod:`gateware.store.slots`, streaming or sequence mode), records the frames the
+ingest opens and completes, and applies one housekeeping event per cycle: a change of mode
+(only between rows), a slot written (from the writer), a release or an ask (from the sequencer,
+in their order). The ingest only ever changes FREE and RECEIVING slots, housekeeping only the
+others, so the two never change one slot on the same cycle.
+"""
+
+from amaranth import Array, Module, Signal
+from amaranth.lib import data, enum, stream, wiring
+from amaranth.lib.wiring import In, Out
+
+from .layouts import SLOT_BITS, FrameInfo
+from .slot_crossing import Command
+
+__all__ = ["SlotTable", "SlotState", "Placement", "PlacementSignature", "opening_layout", "TableCounters"]
+
+
+class SlotState(enum.Enum, shape=3):
+    FREE = 0
+    RECEIVING = 1
+    WRITING = 2
+    READY = 3
+    SHOWN = 4
+
+
+class Placement(enum.Enum, shape=4):
+    """Where a row of a frame goes (a row number beyond the frame is the ingest's own refusal,
+    checked after ``HOLD`` and before the others)."""
+    HOLD = 0          # a change of mode is pending: nothing is decided before it
+    JOIN = 1          # the slot receiving this frame
+    TAKE = 2          # a free slot, for a new frame
+    ABANDON = 3       # the receiving slot, taken from an older frame that is not complete
+    WAIT = 4          # no slot now; one frees when the frame being written is ready
+    STALE = 5         # refused: older than the frame receiving, or not in the sequence
+    SHOWN = 6         # refused: the frame of a slot being shown
+    DUPLICATE = 7     # refused: the frame's slot is complete (sequence)
+    NO_SLOT = 8       # refused: the sequencer holds every other slot
+
+
+class PlacementSignature(wiring.Signature):
+    """The ingest's question to the slot table, seen from the ingest (``sync``).
+
+    Members
+    -------
+    frame : Out(frame_bits)
+        Frame id of the row to place.
+    between_rows : Out(1)
+        The ingest waits for a row's first word: a change of mode may be applied.
+    verdict : In(Placement)
+        Where the row goes, at once.
+    slot : In(SLOT_BITS)
+        The slot for ``JOIN``, ``TAKE`` and ``ABANDON``.
+    depth : In(4)
+        The bit depth of the frame in that slot (for ``JOIN``).
+    """
+
+    def __init__(self, frame_bits):
+        self._frame_bits = frame_bits
+        super().__init__({
+            "frame": Out(frame_bits),
+            "between_rows": Out(1),
+            "verdict": In(Placement),
+            "slot": In(SLOT_BITS),
+            "depth": In(4),
+        })
+
+    def __eq__(self, other):
+        return isinstance(other, PlacementSignature) and other._frame_bits == self._frame_bits
+
+
+def opening_layout(frame_bits):
+    """A slot taken for a new frame: from now on it receives frame ``frame`` at ``depth`` bits."""
+    return data.StructLayout({"slot": SLOT_BITS, "frame": frame_bits, "depth": 4})
+
+
+class TableCounters(data.Struct):
+    """The slot table's event counters (16 bits, wrapping); see :class:`~gateware.store.slots.SlotCounters`."""
+    frames_replaced: 16
+    bad_releases: 16
+
+
+class SlotTable(wiring.Component):
+    """States of the frame slots, placement of rows, and housekeeping (``sync``).
+
+    Parameters
+    ----------
+    slots : int
+        Frame slots.
+    frame_bits : int
+        Width of the frame id.
+
+    Members
+    -------
+    placement : In(PlacementSignature(frame_bits))
+        The ingest's question and its answer.
+    opened : In(stream.Signature(opening_layout(frame_bits), always_ready=True))
+        The ingest has cleared a slot's maps for a new frame: the slot now receives it.
+    completed : In(stream.Signature(SLOT_BITS, always_ready=True))
+        Every row of the frame in this slot has arrived: it is being written.
+    written : In(stream.Signature(SLOT_BITS))
+        From the writer: the completing row of this slot is in memory.
+    sequence_length : In(5)
+        0: streaming; N: sequence of N frames in slots 0..N-1 (at most ``slots``).
+    commands : In(stream.Signature(Command))
+        Asks and releases from the sequencer, in order.
+    answers : Out(stream.Signature(FrameInfo))
+        One answer per ask: the frame the sequencer now holds.
+    counters : Out(TableCounters)
+    """
+
+    def __init__(self, *, slots=4, frame_bits=16):
+        self._slots, self._frame_bits = slots, frame_bits
+        super().__init__({
+            "placement": In(PlacementSignature(frame_bits)),
+            "opened": In(stream.Signature(opening_layout(frame_bits), always_ready=True)),
+            "completed": In(stream.Signature(SLOT_BITS, always_ready=True)),
+            "written": In(stream.Signature(SLOT_BITS)),
+            "sequence_length": In(5),
+            "commands": In(stream.Signature(Command)),
+            "answers": Out(stream.Signature(FrameInfo)),
+            "counters": Out(TableCounters),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        n_slots = self._slots
+        count = self.counters
+        t = _Registers(n_slots, self._frame_bits)
+        state, frame_id, depth, in_sequence = t.state, t.frame_id, t.depth, t.in_sequence
+
+        # -- mode
+        seq_len = Signal(5)          # the mode in force
+        wanted_len = Signal(5)
+        m.d.comb += wanted_len.eq(self.sequence_length)
+        with m.If(self.sequence_length > n_slots):
+            m.d.comb += wanted_len.eq(n_slots)
+        mode_pending = Signal()
+        sequence = Signal()
+        m.d.comb += [mode_pending.eq(wanted_len != seq_len), sequence.eq(seq_len != 0)]
+
+        self._place(m, t, seq_len, mode_pending, sequence)
+
+        # -- the ingest's events
+        opening = self.opened.payload
+        with m.If(self.opened.valid):
+            m.d.sync += [
+                state[opening.slot].eq(SlotState.RECEIVING),
+                frame_id[opening.slot].eq(opening.frame),
+                depth[opening.slot].eq(opening.depth),
+                in_sequence[opening.slot].eq(sequence),
+            ]
+            with m.If(~sequence):
+                m.d.sync += [t.recv_active.eq(1), t.recv_slot.eq(opening.slot), t.recv_frame.eq(opening.frame),
+                             t.last_valid.eq(1), t.last_frame.eq(opening.frame)]
+        with m.If(self.completed.valid):
+            m.d.sync += state[self.completed.payload].eq(SlotState.WRITING)
+            with m.If(~sequence):
+                m.d.sync += t.recv_active.eq(0)
+
+        # -- the answer to an ask
+        ready_found, ready_slot = _first_of(m, n_slots, lambda s: (state[s] == SlotState.READY) & ~in_sequence[s])
+        play = Signal(SLOT_BITS)
+        loaded = Signal()
+        m.d.comb += loaded.eq(1)
+        for s in range(n_slots):
+            with m.If((s < seq_len) & ~((state[s] == SlotState.READY) | (state[s] == SlotState.SHOWN))):
+                m.d.comb += loaded.eq(0)
+        answer_slot = Signal(SLOT_BITS)
+        can_answer = Signal()
+        with m.If(sequence):
+            m.d.comb += [answer_slot.eq(play), can_answer.eq(loaded & (state[play] == SlotState.READY))]
+        with m.Else():
+            m.d.comb += [answer_slot.eq(ready_slot), can_answer.eq(ready_found)]
+        m.d.comb += [
+            self.answers.payload.slot.eq(answer_slot),
+            self.answers.payload.frame_id.eq(frame_id[answer_slot]),
+            self.answers.payload.bit_depth.eq(depth[answer_slot]),
+        ]
+
+        # -- housekeeping: one event per cycle. An answer offered and not taken (the answer FIFO
+        # full) stays offered, unchanged: nothing else happens until it is taken.
+        offered = Signal()
+        m.d.sync += offered.eq(self.answers.valid & ~self.answers.ready)
+        command = self.commands.payload
+        with m.If(mode_pending & self.placement.between_rows & ~offered):
+            m.d.sync += [seq_len.eq(wanted_len), play.eq(0), t.recv_active.eq(0), t.last_valid.eq(0)]
+            for s in range(n_slots):
+                with m.If(state[s] != SlotState.SHOWN):
+                    m.d.sync += state[s].eq(SlotState.FREE)
+                m.d.sync += in_sequence[s].eq(0)
+        with m.Elif(self.written.valid & ~offered):
+            m.d.comb += self.written.ready.eq(1)
+            done = self.written.payload
+            with m.If(state[done] == SlotState.WRITING):
+                m.d.sync += state[done].eq(SlotState.READY)
+                # streaming: the newest complete frame replaces one never shown
+                for s in range(n_slots):
+                    with m.If((state[s] == SlotState.READY) & ~in_sequence[s] & ~in_sequence[done]
+                              & (done != s)):
+                        m.d.sync += [state[s].eq(SlotState.FREE),
+                                     count.frames_replaced.eq(count.frames_replaced + 1)]
+        with m.Elif(self.commands.valid & command.release):
+            m.d.comb += self.commands.ready.eq(1)
+            with m.If(state[command.slot] != SlotState.SHOWN):
+                m.d.sync += count.bad_releases.eq(count.bad_releases + 1)
+            with m.Elif(in_sequence[command.slot] & sequence):
+                m.d.sync += state[command.slot].eq(SlotState.READY)
+            with m.Else():
+                m.d.sync += state[command.slot].eq(SlotState.FREE)
+        with m.Elif(self.commands.valid & can_answer):
+            m.d.comb += self.answers.valid.eq(1)
+            with m.If(self.answers.ready):
+                m.d.comb += self.commands.ready.eq(1)
+                m.d.sync += state[answer_slot].eq(SlotState.SHOWN)
+                with m.If(sequence):
+                    m.d.sync += play.eq(play + 1)
+                    with m.If(play == seq_len - 1):
+                        m.d.sync += play.eq(0)
+        return m
+
+    def _place(self, m, t, seq_len, mode_pending, sequence):
+        """Drive ``placement``: where a row of ``placement.frame`` goes, from the registers ``t``."""
+        place = self.placement
+        n_slots, frame_bits = self._slots, self._frame_bits
+        state = t.state
+        free_found, free_slot = _first_of(m, n_slots, lambda s: state[s] == SlotState.FREE)
+        writing_found, _ = _first_of(m, n_slots, lambda s: state[s] == SlotState.WRITING)
+        shown_match, _ = _first_of(m, n_slots,
+                                   lambda s: (state[s] == SlotState.SHOWN) & (t.frame_id[s] == place.frame))
+        newer = Signal()
+        diff = Signal(frame_bits)
+        m.d.comb += [diff.eq(place.frame - t.last_frame), newer.eq((diff != 0) & ~diff[frame_bits - 1])]
+
+        def verdict(value, slot=None):
+            m.d.comb += place.verdict.eq(value)
+            if slot is not None:
+                m.d.comb += place.slot.eq(slot)
+
+        m.d.comb += place.depth.eq(t.depth[place.slot])
+        seq_slot = place.frame[:SLOT_BITS]
+        with m.If(mode_pending):
+            verdict(Placement.HOLD)
+        with m.Elif(sequence):
+            with m.If(place.frame >= seq_len):
+                verdict(Placement.STALE)
+            with m.Elif(state[seq_slot] == SlotState.FREE):
+                verdict(Placement.TAKE, seq_slot)
+            with m.Elif(state[seq_slot] == SlotState.RECEIVING):
+                verdict(Placement.JOIN, seq_slot)
+            with m.Elif(state[seq_slot] == SlotState.SHOWN):
+                verdict(Placement.SHOWN)
+            with m.Else():
+                verdict(Placement.DUPLICATE)
+        with m.Elif(t.recv_active & (place.frame == t.recv_frame)):
+            verdict(Placement.JOIN, t.recv_slot)
+        with m.Elif(~t.last_valid | newer):
+            with m.If(t.recv_active):
+                verdict(Placement.ABANDON, t.recv_slot)
+            with m.Elif(free_found):
+                verdict(Placement.TAKE, free_slot)
+            with m.Elif(~writing_found):
+                verdict(Placement.NO_SLOT)
+            with m.Else():
+                verdict(Placement.WAIT)
+        with m.Elif(shown_match):
+            verdict(Placement.SHOWN)
+        with m.Else():
+            verdict(Placement.STALE)
+
+
+class _Registers:
+    """The table's registers: per slot, and in streaming mode the frame receiving and the newest
+    frame started."""
+
+    def __init__(self, slots, frame_bits):
+        self.state = Array(Signal(SlotState, name=f"state{s}") for s in range(slots))
+        self.frame_id = Array(Signal(frame_bits, name=f"frame_id{s}") for s in range(slots))
+        self.depth = Array(Signal(4, name=f"depth{s}") for s in range(slots))
+        self.in_sequence = Array(Signal(name=f"in_sequence{s}") for s in range(slots))
+        self.recv_active = Signal()
+        self.recv_slot = Signal(SLOT_BITS)
+        self.recv_frame = Signal(frame_bits)
+        self.last_valid = Signal()
+        self.last_frame = Signal(frame_bits)
+
+
+def _first_of(m, slots, condition):
+    """(any, index of the lowest slot ``s`` < ``slots`` with ``condition(s)``), driven in ``m``."""
+    found, index = Signal(), Signal(SLOT_BITS)
+    for s in reversed(range(slots)):
+        with m.If(condition(s)):
+            m.d.comb += [found.eq(1), index.eq(s)]
+    return found, index
