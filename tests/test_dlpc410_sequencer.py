@@ -267,10 +267,11 @@ def test_binary_prng_chain(dmd, test_name):
 @pytest.mark.verilog
 @pytest.mark.parametrize("ecp2_cycles", [4, 60])
 def test_init_driven_by_the_model(ecp2_cycles, test_name):
-    """The rule model drives ECP2_FINISHED and INIT_ACTIVE (ECP2_FINISHED before ARSTZ's
-    initialisation ends, and long after it) and checks the training pattern on every data pin
-    and that no command comes meanwhile; the first DVALID comes 64 to 80 clocks after
-    INIT_ACTIVE falls, then a frame plays legally."""
+    """ECP2_FINISHED and INIT_ACTIVE as the rule model times them (ECP2_FINISHED before ARSTZ's
+    initialisation ends, and long after it; driven by the responder with the model's cycle
+    counts, which the model checks on every cycle); the model checks the training pattern on
+    every data pin and that no command comes meanwhile; the first DVALID comes 64 to 80 clocks
+    after INIT_ACTIVE falls, then a frame plays legally."""
     p = fast_plan(depth=2).params
     model = dlpc410_for(DMD, p, ecp2_cycles=ecp2_cycles)
     ready = next_ready(p, model_frames([(0, 2)], None), [])
