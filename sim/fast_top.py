@@ -21,7 +21,7 @@ an evaluation, and three 125 MHz clocks apart would cost three (the small-geomet
 
 import math
 
-from amaranth import Cat, ClockDomain, ClockSignal, Const, Instance, Module, ResetSignal, Signal
+from amaranth import Cat, ClockDomain, ClockSignal, Const, Instance, Module, ResetSignal, Signal, Value
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -33,7 +33,8 @@ from sim.models.dlpc410 import timing_cycles
 from sim.models.dlpc410_replay import Replay
 from sim.models.mcb import McbTiming
 
-__all__ = ["FastSystem", "ResponderBench", "dlpc410_side", "pin_layout", "SOURCES", "PLUSARGS", "read_rate"]
+__all__ = ["FastSystem", "ResponderBench", "dlpc410_side", "power_on_reset", "pin_layout", "SOURCES", "PLUSARGS",
+           "read_rate"]
 
 #: The Verilog models the top instantiates.
 SOURCES = [ROOT / "sim" / "hdl" / name for name in
@@ -69,24 +70,29 @@ def read_rate(timing, dmd_hz):
     return (timing.sustained_bytes_per_s / 8 - _INGEST_WORDS_PER_S) / dmd_hz
 
 
-def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cycles, flush, extra=None,
-                 domain="dmd"):
+def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cycles, flush,
+                 ecp2_cycles=ECP2_CYCLES, extra=None, layout=None, always=None, domain="dmd"):
     """The DLPC410's side of the pins ``dlpc`` (an interface of
     :class:`gateware.dlpc410.interface.Signature`, seen from its driver): the responder drives the
-    controller's outputs, the recorder writes the pins and ``extra`` (``{field: signal}`` of
-    :func:`pin_layout`'s other fields) to the file of plusarg ``PLUSARGS["pins"]``."""
+    controller's outputs (its cycle counts: ints, or signals set at run time), the recorder writes
+    the pins and ``extra`` (``{field: signal}`` of ``layout``'s other fields; default layout
+    :func:`pin_layout`) to the file of plusarg ``PLUSARGS["pins"]``, on every cycle with DVALID
+    or ``always`` high and every cycle something changed."""
     rst_active, init_active, ecp2 = Signal(), Signal(), Signal()
+    timing = {name: Value.cast(Const(value, 32) if isinstance(value, int) else value)
+              for name, value in (("rst_active_cycles", rst_active_cycles), ("init_cycles", init_cycles),
+                                  ("init_grace_cycles", init_grace_cycles), ("ecp2_cycles", ecp2_cycles))}
     m.submodules.responder = Instance(
         "dlpc410_responder",
-        p_DCLK_PER_ROW=dmd.dclk_per_row, p_RST_ACTIVE_CYCLES=rst_active_cycles,
-        p_INIT_CYCLES=init_cycles, p_INIT_GRACE_CYCLES=init_grace_cycles, p_ECP2_CYCLES=ECP2_CYCLES,
+        p_DCLK_PER_ROW=dmd.dclk_per_row, **{f"i_{name}": value for name, value in timing.items()},
         i_clk=ClockSignal(domain), i_rst=ResetSignal(domain), i_arstz=dlpc.arstz, i_dvalid=dlpc.dvalid,
         i_blkmd=dlpc.blkmd,
         o_init_active=init_active, o_rst_active=rst_active, o_ecp2_finished=ecp2)
     m.d.comb += [dlpc.rst_active.eq(rst_active), dlpc.init_active.eq(init_active),
                  dlpc.ecp2_finished.eq(ecp2), dlpc.dmd_type.eq(dmd.dmd_type_code or 0)]
-    pins = Signal(pin_layout(dmd.buses))
-    for name, _ in pin_layout(dmd.buses):
+    layout = pin_layout(dmd.buses) if layout is None else layout
+    pins = Signal(layout)
+    for name, _ in layout:
         if hasattr(dlpc, name):
             m.d.comb += getattr(pins, name).eq(getattr(dlpc, name))
     for name, signal in (extra or {}).items():
@@ -94,7 +100,20 @@ def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cyc
     m.submodules.pin_trace = Instance(
         "trace_recorder", p_WIDTH=len(pins.as_value()), p_PLUSARG=PLUSARGS["pins"],
         i_clk=ClockSignal(domain), i_rst=ResetSignal(domain), i_value=pins.as_value(),
-        i_always_record=dlpc.dvalid, i_flush=flush)
+        i_always_record=dlpc.dvalid if always is None else dlpc.dvalid | always, i_flush=flush)
+
+
+def power_on_reset(m, domain, clock):
+    """Domain ``domain`` on ``clock``, held in reset for its first ``RESET_CYCLES`` cycles by a
+    counter. A reset port would make Verilator re-evaluate, on every clock edge, all the logic
+    that depends on it (that is, nearly all): an internal reset is evaluated with its
+    registers."""
+    m.domains += [ClockDomain(domain), ClockDomain(f"{domain}_por", reset_less=True)]
+    m.d.comb += [ClockSignal(domain).eq(clock), ClockSignal(f"{domain}_por").eq(clock)]
+    count = Signal(range(RESET_CYCLES + 1), name=f"{domain}_por_count")
+    with m.If(count != RESET_CYCLES):
+        m.d[f"{domain}_por"] += count.eq(count + 1)
+    m.d.comb += ResetSignal(domain).eq(count != RESET_CYCLES)
 
 
 class ResponderBench(wiring.Component):
@@ -202,22 +221,13 @@ class FastSystem(wiring.Component):
             **connections)
 
     def _clocks_and_resets(self, m):
-        """Domains from the two clock ports; resets from a counter in each domain. A reset
-        port would make Verilator re-evaluate, on every clock edge, all the logic that depends
-        on it (that is, nearly all): an internal reset is evaluated with its registers."""
-        domains = {"sync": self.clk, "gmii_rx": self.clk, "gmii_tx": self.clk, "dmd": self.dmd_clk}
-        for name, clock in domains.items():
-            m.domains += ClockDomain(name)
-            m.d.comb += ClockSignal(name).eq(clock)
-        for name, clock in (("sync", self.clk), ("dmd", self.dmd_clk)):
-            m.domains += ClockDomain(f"{name}_por", reset_less=True)
-            m.d.comb += ClockSignal(f"{name}_por").eq(clock)
-            count = Signal(range(RESET_CYCLES + 1), name=f"{name}_por_count")
-            with m.If(count != RESET_CYCLES):
-                m.d[f"{name}_por"] += count.eq(count + 1)
-            m.d.comb += ResetSignal(name).eq(count != RESET_CYCLES)
+        """Domains from the two clock ports; resets from a counter in each (:func:`power_on_reset`);
+        the GMII domains on ``clk`` share ``sync``'s reset."""
+        power_on_reset(m, "sync", self.clk)
+        power_on_reset(m, "dmd", self.dmd_clk)
         for name in ("gmii_rx", "gmii_tx"):
-            m.d.comb += ResetSignal(name).eq(ResetSignal("sync"))
+            m.domains += ClockDomain(name)
+            m.d.comb += [ClockSignal(name).eq(self.clk), ResetSignal(name).eq(ResetSignal("sync"))]
 
     def elaborate(self, platform):
         m = Module()

@@ -1,5 +1,8 @@
-"""The sequencer in the Amaranth simulator (TEST_DMD): its command stream equals the schedule
-model's cycle for cycle, and every pixel receives exactly its grey level in LSB units."""
+"""The sequencer (TEST_DMD, TEST_DMD4): its command stream equals the schedule model's cycle for
+cycle, and every pixel receives exactly its grey level in LSB units, under the rule-checking
+DLPC410 model. The runs are on the generated Verilog (:mod:`sim.seq_rig`: one Verilator build per
+geometry, the trace replayed through the model after the run); the Amaranth simulator keeps the
+short tests it is the right tool for, and one scenario run on both must give the same run."""
 
 import numpy as np
 import pytest
@@ -7,6 +10,7 @@ import pytest
 from gateware.dlpc410.trigger import PIN_TO_STROBE
 from sim.models import bitplane
 from sim.models.dlpc410 import RULES, RuleBreak
+from sim.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import INIT_CYCLES, dlpc410_for, frame_lights, run_bench
 from spec import prng, schedule
@@ -70,8 +74,8 @@ def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), ea
         strobes = [t + PIN_TO_STROBE for t in (sync_pins if p.trigger == TriggerMode.SYNC else pins)]
     model = schedule.simulate(dmd, p, mframes, strobes)
     end = max(c[0] for c in model.commands) + extra
-    run = run_bench(dmd, p, offered, images, pins=pins, soft=soft, sync_pins=sync_pins,
-                    early_pins=early_pins, cycles=end, name=name)
+    run = run_rig(dmd, p, offered, images, pins=pins, soft=soft, sync_pins=sync_pins,
+                  early_pins=early_pins, cycles=end, name=name)
     assert run.commands == model.decoded()
     assert run.status["late"] == 0 == model.late
     assert run.status["underruns"] == 0
@@ -87,6 +91,7 @@ def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), ea
     return run, model
 
 
+@pytest.mark.verilog
 @pytest.mark.parametrize("mode,strict,order", [
     (ResetMode.GLOBAL, True, PlaneOrder.MSB_FIRST),
     (ResetMode.GLOBAL, True, PlaneOrder.LSB_FIRST),
@@ -104,6 +109,7 @@ def test_every_level_exact(mode, strict, order, test_name):
     assert len(run.lights) == 1
 
 
+@pytest.mark.verilog
 def test_spread_phased_plan(test_name):
     """A phased plan with the groups spread apart (what the planner picks for dual 8-bit PWM
     here, and for quad and dual on the DLP7000): dark gaps off the LSB lattice, a stagger of
@@ -116,6 +122,7 @@ def test_spread_phased_plan(test_name):
     check(p, [(0, 8)], None, [ready + 10], test_name)
 
 
+@pytest.mark.verilog
 @pytest.mark.parametrize("mode,order", [
     (ResetMode.GLOBAL, PlaneOrder.MSB_FIRST),
     (ResetMode.QUAD, PlaneOrder.LSB_FIRST),      # groups of 4 blocks and of the fifth alone
@@ -144,6 +151,7 @@ def test_four_buses(mode, order, test_name):
     assert any(k == "noop" for _t, k, _a in model.commands)
 
 
+@pytest.mark.verilog
 def test_random_images_every_depth_with_empty_blocks(test_name):
     """Random images at bit depths 1..8 back to back (triggered as soon as ready); one slot has
     empty blocks and empty planes, cleared instead of loaded."""
@@ -163,6 +171,7 @@ def test_random_images_every_depth_with_empty_blocks(test_name):
     assert any(k == "clear" for _t, k, _a in model.commands[:200])
 
 
+@pytest.mark.verilog
 def test_extremes_all_dark_all_bright(test_name):
     """All-0 (every block empty: clears only) and all-255 (every block full), depth 8 and 1."""
     shape = (DMD.rows, DMD.columns)
@@ -176,6 +185,7 @@ def test_extremes_all_dark_all_bright(test_name):
     assert first_rows == ["clear"] * DMD.blocks
 
 
+@pytest.mark.verilog
 def test_triggers(test_name):
     """Before init ends, early, during a frame, a burst faster than frames, one cycle before the
     next frame is ready and exactly when it is: counted right, never half-obeyed."""
@@ -199,6 +209,7 @@ def test_triggers(test_name):
     assert run.status["frames"] == 3 and run.status["bad_frames"] == model.bad_frames == 2
 
 
+@pytest.mark.verilog
 def test_sync_out_and_camera(test_name):
     p = fast_plan().params
     p.camera_offset, p.camera_width = 100, 7
@@ -209,6 +220,7 @@ def test_sync_out_and_camera(test_name):
     assert run.camera_out == [(pulses[0] + 1 + 100, 1), (pulses[0] + 1 + 107, 0)]
 
 
+@pytest.mark.verilog
 @pytest.mark.parametrize("mode", [TriggerMode.PERIODIC, TriggerMode.SOFTWARE, TriggerMode.SYNC])
 def test_trigger_modes(mode, test_name):
     p = fast_plan().params
@@ -219,7 +231,7 @@ def test_trigger_modes(mode, test_name):
         p.period = ready + 1
         strobes = [k * p.period - 1 for k in range(1, 7)]
         model = schedule.simulate(DMD, p, model_frames(frames, None), strobes, until=strobes[-1] - 4)
-        run = run_bench(DMD, p, frames, None, cycles=strobes[-1] - 4, name=test_name)
+        run = run_rig(DMD, p, frames, None, cycles=strobes[-1] - 4, name=test_name)
         same_commands(run, model)
         assert run.status["triggers"] == len(model.accepted) >= 2
         assert run.status["overruns"] == model.overruns >= 1
@@ -231,6 +243,7 @@ def test_trigger_modes(mode, test_name):
         assert run.status["triggers"] == 1    # the TTL pin is ignored in sync mode
 
 
+@pytest.mark.verilog
 @pytest.mark.parametrize("dmd", [DMD, TEST_DMD4], ids=["two_buses", "four_buses"])
 def test_binary_prng_chain(dmd, test_name):
     """1-bit Bernoulli frames back to back at the bus limit: the patterns the host rebuilds
@@ -239,8 +252,7 @@ def test_binary_prng_chain(dmd, test_name):
                   strict_rst=False).params
     ready = next_ready(p, [schedule.Frame(0, 1)], [], dmd)
     model = schedule.simulate(dmd, p, [], [ready + PIN_TO_STROBE], until=ready + 6 * p.lsb)
-    run = run_bench(dmd, p, [], None, pins=[ready], cycles=ready + 6 * p.lsb, name=test_name,
-                    seed=0x1234)
+    run = run_rig(dmd, p, [], None, pins=[ready], cycles=ready + 6 * p.lsb, name=test_name, seed=0x1234)
     commands = same_commands(run, model)
     shown = prng.shown_patterns(dmd, commands, 0x1234)
     pulses = [t for t, k, _a in commands if k == "pulse"]
@@ -252,17 +264,18 @@ def test_binary_prng_chain(dmd, test_name):
     assert not np.array_equal(shown[-1], prng.shown_patterns(dmd, commands, 0)[-1])
 
 
+@pytest.mark.verilog
 @pytest.mark.parametrize("ecp2_cycles", [4, 60])
 def test_init_driven_by_the_model(ecp2_cycles, test_name):
-    """The rule model drives ECP2_FINISHED and INIT_ACTIVE (ECP2_FINISHED before ARSTZ's
-    initialisation ends, and long after it) and checks the training pattern on every data pin
-    and that no command comes meanwhile; the first DVALID comes 64 to 80 clocks after
-    INIT_ACTIVE falls, then a frame plays legally."""
+    """ECP2_FINISHED and INIT_ACTIVE as the rule model times them (ECP2_FINISHED before ARSTZ's
+    initialisation ends, and long after it; driven by the responder with the model's cycle
+    counts, which the model checks on every cycle); the model checks the training pattern on
+    every data pin and that no command comes meanwhile; the first DVALID comes 64 to 80 clocks
+    after INIT_ACTIVE falls, then a frame plays legally."""
     p = fast_plan(depth=2).params
     model = dlpc410_for(DMD, p, ecp2_cycles=ecp2_cycles)
     ready = next_ready(p, model_frames([(0, 2)], None), [])
-    run = run_bench(DMD, p, [(0, 2)], pins=[ready], cycles=ready + 3 * p.lsb + 400, name=test_name,
-                    model=model)
+    run = run_rig(DMD, p, [(0, 2)], pins=[ready], cycles=ready + 3 * p.lsb + 400, name=test_name, model=model)
     assert model.init_end == max(ecp2_cycles, 0) + INIT_CYCLES
     first = model.log[0].cycle
     assert 64 <= first - model.init_end < 80
@@ -296,6 +309,27 @@ def test_init_waits_for_ecp2(test_name):
     simulate(dut, [bench], name=test_name, clocks={"sync": 200e6})
 
 
+@pytest.mark.verilog
+def test_rig_runs_as_the_amaranth_bench(test_name):
+    """One short scenario (a trigger before initialisation ends, two frames from two slots paced
+    by the pin, a camera pulse) in the Amaranth simulator (the model stepped every cycle) and on
+    the rig (the trace replayed): the same commands, both the schedule model's, and the same
+    time base, counters, sync and camera edges and releases."""
+    p = fast_plan(depth=2).params
+    p.camera_offset, p.camera_width = 20, 5
+    offered, pins = paced(p, [(0, 2), (1, 2)], None)
+    model = schedule.simulate(DMD, p, model_frames(offered, None), [t + PIN_TO_STROBE for t in pins])
+    given = {"pins": pins, "early_pins": (5,), "cycles": max(c[0] for c in model.commands) + 100}
+    bench = run_bench(DMD, p, offered, None, name=f"{test_name}_amaranth", **given)
+    rig = run_rig(DMD, p, offered, None, name=test_name, **given)
+    assert bench.commands == model.decoded() == rig.commands
+    for what in ("shift", "status", "sync_out", "camera_out", "releases"):
+        assert getattr(rig, what) == getattr(bench, what), what
+    assert bench.releases == [(bench.releases[0][0], 0)] and len(bench.camera_out) == 4
+    assert bench.status["early"] == 1 and bench.status["triggers"] == 2
+
+
+@pytest.mark.verilog
 def test_rule_model_catches_too_short_rst_time(test_name):
     """Parameters planned for a shorter RST_ACTIVE than the controller's: the rule model stops
     the run at the first pulse that comes while RST_ACTIVE is high or the first write into a
@@ -305,10 +339,11 @@ def test_rule_model_catches_too_short_rst_time(test_name):
     model.rst_active_cycles = p.t_rst + p.t_settle
     ready = next_ready(p, model_frames([(0, 2)], None), [])
     with pytest.raises(RuleBreak) as e:
-        run_bench(DMD, p, [(0, 2)], pins=[ready], cycles=ready + 3 * p.lsb, name=test_name, model=model)
+        run_rig(DMD, p, [(0, 2)], pins=[ready], cycles=ready + 3 * p.lsb, name=test_name, model=model)
     assert e.value.rule in (RULES["settle"], RULES["rst_active"])
 
 
+@pytest.mark.verilog
 def test_binary_chain_from_memory(test_name):
     """1-bit frames from the store back to back: each pattern is loaded behind the one shown."""
     rng = np.random.default_rng(9)
@@ -319,7 +354,7 @@ def test_binary_chain_from_memory(test_name):
     ready = next_ready(p, mframes, [])
     until = ready + 5 * p.lsb
     model = schedule.simulate(DMD, p, mframes, [ready + PIN_TO_STROBE], until=until)
-    run = run_bench(DMD, p, frames, images, pins=[ready], cycles=until, name=test_name)
+    run = run_rig(DMD, p, frames, images, pins=[ready], cycles=until, name=test_name)
     commands = same_commands(run, model)
     pulses = [t for t, k, _a in commands if k == "pulse"]
     assert len(pulses) == 5 and set(np.diff(pulses)) == {p.lsb}
@@ -328,6 +363,7 @@ def test_binary_chain_from_memory(test_name):
     assert run.status["frames"] == 5 and run.sync_out == [(pulses[0], 1)]
 
 
+@pytest.mark.verilog
 def test_too_short_lsb_is_counted_late(test_name):
     """A least significant plane shorter than the settle rule allows: the pulses come late
     (never while RST_ACTIVE is high, never into a settling block), both gateware and model
@@ -337,7 +373,7 @@ def test_too_short_lsb_is_counted_late(test_name):
     frames = [(0, 3)]
     ready = next_ready(p, model_frames(frames, None), [])
     model = schedule.simulate(DMD, p, model_frames(frames, None), [ready + PIN_TO_STROBE])
-    run = run_bench(DMD, p, frames, None, pins=[ready], cycles=model.commands[-1][0] + 50, name=test_name)
+    run = run_rig(DMD, p, frames, None, pins=[ready], cycles=model.commands[-1][0] + 50, name=test_name)
     same_commands(run, model)
     assert run.status["late"] == model.late > 0
 
@@ -348,6 +384,7 @@ def waiting_after(p, frames, strobes):
     return next_ready(p, model_frames(frames, None), strobes)
 
 
+@pytest.mark.verilog
 @pytest.mark.parametrize("mode,lead", [(ResetMode.GLOBAL, 16), (ResetMode.DUAL, 75)])
 def test_frame_offered_while_waiting_is_shown_next(mode, lead, test_name):
     """Frame 1 completes while the projector waits (frame 0 shown, its repeat preloaded): its
@@ -371,6 +408,7 @@ def test_frame_offered_while_waiting_is_shown_next(mode, lead, test_name):
     assert [s for _t, s in run.releases] == [0]
 
 
+@pytest.mark.verilog
 def test_trigger_during_reload_is_an_overrun(test_name):
     """A trigger while the newer frame's first plane is being loaded is ignored and counted:
     nothing mixed is shown; the next trigger shows the newer frame whole."""
@@ -386,6 +424,7 @@ def test_trigger_during_reload_is_an_overrun(test_name):
     assert len(run.lights) == 2 and [f.slot for f in model.shown] == [0, 1]
 
 
+@pytest.mark.verilog
 @pytest.mark.parametrize("mode,after", [
     (ResetMode.GLOBAL, 1),       # inside the settle time: the stale rows are asked, not loaded
     (ResetMode.DUAL, 1),         # group 1 still plays: taken when it ends, its load abandoned

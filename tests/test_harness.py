@@ -1,4 +1,7 @@
-"""The harnesses themselves: layouts round-trip, and a failing cocotb test fails pytest."""
+"""The harnesses themselves: layouts round-trip, a failing cocotb test fails pytest, and runs of
+one build at the same time (pytest-xdist workers) each report their own result."""
+
+import threading
 
 import random
 
@@ -6,6 +9,7 @@ import pytest
 from amaranth import Module, signed
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import Out
+from cocotb_tools.check_results import get_results
 
 from gateware.bitplane import word_layout
 from sim.harness import cocotb_run
@@ -48,4 +52,34 @@ class Counter(wiring.Component):
 @pytest.mark.verilog
 def test_failing_cocotb_test_fails_pytest():
     with pytest.raises(AssertionError, match="1 of 1 cocotb tests failed"):
-        cocotb_run.run(Counter(), toplevel="counter", module="sim.tb.selfcheck", key="selfcheck")
+        cocotb_run.run(Counter(), toplevel="counter", module="sim.tb.selfcheck", key="selfcheck",
+                       testcase="wrong_expectation")
+
+
+@pytest.mark.verilog
+def test_concurrent_runs_of_one_build_report_their_own_results(tmp_path):
+    """Two runs of the same build started together, one told to pass and one to fail: each has
+    its own directory and results, and each call reports its own outcome."""
+    outcome = {}
+    start = threading.Barrier(2)
+
+    def run(name, fail):
+        start.wait()
+        try:
+            cocotb_run.run(Counter(), toplevel="counter", module="sim.tb.selfcheck", key="selfcheck",
+                           testcase="fail_as_told", params={"cycles": 20_000, "fail": fail},
+                           run_dir=tmp_path / name)
+            outcome[name] = "passed"
+        except AssertionError as error:
+            outcome[name] = str(error)
+
+    threads = [threading.Thread(target=run, args=("right", False)),
+               threading.Thread(target=run, args=("wrong", True))]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert outcome["right"] == "passed"
+    assert "1 of 1 cocotb tests failed" in outcome["wrong"] and str(tmp_path / "wrong") in outcome["wrong"]
+    assert get_results(tmp_path / "right" / "results.xml") == (1, 0)
+    assert get_results(tmp_path / "wrong" / "results.xml") == (1, 1)

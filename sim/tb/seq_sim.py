@@ -45,6 +45,7 @@ class Run:
     camera_out: list = field(default_factory=list)
     releases: list = field(default_factory=list)     # (now, slot) handed back
     lights: list = field(default_factory=list)       # camera images of the frames (frame_lights)
+    report: dict = field(default_factory=dict)       # on the rig: the testbench's (sim.seq_rig)
 
     def frames(self):
         """``(first, last)`` model cycles of each shown frame: sync out rising and falling."""

@@ -1,0 +1,55 @@
+"""Sequencer rig figures (:mod:`sim.seq_rig`), per geometry: the time to build the rig from
+nothing, the simulation's speed, and the speed of a whole run (the stimulus files, the
+simulation, the trace replayed through the rule-checking model).
+
+The run is one triggered 8-bit global frame of the ramp image (RST_ACTIVE and settle scaled
+down as in the tests), to the end of its last pulse; the speeds count every clock cycle
+simulated, initialisation included. The build goes to a build key of its own,
+emptied first; its time is the first run's wall time less the second's (the same run on the
+finished build).
+"""
+
+import shutil
+import time
+
+from gateware.dlpc410.trigger import PIN_TO_STROBE
+from sim.harness.paths import build_dir, slug
+from sim.seq_rig import TOPLEVEL, rig_verilog, run_rig
+from spec import schedule
+from spec.facts import DMDS, TEST_DMD, TEST_DMD4
+
+GEOMETRIES = {"test": TEST_DMD, "test4": TEST_DMD4, "dlp7000": DMDS["dlp7000"]}
+
+
+def frame_run(dmd, key):
+    """One triggered frame on the rig: its wall time, and the run."""
+    p = schedule.plan(dmd, 200e6, t_rst_s=40 / 200e6, t_settle_s=80 / 200e6).params
+    frames = [schedule.Frame(0, 8)]
+    pin = max(g.loaded_at for g in schedule.simulate(dmd, p, frames).groups) + 6
+    cycles = schedule.simulate(dmd, p, frames, [pin + PIN_TO_STROBE]).commands[-1][0] + 64
+    start = time.monotonic()
+    run = run_rig(dmd, p, [(0, 8)], pins=[pin], cycles=cycles, name=f"bench_{key}", key=key)
+    assert run.status["frames"] == 1 and run.status["late"] == 0
+    return time.monotonic() - start, run
+
+
+def run():
+    figures = {}
+    for name, dmd in GEOMETRIES.items():
+        key = f"bench-{slug(dmd.name)}"
+        shutil.rmtree(build_dir("cocotb", f"{TOPLEVEL}-{key}"))
+        start = time.monotonic()
+        rig_verilog(dmd)
+        convert = time.monotonic() - start
+        first, _ = frame_run(dmd, key)
+        second, again = frame_run(dmd, key)
+        figures[f"seq_rig.convert_s_{name}"] = (convert, "s")
+        figures[f"seq_rig.build_s_{name}"] = (first - second, "s")
+        figures[f"seq_rig.sim_cycles_per_s_{name}"] = (again.report["cycles"] / again.report["wall_s"], "dmd cycle/s")
+        figures[f"seq_rig.run_cycles_per_s_{name}"] = (again.report["cycles"] / second, "dmd cycle/s")
+    return figures
+
+
+if __name__ == "__main__":
+    for figure, (value, unit) in run().items():
+        print(f"{figure:40s} {value:12.1f} {unit}")

@@ -1,0 +1,342 @@
+"""The sequencer rig: the DLPC410 sequencer's generated Verilog, one Verilator build per DMD
+geometry, every scenario given at run time.
+
+:class:`SequencerRig` is :class:`sim.tb.plane_source.SourcedSequencer` (the sequencer and the
+store stand-in) with, around it, only Verilog that runs without Python per cycle:
+
+* the store stand-in's tables (planes, occupancy, frames offered) and the pin events (trigger,
+  sync, soft trigger, early triggers) are ``file_memory.v`` memories loaded at start from files
+  named by plusargs (:data:`PLUSARGS`); :class:`EventPlayer` plays the events;
+* ``dlpc410_responder.v`` drives INIT_ACTIVE, RST_ACTIVE and ECP2_FINISHED, its cycle counts set
+  at run time;
+* ``trace_recorder.v`` writes the pins, sync and camera out, the time base's start and the
+  slots released (:func:`rig_layout`) to a file (:func:`sim.fast_top.dlpc410_side`).
+
+The registers, the seed and the responder's timing are ports the testbench
+(:mod:`sim.tb.seq_rig`) sets once. :func:`run_rig` writes the files, runs the build for the
+geometry and, after the run, replays the trace through the rule-checking DLPC410 model
+(:func:`sim.models.trace.replay_dlpc410`, which also checks the responder against the model)
+and returns what :func:`sim.tb.seq_sim.run_bench` returns for the same arguments.
+"""
+
+import functools
+import json
+from pathlib import Path
+
+from amaranth import Instance, Module, Mux, Signal, Value
+from amaranth.lib import data, wiring
+from amaranth.lib.wiring import In, Out
+from amaranth.utils import ceil_log2
+
+from gateware.compose import members
+from gateware.dlpc410.sequencer import Status
+from gateware.registers import Registers
+from gateware.store.layouts import SLOT_BITS
+from sim.fast_top import PLUSARGS as FAST_PLUSARGS
+from sim.fast_top import dlpc410_side, pin_layout, power_on_reset
+from sim.harness import cocotb_run
+from sim.harness.layout import pack
+from sim.harness.paths import ROOT, build_dir, slug
+from sim.models import trace
+from sim.tb.plane_source import TABLES, OfferedFrame, SourcedSequencer, TableSignature, contents, table_depths
+from sim.tb.seq_sim import Run, dlpc410_for
+from spec.facts import DMDS
+from spec.registers import TIME_BITS
+
+__all__ = ["SequencerRig", "EventPlayer", "run_rig", "run_script", "rig_verilog", "analyse", "event_table",
+           "rig_layout", "event_layout", "Timing", "SOURCES", "PLUSARGS", "INPUTS", "MAX_EVENTS", "TOPLEVEL"]
+
+TOPLEVEL = "sequencer_rig"
+#: The Verilog models the rig instantiates.
+SOURCES = [ROOT / "sim" / "hdl" / name for name in ("file_memory.v", "dlpc410_responder.v", "trace_recorder.v")]
+#: Plusargs naming the files: the tables and events in, the pin trace out.
+PLUSARGS = {"planes": "SEQ_PLANES", "occupancy_map": "SEQ_OCCUPANCY", "offered": "SEQ_FRAMES",
+            "events": "SEQ_EVENTS", "pins": FAST_PLUSARGS["pins"]}
+#: The sequencer inputs the event player drives.
+INPUTS = ("trigger_in", "sync_in", "soft_trigger")
+#: Entries of the event table.
+MAX_EVENTS = 64
+#: Cycles an event holds its input high at most.
+HOLD_BITS = 3
+
+
+class Timing(data.Struct):
+    """The responder's cycle counts (``dlpc410_responder.v``)."""
+    rst_active_cycles: 32
+    init_cycles: 32
+    init_grace_cycles: 32
+    ecp2_cycles: 32
+
+
+def event_layout():
+    """An entry of the event table: from ``at`` (the sequencer's time base ``now``, or with
+    ``on_cycle`` the cycle count from the end of reset) each input of :data:`INPUTS` is high for
+    its field's number of cycles (0: not touched)."""
+    return data.StructLayout({"at": TIME_BITS, "on_cycle": 1, **{name: HOLD_BITS for name in INPUTS}})
+
+
+def rig_layout(buses):
+    """The pin trace's record: :func:`sim.fast_top.pin_layout`'s fields, ``running`` (the time
+    base counts: ``now`` is 1 on the first cycle it is high) and the release stream (``ready``
+    is always high: each cycle with ``release_valid`` hands ``release_slot`` back)."""
+    return data.StructLayout({**{name: field.shape for name, field in pin_layout(buses)},
+                              "running": 1, "release_valid": 1, "release_slot": SLOT_BITS})
+
+
+class EventPlayer(wiring.Component):
+    """Plays the event table on the sequencer's inputs.
+
+    The entries are in order: those ``on_cycle`` first, by cycle, then the others by ``now``,
+    one entry per instant (merged). An entry fires on its instant: ``on_cycle`` entries only
+    while the time base has not started (``now`` at most 1), the others from ``now`` 2 on (what
+    :func:`sim.tb.seq_sim.run_bench` does with its pin lists); an entry whose instant passed
+    unfired is skipped. A fired input stays high for its hold; an entry for an input already
+    high starts the hold again.
+
+    Members
+    -------
+    table : Out(TableSignature)
+        The event table (:func:`event_layout`), read asynchronously.
+    now, cycle : In(TIME_BITS)
+        The sequencer's time base, and cycles since the end of reset.
+    trigger_in, sync_in, soft_trigger : Out(1)
+    """
+
+    def __init__(self, entries=MAX_EVENTS):
+        self._entries = entries
+        super().__init__({
+            "table": Out(TableSignature(ceil_log2(entries + 1), event_layout())),
+            "now": In(TIME_BITS),
+            "cycle": In(TIME_BITS),
+            **{name: Out(1) for name in INPUTS},
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        index = Signal(range(self._entries + 1))
+        entry = self.table.data
+        started = self.now >= 2
+        due = Signal()
+        fire = Signal()
+        m.d.comb += [
+            self.table.addr.eq(index),
+            due.eq((index < self._entries)
+                   & Mux(entry.on_cycle, (self.cycle >= entry.at) | started, started & (self.now >= entry.at))),
+            fire.eq(due & Mux(entry.on_cycle, (self.cycle == entry.at) & ~started, self.now == entry.at)),
+        ]
+        with m.If(due):
+            m.d.sync += index.eq(index + 1)
+        for name in INPUTS:
+            hold = entry[name]
+            left = Signal(HOLD_BITS, name=f"{name}_left")
+            start = fire & (hold != 0)
+            m.d.comb += getattr(self, name).eq(start | (left != 0))
+            with m.If(start):
+                m.d.sync += left.eq(hold - 1)
+            with m.Elif(left != 0):
+                m.d.sync += left.eq(left - 1)
+        return m
+
+
+class SequencerRig(wiring.Component):
+    """The sequencer, its store stand-in and its DLPC410 in Verilog, for one geometry.
+
+    Parameters
+    ----------
+    dmd : DmdType
+
+    Members
+    -------
+    clk : In(1)
+        The ``sync`` clock; the domain leaves reset ``RESET_CYCLES`` cycles after it starts
+        (:func:`sim.fast_top.power_on_reset`).
+    regs, reload : In
+        As the sequencer's.
+    trigger_in : In(1)
+        The trigger pin, with the event player's trigger.
+    seed : In(64); reseed : In(1)
+        The seed is loaded on the first cycle out of reset if ``reseed`` is high.
+    timing : In(Timing)
+        The responder's cycle counts; set before the clock starts.
+    flush : In(1)
+        Writes the trace recorder's buffered lines to its file.
+    at_rest, sync_out, status : Out
+        As the sequencer's.
+    running : Out(1)
+        The time base counts (``status.now`` is not 0).
+    """
+
+    def __init__(self, dmd):
+        self._dmd = dmd
+        self._core = SourcedSequencer(dmd)
+        super().__init__({
+            "clk": In(1),
+            **members(self._core, ("regs", "reload", "trigger_in", "seed", "reseed", "at_rest", "sync_out",
+                                   "status")),
+            "timing": In(Timing),
+            "flush": In(1),
+            "running": Out(1),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        dmd = self._dmd
+        power_on_reset(m, "sync", self.clk)
+        m.submodules.core = core = self._core
+        m.submodules.player = player = EventPlayer()
+        cycle = Signal(TIME_BITS)
+        m.d.sync += cycle.eq(cycle + 1)
+        m.d.comb += [
+            player.now.eq(core.status.now), player.cycle.eq(cycle),
+            core.regs.eq(self.regs), core.reload.eq(self.reload), core.seed.eq(self.seed),
+            core.reseed.eq(self.reseed & (cycle == 0)),
+            core.trigger_in.eq(self.trigger_in | player.trigger_in),
+            core.sync_in.eq(player.sync_in), core.soft_trigger.eq(player.soft_trigger),
+            core.release.ready.eq(1),
+            self.at_rest.eq(core.at_rest), self.sync_out.eq(core.sync_out), self.status.eq(core.status),
+            self.running.eq(core.status.now != 0),
+        ]
+        depths = table_depths(dmd)
+        for name in TABLES:
+            _file_table(m, name, getattr(core, name), depths[name])
+        _file_table(m, "events", player.table, MAX_EVENTS)
+        dlpc410_side(m, dmd, core.pins, flush=self.flush, domain="sync", layout=rig_layout(dmd.buses),
+                     always=core.release.valid,
+                     extra={"trigger_in": core.trigger_in, "sync_out": core.sync_out,
+                            "camera_out": core.camera_out, "running": self.running,
+                            "release_valid": core.release.valid, "release_slot": core.release.payload},
+                     **{name: getattr(self.timing, name) for name, _ in Timing.as_shape()})
+        return m
+
+
+def _file_table(m, name, port, depth):
+    """A ``file_memory.v`` behind the read port ``port`` (a :class:`TableSignature` interface),
+    loaded from the file of plusarg ``PLUSARGS[name]``."""
+    width = len(Value.cast(port.data))
+    m.submodules[f"{name}_table"] = Instance(
+        "file_memory", p_WIDTH=width, p_DEPTH=depth, p_ADDR_BITS=len(port.addr), p_PLUSARG=PLUSARGS[name],
+        i_addr=port.addr, o_data=port.data)
+
+
+# --- running it ----------------------------------------------------------------------------------
+
+def build_key(dmd):
+    """The build's key for ``dmd``: its name in the facts table."""
+    return next((key for key, known in DMDS.items() if known is dmd), slug(dmd.name))
+
+
+@functools.cache
+def rig_verilog(dmd):
+    """The rig's Verilog for ``dmd``, converted once per process."""
+    return cocotb_run.emit_verilog(SequencerRig(dmd), TOPLEVEL)
+
+
+def _write_hex(path, words, width):
+    digits = (width + 3) // 4
+    Path(path).write_text("".join(f"{int(w):0{digits}x}\n" for w in words))
+
+
+def event_table(pins=(), sync_pins=(), soft=(), early_pins=()):
+    """The event table (packed entries, merged per instant, in the player's order) of
+    :func:`run_rig`'s pin arguments."""
+    holds = {}
+    for times, name, hold, on_cycle in ((pins, "trigger_in", 4, False), (sync_pins, "sync_in", 4, False),
+                                        (soft, "soft_trigger", 1, False), (early_pins, "trigger_in", 1, True)):
+        for at in times:
+            assert at >= (1 if on_cycle else 2), f"{name} event at {at}: too early to be played"
+            entry = holds.setdefault((not on_cycle, at), {})
+            entry[name] = max(entry.get(name, 0), hold)
+    assert len(holds) <= MAX_EVENTS, f"at most {MAX_EVENTS} event instants"
+    layout = event_layout()
+    return [pack(layout, {"at": at, "on_cycle": int(not by_now), **entry})
+            for (by_now, at), entry in sorted(holds.items())]
+
+
+def _stimulus(directory, dmd, frames, images, events):
+    """Write the tables and the events; the plusargs naming them and the trace."""
+    c = contents(dmd, frames, images)
+    files = {name: directory / f"{name}.hex" for name in (*TABLES, "events")}
+    for name, words, width in (("planes", c.planes, 64), ("occupancy_map", c.occupancy, 8 * dmd.blocks),
+                               ("offered", c.offered, OfferedFrame.as_shape().size),
+                               ("events", events, event_layout().size)):
+        _write_hex(files[name], words, width)
+    files["pins"] = directory / "pins.txt"
+    return files, [f"+{PLUSARGS[name]}={path}" for name, path in files.items()]
+
+
+def run_script(dmd, params, frames, images=None, *, script, name, model=None, seed=None, events=(),
+               max_cycles, until_now=None, key=None):
+    """Run the rig for ``dmd`` on a testbench ``script`` (:mod:`sim.tb.seq_rig`); returns the
+    :class:`Run` (:func:`analyse`, up to ``until_now``) with the testbench's report: its
+    ``observed`` values, the clock ``cycles`` simulated and the simulation's ``wall_s``.
+    ``model``: the controller (default :func:`sim.tb.seq_sim.dlpc410_for`), whose cycle counts
+    the responder takes; ``events``: the event table (:func:`event_table`); ``max_cycles``: the
+    script's time limit; ``key``: the build's (default: one per geometry)."""
+    model = dlpc410_for(dmd, params) if model is None else model
+    directory = build_dir("seq_rig", slug(name))
+    files, plusargs = _stimulus(directory, dmd, frames, images, list(events))
+    report = directory / "report.json"
+    report.unlink(missing_ok=True)
+    timing = {"rst_active_cycles": model.rst_active_cycles, "init_cycles": model.init_cycles,
+              "init_grace_cycles": model.init_grace_cycles, "ecp2_cycles": model.ecp2_cycles}
+    p = {"regs": pack(Registers, params.registers(dmd)), "timing": pack(Timing, timing),
+         "seed": seed, "script": script, "report": str(report), "max_cycles": max_cycles,
+         "status": [(n, f.offset, f.width) for n, f in data.Layout.cast(Status)]}
+    cocotb_run.run(rig_verilog(dmd), toplevel=TOPLEVEL, module="sim.tb.seq_rig", key=key or build_key(dmd),
+                   params=p, extra_sources=SOURCES, plusargs=plusargs, run_dir=directory / "run")
+    run = analyse(model, trace.read(files["pins"]), dmd, until_now=until_now)
+    run.report = json.loads(report.read_text())
+    return run
+
+
+def run_rig(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, name, early_pins=(), sync_pins=(),
+            seed=None, model=None, key=None):
+    """:func:`sim.tb.seq_sim.run_bench` on the rig: the same arguments, the same :class:`Run`.
+
+    Runs until the sequencer's time base reaches ``cycles``. ``pins``: ``now`` values at which
+    the trigger pin rises (high for 4 cycles), ``sync_pins`` the same for the sync pin,
+    ``soft`` one-cycle software triggers; ``early_pins``: cycles (before initialisation ends)
+    of one-cycle trigger pulses; ``seed``: loaded on the first cycle; ``key``: as
+    :func:`run_script`'s. Raises the rule model's
+    :class:`~sim.models.dlpc410.RuleBreak`, or :class:`~sim.models.trace.Mismatch` when the
+    responder disagrees with the model."""
+    script = [{"op": "until_now", "now": cycles}, {"op": "observe", "name": "end", "signals": ["status"]}]
+    run = run_script(dmd, params, frames, images, script=script, name=name, model=model, seed=seed,
+                     events=event_table(pins, sync_pins, soft, early_pins), max_cycles=cycles + 100_000,
+                     until_now=cycles, key=key)
+    run.status = run.report["observed"]["end"]["status"]
+    return run
+
+
+def analyse(model, pins, dmd, *, until_now=None):
+    """Replay the trace ``pins`` through ``model`` (up to the cycle on which the time base was
+    ``until_now``, default all of it) and gather the :class:`Run` (without status)."""
+    layout = rig_layout(dmd.buses)
+    unpack = {name: (offset, mask) for name, offset, mask in trace.fields(layout)}
+
+    def field(value, name):
+        offset, mask = unpack[name]
+        return value >> offset & mask
+
+    start = next((c for c, v in pins if field(v, "running")), None)
+    shift = 0 if start is None else 1 - start
+    until = None if until_now is None else until_now - shift
+    trace.replay_dlpc410(model, pins, layout, until=until)
+    run = Run(model, shift=shift)
+    last = {"sync_out": 0, "camera_out": 0}
+    for cycle, value in pins:
+        if until is not None and cycle > until:
+            break
+        now = cycle + shift
+        if not field(value, "running"):
+            continue
+        if field(value, "release_valid"):
+            run.releases.append((now, field(value, "release_slot")))
+        for name, offset in (("sync_out", -1), ("camera_out", 0)):
+            level = field(value, name)
+            if level != last[name]:
+                getattr(run, name).append((now + offset, level))
+                last[name] = level
+    run.commands = model.commands(shift - 1)
+    return run
+
