@@ -52,12 +52,13 @@ RESET_CYCLES = 4
 _INGEST_WORDS_PER_S = 125e6 / 8
 
 
-def pin_layout(buses):
-    """One record of the DLPC410 pin trace: the pins the model reads, the controller's outputs
-    the responder drove, and the trigger, sync and camera pins."""
+def pin_layout(buses, beats=1):
+    """One record of the DLPC410 pin trace: the pins the model reads (data and DVALID on every
+    DCLK edge of the cycle), the controller's outputs the responder drove, and the trigger, sync
+    and camera pins."""
     return data.StructLayout({
-        **{f"din_{b}": 32 for b in "abcd"[:buses]},
-        "dvalid": 1, "rowmd": 2, "rowad": 11, "blkmd": 2, "blkad": 4, "rst2blkz": 1, "comp_data": 1,
+        **{f"din_{b}": 32 * beats for b in "abcd"[:buses]},
+        "dvalid": 2 * beats, "rowmd": 2, "rowad": 11, "blkmd": 2, "blkad": 4, "rst2blkz": 1, "comp_data": 1,
         "ns_flip": 1, "wdt_enblz": 1, "pwr_float": 1, "arstz": 1,
         "init_active": 1, "rst_active": 1, "ecp2_finished": 1,
         "trigger_in": 1, "sync_out": 1, "camera_out": 1,
@@ -77,20 +78,22 @@ def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cyc
     controller's outputs (its cycle counts: ints, or signals set at run time), the recorder writes
     the pins and ``extra`` (``{field: signal}`` of ``layout``'s other fields; default layout
     :func:`pin_layout`) to the file of plusarg ``PLUSARGS["pins"]``, on every cycle with DVALID
-    or ``always`` high and every cycle something changed."""
+    or ``always`` high and every cycle something changed. The interface's ``beats`` (DCLK cycles
+    per cycle) set the row cycle's length in cycles and the trace's widths."""
+    beats = dlpc.signature.beats
     rst_active, init_active, ecp2 = Signal(), Signal(), Signal()
     timing = {name: Value.cast(Const(value, 32) if isinstance(value, int) else value)
               for name, value in (("rst_active_cycles", rst_active_cycles), ("init_cycles", init_cycles),
                                   ("init_grace_cycles", init_grace_cycles), ("ecp2_cycles", ecp2_cycles))}
     m.submodules.responder = Instance(
         "dlpc410_responder",
-        p_DCLK_PER_ROW=dmd.dclk_per_row, **{f"i_{name}": value for name, value in timing.items()},
-        i_clk=ClockSignal(domain), i_rst=ResetSignal(domain), i_arstz=dlpc.arstz, i_dvalid=dlpc.dvalid,
+        p_CYCLES_PER_ROW=dmd.dclk_per_row // beats, **{f"i_{name}": value for name, value in timing.items()},
+        i_clk=ClockSignal(domain), i_rst=ResetSignal(domain), i_arstz=dlpc.arstz, i_dvalid=dlpc.dvalid[0],
         i_blkmd=dlpc.blkmd,
         o_init_active=init_active, o_rst_active=rst_active, o_ecp2_finished=ecp2)
     m.d.comb += [dlpc.rst_active.eq(rst_active), dlpc.init_active.eq(init_active),
                  dlpc.ecp2_finished.eq(ecp2), dlpc.dmd_type.eq(dmd.dmd_type_code or 0)]
-    layout = pin_layout(dmd.buses) if layout is None else layout
+    layout = pin_layout(dmd.buses, beats) if layout is None else layout
     pins = Signal(layout)
     for name, _ in layout:
         if hasattr(dlpc, name):
@@ -100,7 +103,7 @@ def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cyc
     m.submodules.pin_trace = Instance(
         "trace_recorder", p_WIDTH=len(pins.as_value()), p_PLUSARG=PLUSARGS["pins"],
         i_clk=ClockSignal(domain), i_rst=ResetSignal(domain), i_value=pins.as_value(),
-        i_always_record=dlpc.dvalid if always is None else dlpc.dvalid | always, i_flush=flush)
+        i_always_record=dlpc.dvalid.any() if always is None else dlpc.dvalid.any() | always, i_flush=flush)
 
 
 def power_on_reset(m, domain, clock):

@@ -130,7 +130,7 @@ def analyse(the_plan, images, stimulus, files, *, build=None):
     t0 = time.monotonic()
     layout = pin_layout(DMD.buses)
     pins = trace.read(files["pins"])
-    model = Dlpc410(DMD, dclk=DMD_HZ, init_cycles=INIT_CYCLES, init_grace_cycles=INIT_GRACE)
+    model = Dlpc410(DMD, clock_hz=DMD_HZ, init_cycles=INIT_CYCLES, init_grace_cycles=INIT_GRACE)
     trace.replay_dlpc410(model, pins, layout)
     triggers = trace.rising_edges(pins, layout, "trigger_in")
     pulses = [c.cycle for c in model.log if c.kind == "pulse"]

@@ -1,4 +1,4 @@
-"""The sequencer (TEST_DMD, TEST_DMD4): its command stream equals the schedule model's cycle for
+"""The sequencer (TEST_DMD, TEST_DMD4; at DCLK 400 MHz TEST_DMD_400, TEST_DMD4_400): its command stream equals the schedule model's cycle for
 cycle, and every pixel receives exactly its grey level in LSB units, under the rule-checking
 DLPC410 model. The runs are on the generated Verilog (:mod:`sim.seq_rig`: one Verilator build per
 geometry, the trace replayed through the model after the run); the Amaranth simulator keeps the
@@ -14,7 +14,7 @@ from sim.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import INIT_CYCLES, dlpc410_for, frame_lights, run_bench
 from spec import prng, schedule
-from spec.facts import TEST_DMD, TEST_DMD4
+from spec.facts import TEST_DMD, TEST_DMD4, TEST_DMD4_400, TEST_DMD_400
 from spec.registers import PlaneOrder, ResetMode, Source, TriggerMode
 
 DMD = TEST_DMD
@@ -22,8 +22,8 @@ DMD = TEST_DMD
 FAST = {"t_rst_s": 20 / 200e6, "t_settle_s": 30 / 200e6}
 
 
-def fast_plan(dmd=DMD, **kw):
-    return schedule.plan(dmd, 200e6, **FAST, **kw)
+def fast_plan(dmd=DMD, dclk=200e6, **kw):
+    return schedule.plan(dmd, dclk, **FAST, **kw)
 
 
 def model_frames(frames, images, dmd=DMD):
@@ -62,7 +62,7 @@ def same_commands(run, model):
 
 
 def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), early_pins=(),
-          offered=None, dmd=DMD):
+          offered=None, dmd=DMD, store_words=1):
     """Run gateware and model; assert equal commands, counters, and exact light per frame.
     ``frames``: the frames expected on the DMD; ``offered``: what the store offers (default:
     the same). The rule model logs no no-op rows (a 1080p clear's), the schedule model does."""
@@ -75,7 +75,7 @@ def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), ea
     model = schedule.simulate(dmd, p, mframes, strobes)
     end = max(c[0] for c in model.commands) + extra
     run = run_rig(dmd, p, offered, images, pins=pins, soft=soft, sync_pins=sync_pins,
-                  early_pins=early_pins, cycles=end, name=name)
+                  early_pins=early_pins, cycles=end, name=name, store_words=store_words)
     assert run.commands == model.decoded()
     assert run.status["late"] == 0 == model.late
     assert run.status["underruns"] == 0
@@ -107,6 +107,36 @@ def test_every_level_exact(mode, strict, order, test_name):
     ready = next_ready(p, model_frames([(0, 8)], None), [])
     run, _ = check(p, [(0, 8)], None, [ready + 10], test_name)
     assert len(run.lights) == 1
+
+
+@pytest.mark.verilog
+@pytest.mark.parametrize("dmd,mode,order,store_words", [
+    (TEST_DMD_400, ResetMode.GLOBAL, PlaneOrder.MSB_FIRST, 2),    # a row every row cycle
+    (TEST_DMD_400, ResetMode.DUAL, PlaneOrder.LSB_FIRST, 1),      # the store paces the rows
+    (TEST_DMD4_400, ResetMode.QUAD, PlaneOrder.MSB_FIRST, 2),     # four buses, two beats of two words
+])
+def test_two_beats_per_cycle(dmd, mode, order, store_words, test_name):
+    """DCLK 400 MHz: two DCLK beats per cycle (a row cycle of half the cycles); a ramp frame then
+    a random frame with empty blocks; commands equal the model's cycle for cycle, every grey
+    level exact under the rule model, which reads two beats a cycle. With two words a transfer
+    from the store, a row loads every row cycle."""
+    rng = np.random.default_rng(6)
+    noisy = rng.integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8) & 0b10110111
+    noisy[dmd.rows_per_block:2 * dmd.rows_per_block] = 0
+    images = {0: ramp_image(dmd, 0), 1: noisy}
+    plan = fast_plan(dmd, 400e6, reset_mode=mode, order=order, words_per_cycle=store_words)
+    p = plan.params
+    assert p.beats == 2
+    row = dmd.dclk_per_row // 2
+    assert p.row_period == (row if store_words * 64 >= dmd.bits_per_dclk * 2 else 2 * row)
+    frames = [(0, 8), (1, 6)]
+    offered, pins = [], []
+    for slot, depth in frames:
+        offered.append((slot, depth, pins[-1] + PIN_TO_STROBE + 4 if pins else 0))
+        strobes = [t + PIN_TO_STROBE for t in pins]
+        pins.append(next_ready(p, model_frames(offered, images, dmd), strobes, dmd) - PIN_TO_STROBE)
+    run, _ = check(p, frames, images, pins, test_name, offered=offered, dmd=dmd, store_words=store_words)
+    assert len(run.lights) == 2
 
 
 @pytest.mark.verilog

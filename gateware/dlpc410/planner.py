@@ -14,7 +14,7 @@ from amaranth import Array, Cat, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from spec.schedule import INIT_TO_DVALID
+from spec.schedule import INIT_TO_DVALID, row_cycles
 
 from ..registers import TIME_BITS, Registers, Source
 from ..store.layouts import SLOT_BITS, FrameInfo
@@ -37,6 +37,8 @@ class Planner(wiring.Component):
     Parameters
     ----------
     dmd : :class:`spec.facts.DmdType`
+    beats : int
+        DCLK beats per cycle (a row cycle's length in cycles).
 
     Members
     -------
@@ -86,8 +88,8 @@ class Planner(wiring.Component):
         Frames started; pulses made after their time; frames dropped for their bit depth.
     """
 
-    def __init__(self, dmd):
-        self._dmd = dmd
+    def __init__(self, dmd, *, beats=1):
+        self._dmd, self._beats = dmd, beats
         groups = dmd.blocks
         gb = group_bits(dmd)
         super().__init__({
@@ -120,7 +122,7 @@ class Planner(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         dmd, regs, now = self._dmd, self.regs, self.now
-        R = dmd.dclk_per_row
+        R = row_cycles(dmd, self._beats)
         G = dmd.blocks
         use_prng = regs.source == Source.PRNG
 

@@ -63,7 +63,7 @@ class System:
         self.dmd = DMDS[p["dmd"]]
         self.memory = McbModel(p["memory_bytes"])
         self.plan = run_plan(p)
-        self.dlpc = Dlpc410(self.dmd, dclk=1e9 / DMD_NS, rst_active_cycles=p["t_rst"],
+        self.dlpc = Dlpc410(self.dmd, clock_hz=1e9 / DMD_NS, rst_active_cycles=p["t_rst"],
                             settle_cycles=p["t_settle"], init_cycles=p["init_cycles"],
                             init_grace_cycles=p["init_grace"], check_training=p.get("check_training", True))
         self.net = Model(self.dmd, _address(p["mac"]), _address(p["ip"]), p["port"])
