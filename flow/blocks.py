@@ -82,8 +82,7 @@ BLOCKS = {
 }
 
 
-def core(dmd="dlp7000"):
+def core(dmd="dlp7000", dclk_hz=400e6):
     """The projector's core as the board builds it (:func:`gateware.top.platform.core`)."""
-    from gateware.platform.clocks import Spartan6Clocks
     from gateware.top.platform import core as board_core
-    return board_core(DMDS[dmd], Spartan6Clocks.frequencies())
+    return board_core(DMDS[dmd], dclk_hz)

@@ -165,6 +165,8 @@ class FastSystem(wiring.Component):
         64-bit words of memory.
     timing : McbTiming, optional
         DDR2 timing (default :class:`sim.models.mcb.McbTiming`, the Python model's).
+    beats : int
+        DCLK cycles per ``dmd`` cycle (2: DCLK 400 MHz).
 
     Members
     -------
@@ -182,8 +184,8 @@ class FastSystem(wiring.Component):
     """
 
     def __init__(self, dmd, registers, *, mac, ip, port, clocks, init_cycles=200, init_grace_cycles=4,
-                 memory_words=1 << 21, timing=None):
-        self._dmd = dmd
+                 memory_words=1 << 21, timing=None, beats=1):
+        self._dmd, self._beats = dmd, beats
         self._registers = registers
         self._addresses = dict(mac=mac, ip=ip, port=port)
         self._clocks = clocks
@@ -238,7 +240,7 @@ class FastSystem(wiring.Component):
         self._clocks_and_resets(m)
         # The sequencer's registers for the run are the core's power-up registers.
         m.submodules.core = core = Projector(dmd, **self._addresses, regs=self._registers,
-                                             sync_hz=self._clocks["sync"], mdio_cycles=(40, 10))
+                                             sync_hz=self._clocks["sync"], mdio_cycles=(40, 10), beats=self._beats)
         m.d.comb += [core.trigger_in.eq(self.trigger_in), core.sync_in.eq(0), core.mdio_i.eq(1)]
 
         rx = Signal(gmii.RxPins)

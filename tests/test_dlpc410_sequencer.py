@@ -81,6 +81,7 @@ def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), ea
     assert run.status["late"] == 0 == model.late
     assert run.status["underruns"] == 0
     assert run.status["overruns"] == model.overruns
+    assert run.status["held"] == model.held
     assert run.status["triggers"] == len(model.accepted)
     assert run.status["early"] == len(early_pins)
     # the camera model on the rule model's mirror history, the window holding each frame
@@ -238,6 +239,32 @@ def test_triggers(test_name):
                        early_pins=(3, 9), offered=frames)
     assert model.overruns == 5 and len(model.accepted) == 3
     assert run.status["frames"] == 3 and run.status["bad_frames"] == model.bad_frames == 2
+
+
+@pytest.mark.verilog
+@pytest.mark.parametrize("mode", [ResetMode.GLOBAL, ResetMode.DUAL])
+def test_early_triggers_held(mode, test_name):
+    """With ``trigger_hold``, a trigger during a frame is held and obeyed on the first cycle
+    every group is ready (the frame after it starts at once), a second one meanwhile is an
+    overrun, and a trigger while a newer frame's first plane reloads is held too: no frame is
+    lost. Triggers come faster than frames: the frames play back to back."""
+    plan = fast_plan(reset_mode=mode, depth=4)
+    p = plan.params
+    p.trigger_hold = True
+    first = next_ready(p, model_frames([(0, 4)], None), []) - PIN_TO_STROBE
+    frames = [(0, 4, 0), (1, 4, first + PIN_TO_STROBE + 4), (0, 3, first + PIN_TO_STROBE + 4)]
+    # triggers at 0.6 of the frame period: each one early, held, a burst's second an overrun
+    period = plan.frame_cycles
+    pins = [first + round(k * 0.6 * period) for k in range(5)] + [first + round(1.2 * period) + 30]
+    # the frames shown, in order (a frame repeats when no newer one is there at its end)
+    result = schedule.simulate(DMD, p, model_frames(frames, None), [t + PIN_TO_STROBE for t in pins])
+    fi = {t: f for t, g, kind, f, _e in result.pulses if g == 0}
+    shown = [(result.shown[fi[t]].slot, result.shown[fi[t]].depth) for t in result.frame_starts]
+    run, model = check(p, shown, None, pins, test_name, offered=frames, extra=period)
+    assert model.held >= 2 and model.overruns >= 1 and len(model.accepted) >= 3
+    # a held trigger is obeyed the cycle every group is ready: frames back to back
+    starts = model.frame_starts
+    assert all(b > a for a, b in zip(starts, starts[1:], strict=False))
 
 
 @pytest.mark.verilog

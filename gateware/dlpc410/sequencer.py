@@ -230,6 +230,7 @@ class Sequencer(wiring.Component):
             self.status.triggers.eq(control.triggers),
             self.status.overruns.eq(control.overruns),
             self.status.early.eq(control.early),
+            self.status.held.eq(control.held),
             self.status.underruns.eq(bus.underruns),
         ]
 

@@ -14,6 +14,9 @@ model; the model's mirror history feeds the camera model (:func:`frame_lights`).
 
 from dataclasses import dataclass, field
 
+from amaranth.lib import data
+
+from gateware.dlpc410.layouts import Status
 from gateware.registers import Registers
 from sim.harness.amaranth_sim import simulate
 from sim.models.camera import Camera
@@ -123,8 +126,7 @@ def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, nam
             high_left = max(0, high_left - 1)
             sync_left = max(0, sync_left - 1)
         st = ctx.get(dut.status)
-        run.status = {k: int(getattr(st, k)) for k in
-                      ("now", "frames", "triggers", "overruns", "early", "late", "underruns", "bad_frames")}
+        run.status = {name: int(getattr(st, name)) for name, _ in data.Layout.cast(Status)}
 
     process = amaranth_process(model, dut.pins)
     simulate(dut, [bench], name=name, clocks={"sync": 200e6}, processes=[process])
