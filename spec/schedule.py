@@ -164,6 +164,7 @@ class Frame:
     depth: int
     occupancy: tuple = None      # None: every block full
     ready: int = 0               # cycle from which the store offers it
+    sequence: bool = False       # the next of a stored sequence: never replaces a waiting frame
 
     def occupied(self, plane, block):
         return self.occupancy is None or bool((self.occupancy[block] >> plane) & 1)
@@ -453,7 +454,7 @@ class _Model:
             cands.append(max(st[g].writable, self.next_row) if ops[i][0] == "row" else st[g].writable)
         nxt = self.frames.offer()
         take_at = None
-        if self.idle_take and nxt is not None and not self.playing():
+        if self.idle_take and nxt is not None and not self.playing() and not self.frames.offered[nxt[0]].sequence:
             take_at = max(nxt[1], self.queued_at, t + 1)
             cands.append(take_at)
         hold_at = None
@@ -477,7 +478,7 @@ class _Model:
             t = self.t
             nxt = self.frames.offer()
             take_now = (self.idle_take and nxt is not None and nxt[1] <= t and t >= self.queued_at
-                        and not self.playing())
+                        and not self.playing() and not self.frames.offered[nxt[0]].sequence)
             if t % 2 == 0 and t >= self.bus_free and self.decide(t):
                 if max_frames is not None and len(self.res.frame_starts) > max_frames:
                     break
@@ -505,7 +506,8 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
         Offered in turn from their ``ready`` cycle (one frame per cycle at most; a frame with a
         bad bit depth is dropped the cycle it is offered): each time group 0 needs a new frame
         it takes the offered one, else shows the current one again; triggered and not chained,
-        one offered while every group waits loaded for a trigger is taken at once.
+        one offered while every group waits loaded for a trigger is taken at once (unless it is
+        the next frame of a stored sequence).
     strobes : iterable of int
         Cycles at which the trigger block signals a trigger (see :mod:`gateware.dlpc410.trigger`).
     until : int

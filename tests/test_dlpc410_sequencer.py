@@ -28,12 +28,12 @@ def fast_plan(dmd=DMD, dclk=200e6, **kw):
 
 
 def model_frames(frames, images, dmd=DMD):
-    """Model frames of (slot, depth) or (slot, depth, ready) tuples."""
+    """Model frames of (slot, depth), (slot, depth, ready) or (slot, depth, ready, sequence)."""
     out = []
-    for slot, depth, *ready in frames:
+    for slot, depth, *rest in frames:
         occ = None if images is None else \
             tuple(int(x) for x in bitplane.occupancy(images[slot], dmd.rows_per_block))
-        out.append(schedule.Frame(slot, depth, occ, *ready))
+        out.append(schedule.Frame(slot, depth, occ, *rest[:1], *map(bool, rest[1:])))
     return out
 
 
@@ -265,6 +265,21 @@ def test_early_triggers_held(mode, test_name):
     # a held trigger is obeyed the cycle every group is ready: frames back to back
     starts = model.frame_starts
     assert all(b > a for a, b in zip(starts, starts[1:], strict=False))
+
+
+@pytest.mark.verilog
+def test_stored_sequence_frames_wait_their_turn(test_name):
+    """Frames of a stored sequence offered while the first waits for its trigger do not replace
+    it (a newer streamed frame would): each trigger shows the next frame in order."""
+    rng = np.random.default_rng(9)
+    images = {s: rng.integers(0, 256, (DMD.rows, DMD.columns), dtype=np.uint8) for s in range(2)}
+    p = fast_plan(depth=4).params
+    frames = [(0, 4, 0, 1), (1, 4, 0, 1), (0, 4, 0, 1)]
+    first = next_ready(p, model_frames(frames[:1], images), []) + 200
+    period = schedule.plan(DMD, 200e6, **FAST, depth=4).frame_cycles
+    pins = [first + k * (period + 300) for k in range(3)]
+    run, model = check(p, [(0, 4), (1, 4), (0, 4)], images, pins, test_name, offered=frames)
+    assert [f.slot for f in model.shown] == [0, 1, 0] and len(run.lights) == 3
 
 
 @pytest.mark.verilog

@@ -49,6 +49,15 @@ class Bench:
         await stream_feed(ctx, self.dut.pixels, store_stim.frame_beats(image, frame_id, rows=rows),
                           idle=idle)
 
+    async def feed_sequence(self, ctx, images, order):
+        """Sequence mode of ``len(images)`` frames at depth 1, then the frames in ``order``."""
+        ctx.set(self.dut.sequence_length, len(images))
+        ctx.set(self.dut.bit_depth, 1)
+        for _ in range(3):
+            await ctx.tick()
+        for f in order:
+            await self.feed(ctx, images[f], f)
+
     async def ask(self, ctx):
         """Ask for a frame and wait for the answer: (slot, frame_id, bit_depth)."""
         dut = self.dut
@@ -323,17 +332,11 @@ def test_shown_slot_never_written_and_hostile_headers(test_name):
 def test_sequence_mode(test_name):
     """Sequence of 3 frames sent out of order: played 0, 1, 2, 0, 1, 2, 0 with their ids."""
     bench = Bench(SHORT_DMD)
-    dut = bench.dut
     images = {f: store_stim.random_image(SHORT_DMD, 400 + f) for f in range(3)}
     got = []
 
     async def producer(ctx):
-        ctx.set(dut.sequence_length, 3)
-        ctx.set(dut.bit_depth, 1)
-        for _ in range(3):
-            await ctx.tick()
-        for f in (2, 0, 1):
-            await bench.feed(ctx, images[f], f)
+        await bench.feed_sequence(ctx, images, (2, 0, 1))
         await bench.feed(ctx, images[1], 3, rows=range(4))        # beyond the sequence: stale
 
     async def consumer(ctx):
@@ -353,6 +356,45 @@ def test_sequence_mode(test_name):
 
     bench.run([producer, consumer], test_name, deadline=6e-4)
     assert got == [0, 1, 2, 0, 1, 2, 0]
+
+
+def test_sequence_of_two_asked_ahead(test_name):
+    """Sequence of 2 frames, the next frame asked for before the shown one is handed back (as
+    the broker does when the sequencer takes the frame on offer): the ask for the slot still
+    shown waits, its release is taken meanwhile, and the frames play 0, 1, 0, 1, 0."""
+    bench = Bench(SHORT_DMD)
+    dut = bench.dut
+    images = {f: store_stim.random_image(SHORT_DMD, 900 + f) for f in range(2)}
+    got = []
+
+    async def producer(ctx):
+        await bench.feed_sequence(ctx, images, (0, 1))
+
+    async def consumer(ctx):
+        # the sequencer shows one frame while the broker holds the next on offer
+        shown, f, _ = await bench.ask(ctx)
+        got.append(f)
+        offered, f, _ = await bench.ask(ctx)
+        got.append(f)
+        for _ in range(3):
+            # the offered frame is taken: the broker asks again at once, for the slot still
+            # shown; that slot's release follows later
+            ctx.set(dut.ask.valid, 1)
+            await ctx.tick("dmd").until(dut.ask.ready)
+            ctx.set(dut.ask.valid, 0)
+            for _ in range(20):
+                await ctx.tick("dmd")
+            await bench.release(ctx, shown)
+            shown = offered
+            ctx.set(dut.frames.ready, 1)
+            payload, = await ctx.tick("dmd").sample(dut.frames.payload).until(dut.frames.valid)
+            ctx.set(dut.frames.ready, 0)
+            offered = int(payload.slot)
+            got.append(int(payload.frame_id))
+        assert bench.counters(ctx)["bad_releases"] == 0
+
+    bench.run([producer, consumer], test_name, deadline=6e-4)
+    assert got == [0, 1, 0, 1, 0]
 
 
 def test_row_subsets_and_bad_requests(test_name):

@@ -133,11 +133,12 @@ class FrameControl(wiring.Component):
                 m.d.comb += self.running.eq(1)
                 queue_first_planes()
 
-        # A newer frame offered while no group plays replaces the preloaded first planes; nothing
+        # A newer streamed frame offered while no group plays replaces the preloaded first planes (the
+        # next frame of a stored sequence waits for its turn); nothing
         # abandoned is pulsed (no trigger is obeyed before every group is loaded again), and the
         # settle times of the last pulses still hold. With ``reload`` at rest, the same frame is
         # loaded again under new registers.
-        newer = ~use_prng & ~regs.chain & self.offer.valid
+        newer = ~use_prng & ~regs.chain & self.offer.valid & ~self.offer.sequence
         idle = fsm.ongoing("RUN") & ~self.playing
         resting = fsm.ongoing("RUN") & self.all_ready
         m.d.comb += [take_idle.eq((idle & newer) | (resting & self.reload)),

@@ -25,10 +25,13 @@ __all__ = ["Planner", "Offer"]
 
 
 class Offer(data.Struct):
-    """The frame the store offers now: ``valid`` when it has a bit depth the sequencer plays."""
+    """The frame the store offers now: ``valid`` when it has a bit depth the sequencer plays;
+    ``sequence`` when it is the next frame of a stored sequence (it does not replace a frame
+    waiting for its trigger)."""
     valid: 1
     slot: SLOT_BITS
     depth: 4
+    sequence: 1
 
 
 class Planner(wiring.Component):
@@ -165,7 +168,8 @@ class Planner(wiring.Component):
         depth_in = self.frames.payload.bit_depth
         frame_ok = (depth_in != 0) & (depth_in <= 8)
         m.d.comb += [self.offer.valid.eq(self.frames.valid & frame_ok),
-                     self.offer.slot.eq(self.frames.payload.slot), self.offer.depth.eq(depth_in)]
+                     self.offer.slot.eq(self.frames.payload.slot), self.offer.depth.eq(depth_in),
+                     self.offer.sequence.eq(self.frames.payload.sequence)]
         with m.If(self.frames.valid & ~frame_ok):
             m.d.comb += self.frames.ready.eq(1)
             m.d.sync += self.bad_frames.eq(self.bad_frames + 1)
