@@ -41,8 +41,8 @@ def enable(directory):
     directory = Path(directory).resolve()
     directory.mkdir(parents=True, exist_ok=True)
     os.environ[CACHE_ENV] = str(directory)
-    # make splits MAKEFLAGS at unescaped spaces
-    wrapper = f"{sys.executable} {Path(__file__).resolve()}".replace(" ", "\\ ")
+    # make splits MAKEFLAGS at unescaped spaces; -P: this folder must not shadow the standard library
+    wrapper = f"{sys.executable} -P {Path(__file__).resolve()}".replace(" ", "\\ ")
     flags = os.environ.get("MAKEFLAGS", "").split()
     for name, value in (("OBJCACHE", wrapper), ("OPT_FAST", OPT_FAST)):
         if not any(flag.startswith(f"{name}=") for flag in flags):
