@@ -54,15 +54,16 @@ class BringupTop(Elaboratable):
 
         # Plane words cross into DCLK's domain through an async FIFO.
         m.submodules.words_cdc = fifo = AsyncFIFO(width=64, depth=16, w_domain="sync", r_domain="dmd")
+        into, out = fifo.w_stream, fifo.r_stream
         m.d.comb += [
-            fifo.w_data.eq(serialiser.words.payload.data),
-            fifo.w_en.eq(serialiser.words.valid),
-            serialiser.words.ready.eq(fifo.w_rdy),
-            fifo.r_en.eq(1),
+            into.payload.eq(serialiser.words.payload.data),
+            into.valid.eq(serialiser.words.valid),
+            serialiser.words.ready.eq(into.ready),
+            out.ready.eq(1),
         ]
         word_dmd = Signal(64)
-        with m.If(fifo.r_rdy):
-            m.d.dmd += word_dmd.eq(fifo.r_data)
+        with m.If(out.valid):
+            m.d.dmd += word_dmd.eq(out.payload)
 
         m.submodules.dlpc410 = dlpc = Dlpc410Pins()
         lanes = beat.word_to_lanes(word_dmd)

@@ -303,6 +303,14 @@ class Dlpc410:
         initialisation, no row cycle open): adapters then need read nothing else."""
         return bool(self._arstz) and not self._initialising(self.cycle) and self._row is None
 
+    def quiet_outputs_until(self):
+        """The first cycle after this one whose outputs differ from this cycle's if only idle
+        cycles (DVALID low, ARSTZ high) come, or None if they never do."""
+        changes = [self._rst_until + 1 if self.cycle <= self._rst_until else None,
+                   self.ecp2_cycles if self.cycle < self.ecp2_cycles else None,
+                   self.init_end if self.init_end is not None and self.cycle < self.init_end else None]
+        return min((c for c in changes if c is not None), default=None)
+
     def run(self, items):
         """Feed a sequence of per-cycle dicts and :class:`Idle` items (see the driver)."""
         for item in items:
@@ -616,6 +624,10 @@ def amaranth_process(model, iface, *, domain="sync"):
     return process
 
 
+#: What a quiet cycle's pins amount to (:meth:`CocotbAdapter._sample`).
+_QUIET = {"dvalid": 0, "arstz": 1}
+
+
 class CocotbAdapter:
     """Steps ``model`` on each rising edge of ``clock`` from the signals of a cocotb ``dut``.
 
@@ -628,10 +640,17 @@ class CocotbAdapter:
     Each cycle it samples the pins mid-cycle (falling edge of ``clock``, where registered
     outputs are stable) and drives the controller's outputs after the next rising edge, as
     :func:`amaranth_process` does.
+
+    With ``rest``, quiet stretches (:meth:`Dlpc410.quiet`, DVALID low and ARSTZ high) in which
+    the controller's outputs stay as they are (:meth:`Dlpc410.quiet_outputs_until`) are not
+    stepped cycle by cycle: the adapter rests until DVALID or ARSTZ changes (on a rising edge
+    of ``clock``) and then gives the model the cycles it rested as :meth:`Dlpc410.idle`, which
+    is stepping each of them. Meanwhile the model's ``cycle`` lags behind the simulation: for
+    testbenches that read the model's commands (``log``, the mirror history), not its cycle.
     """
 
-    def __init__(self, model, dut, clock, *, prefix="dlpc__", names=None):
-        self.model, self.clock = model, clock
+    def __init__(self, model, dut, clock, *, prefix="dlpc__", names=None, rest=False):
+        self.model, self.clock, self.rest = model, clock, rest
         names = names or {}
 
         def handle(member):
@@ -641,6 +660,7 @@ class CocotbAdapter:
         self.outputs = [(n, h) for n in OUTPUTS if (h := handle(n)) is not None]
         self._dvalid, self._arstz = handle("dvalid"), handle("arstz")
         self._driven = {}
+        self._changed = None         # set when DVALID or ARSTZ changes, once the adapter rests
 
     def _drive(self, levels):
         for n, h in self.outputs:
@@ -652,15 +672,53 @@ class CocotbAdapter:
         if self._dvalid is not None and self._arstz is not None and self.model.quiet():
             dvalid, arstz = int(self._dvalid.value), int(self._arstz.value)
             if not dvalid and arstz:
-                return {"dvalid": 0, "arstz": 1}
+                return dict(_QUIET)
         return {n: int(h.value) for n, h in self.inputs}
 
     async def run(self):
         from cocotb.triggers import FallingEdge, RisingEdge
+        from cocotb.utils import get_sim_time
 
+        falling, rising = FallingEdge(self.clock), RisingEdge(self.clock)
         self._drive(self.model.outputs())
+        last = period = None
         while True:
-            await FallingEdge(self.clock)
+            await falling
             sampled = self._sample()
-            await RisingEdge(self.clock)
+            await rising
             self._drive(self.model.step(sampled))
+            if not self.rest:
+                continue
+            now = get_sim_time("step")
+            if period is None:       # the clock's period, from its first two rising edges
+                period, last = (None if last is None else now - last), now
+            elif sampled == _QUIET and self.model.quiet():
+                await self._rest(now, period)
+
+    async def _rest(self, edge, period):
+        """Rest from the rising edge at ``edge`` (steps) while the model is quiet and its outputs
+        stay as they are; on return, the next falling edge samples the next cycle the model has
+        not had."""
+        import cocotb
+        from cocotb.triggers import Event
+        from cocotb.utils import get_sim_time
+
+        if self._dvalid is None or self._arstz is None or self.model.quiet_outputs_until() is not None:
+            return
+        if self._changed is None:
+            # one waiter per pin for the whole run: the adapter itself waits on a single event,
+            # so that cancelling it stays immediate
+            self._changed = Event()
+            for pin in (self._dvalid, self._arstz):
+                cocotb.start_soon(self._watch(pin))
+        self._changed.clear()
+        await self._changed.wait()
+        rested, phase = divmod(get_sim_time("step") - edge, period)
+        assert phase == 0, "DVALID or ARSTZ changed between rising edges of the clock"
+        if rested:
+            self.model.idle(rested, dict(_QUIET))
+
+    async def _watch(self, pin):
+        while True:
+            await pin.value_change
+            self._changed.set()

@@ -318,12 +318,18 @@ def amaranth_process(port_model, port, *, domain, frequency):
 
 class CocotbPort:
     """Connects ``port_model`` to the Verilog ports ``<prefix>__<member>`` of ``dut``; start
-    :meth:`run` with ``cocotb.start_soon``. ``period_ns`` is that of ``clock``."""
+    :meth:`run` with ``cocotb.start_soon``. ``period_ns`` is that of ``clock``.
+
+    The model is clocked on every rising edge on which something can happen: while the port is
+    quiet (:meth:`McbPort.quiet`) and no strobe was set at the last edge, the adapter waits for
+    a strobe to change instead of looking at every edge.
+    """
 
     def __init__(self, dut, prefix, clock, port_model, period_ns):
         self.inputs = {name: getattr(dut, f"{prefix}__{name}") for name in INPUTS}
         self.outputs = {name: getattr(dut, f"{prefix}__{name}") for name in OUTPUTS}
         self.clock_signal, self.model, self.period = clock, port_model, period_ns * 1e-9
+        self.period_ns = period_ns
         self._last = {}
         self._drive(port_model.outputs)
 
@@ -348,13 +354,24 @@ class CocotbPort:
         return values
 
     async def run(self):
-        from cocotb.triggers import RisingEdge
-        cycle = 0
+        from cocotb.triggers import First, RisingEdge
+        from cocotb.utils import get_sim_steps, get_sim_time
         edge = RisingEdge(self.clock_signal)
+        strobes = [self.inputs[name].value_change for name in ("cmd_en", "wr_en", "rd_en")]
+        period = get_sim_steps(self.period_ns, "ns")
+        await edge
+        first, cycle = get_sim_time("step"), 1
         while True:
-            await edge
-            cycle += 1
             inputs = self._sample()
             if not (inputs["cmd_en"] or inputs["wr_en"] or inputs["rd_en"]) and self.model.quiet():
-                continue        # a Python call per edge of an idle port is most of a long run's time
+                # a Python call per edge of an idle port is most of a long run's time: none until
+                # a strobe changes, then the edges again from the next, numbered from the time
+                await First(*strobes)
+                await edge
+                steps = get_sim_time("step") - first
+                assert steps % period == 0, "the port's clock is not periodic"
+                cycle = steps // period + 1
+                continue
             self._drive(self.model.clock(cycle * self.period, **inputs))
+            await edge
+            cycle += 1
