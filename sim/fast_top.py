@@ -34,7 +34,7 @@ from sim.models.dlpc410_replay import Replay
 from sim.models.mcb import McbTiming
 
 __all__ = ["FastSystem", "ResponderBench", "dlpc410_side", "power_on_reset", "pin_layout", "SOURCES", "PLUSARGS",
-           "read_rate"]
+           "read_rate", "INGEST_BYTES_PER_S"]
 
 #: The Verilog models the top instantiates.
 SOURCES = [ROOT / "sim" / "hdl" / name for name in
@@ -48,8 +48,9 @@ ECP2_CYCLES = 4
 #: Cycles each domain stays in reset after its clock starts.
 RESET_CYCLES = 4
 
-#: GMII line rate in 64-bit words per second (the store's write traffic at most).
-_INGEST_WORDS_PER_S = 125e6 / 8
+#: GMII line rate in bytes per second: the store's write traffic at most (a pixel byte makes a
+#: byte of bit-planes).
+INGEST_BYTES_PER_S = 125e6
 
 
 def pin_layout(buses, beats=1):
@@ -66,9 +67,12 @@ def pin_layout(buses, beats=1):
 
 
 def read_rate(timing, dmd_hz):
-    """Words per ``dmd`` cycle the plane reader can count on: the DDR2's sustained bandwidth
-    (refresh taken off) less the store's writes (at most the GMII line rate)."""
-    return (timing.sustained_bytes_per_s / 8 - _INGEST_WORDS_PER_S) / dmd_hz
+    """64-bit words per ``dmd`` cycle the plane reader can count on: the DDR2's sustained
+    bandwidth (refresh taken off) less the store's writes at the GMII line rate. The memory
+    model gives the reader this much under that ingest (``store.read_words_per_dmd_cycle_with_
+    ingest``, :mod:`sim.bench.store`; a test holds the two together). On the Atlys (DDR2-800 x16,
+    1.6 GB/s peak) it is under one word a cycle at 200 MHz whatever the port's width."""
+    return (timing.sustained_bytes_per_s - INGEST_BYTES_PER_S) / 8 / dmd_hz
 
 
 def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cycles, flush,

@@ -34,6 +34,11 @@ def random_image(dmd, seed):
     return np.random.default_rng(seed).integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8)
 
 
+def plane_words(transfers, width):
+    """The 64-bit plane words in ``transfers`` of ``width`` bits each, the low word first."""
+    return [int(t) >> (64 * i) & (2**64 - 1) for t in transfers for i in range(width // 64)]
+
+
 def check_plane(dmd, image, plane, words, first_row=0, row_count=None, what=""):
     """``words`` (read back in order) against numpy's slicing of ``image``."""
     row_count = dmd.rows if row_count is None else row_count
