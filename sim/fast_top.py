@@ -21,7 +21,7 @@ an evaluation, and three 125 MHz clocks apart would cost three (the small-geomet
 
 import math
 
-from amaranth import Cat, ClockDomain, ClockSignal, Const, Instance, Module, ResetSignal, Signal, Value
+from amaranth import Cat, ClockDomain, ClockSignal, Const, Instance, Module, ResetSignal, Shape, Signal, Value
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -213,13 +213,20 @@ class FastSystem(wiring.Component):
 
         ports = [core.mcb_write, core.mcb_read]
         connections = {}
-        for name, member in mcb.PortSignature().members.items():
-            both = Cat(*(getattr(p, name) for p in ports))
+        # the model gives each port the slots of the widest one: pad the narrower ports' members
+        for name, member in mcb.PortSignature(max(mcb.WIDTHS)).members.items():
+            slot = Shape.cast(member.shape).width
+            parts = []
+            for p in ports:
+                value = getattr(p, name)
+                pad = slot - len(Value.cast(value))
+                parts += [value, *([Signal(pad, name=f"{name}_pad")] if pad else [])]
             # Out members are driven by the core: inputs of the model
-            connections[("i_" if member.flow == wiring.Out else "o_") + name] = both
+            connections[("i_" if member.flow == wiring.Out else "o_") + name] = Cat(*parts)
         m.submodules.memory = Instance(
             "mcb_model",
             p_PORTS=2, p_WORDS=self._memory_words,
+            p_WIDTH=Const(sum(p.signature.width << (32 * i) for i, p in enumerate(ports)), 64),
             p_CALIB_CYCLES=cycles(t.calib_delay_s), p_CMD_LATENCY=cycles(t.command_latency_s),
             p_WORD_NS=t.word_s * 1e9, p_READ_LATENCY_NS=t.read_latency_s * 1e9,
             p_REFRESH_INTERVAL_NS=t.refresh_interval_s * 1e9, p_REFRESH_NS=t.refresh_s * 1e9,

@@ -4,10 +4,11 @@ One plain-Python :class:`McbModel` holds the memory (numpy, 64-bit words, bytes 
 order from the low bits up) and the shared DRAM timing; each :class:`McbPort` has the
 fabric-side FIFOs of one port of 32, 64 or 128 bits (4 commands, 64 write words and 64 read
 words of the port's width; a port word covers ``width / 8`` consecutive bytes, so a 128-bit
-word holds two 64-bit memory words, the first in its low bits) and is clocked by its own clock: :meth:`McbPort.clock` is called once per
-rising edge of that clock with the inputs sampled at the edge and returns the registered outputs
-for the next cycle. Thin adapters drive it from the Amaranth simulator
-(:func:`amaranth_process`) and from cocotb (:class:`CocotbPort`).
+word holds two 64-bit memory words, the first in its low bits) and is clocked by its own
+clock: :meth:`McbPort.clock` is called once per rising edge of that clock with the inputs
+sampled at the edge and returns the registered outputs for the next cycle. Thin adapters
+drive it from the Amaranth simulator (:func:`amaranth_process`) and from cocotb
+(:class:`CocotbPort`).
 
 Timing
 ------
@@ -25,8 +26,9 @@ Errors
 ------
 :class:`McbError` (with a ``kind``) is raised on: traffic before ``calib_done``
 (``before_calib``), a command while ``cmd_full`` (``cmd_full``), a byte address that is not a
-multiple of the port's word (4, 8 or 16 bytes) or a burst outside the memory (``misaligned``, ``out_of_range``), a write command
-whose words are not all in the write FIFO when it is pushed (``data_missing``), a write word
+multiple of the port's word (4, 8 or 16 bytes) or a burst outside the memory (``misaligned``,
+``out_of_range``), a write command whose words are not all in the write FIFO when it is pushed
+(``data_missing``), a write word
 pushed while ``wr_full`` (``wr_full``), a read word taken while ``rd_empty`` (``rd_empty``), the
 controller finding the write FIFO empty during a write (``underrun``, reachable only with
 ``check_write_data=False``, as the real MCB does not check at push time), read data arriving at
@@ -359,6 +361,12 @@ class CocotbPort:
         self.clock_signal, self.model, self.period = clock, port_model, period_ns * 1e-9
         self._last = {}
         self._drive(port_model.outputs)
+
+    @staticmethod
+    def widths(dut, *prefixes):
+        """The widths of the Verilog ports ``<prefix>__*`` of ``dut``, for :class:`McbModel`'s
+        ``widths``."""
+        return tuple(len(getattr(dut, f"{prefix}__rd_data")) for prefix in prefixes)
 
     def _drive(self, values):
         # only what changed: each write is a simulator call
