@@ -52,6 +52,11 @@ def _reader():
     return Reader(DMDS["dlp7000"], slots=4)
 
 
+def _read_widener():
+    from gateware.platform.read_widener import ReadWidener
+    return ReadWidener()
+
+
 def _sequencer(dmd="dlp7000"):
     from gateware.dlpc410.sequencer import Sequencer
     return Sequencer(DMDS[dmd])
@@ -76,6 +81,7 @@ BLOCKS = {
     "frame_slots": _frame_slots,
     "writer": _writer,
     "reader": _reader,
+    "read_widener": _read_widener,
     "sequencer": _sequencer,
     "sequencer_dlp9500": lambda: _sequencer("dlp9500"),
     "register_crossing": _register_crossing,

@@ -21,7 +21,7 @@ an evaluation, and three 125 MHz clocks apart would cost three (the small-geomet
 
 import math
 
-from amaranth import Cat, ClockDomain, ClockSignal, Const, Instance, Module, ResetSignal, Signal, Value
+from amaranth import Cat, ClockDomain, ClockSignal, Const, Instance, Module, ResetSignal, Shape, Signal, Value
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -34,7 +34,7 @@ from sim.models.dlpc410_replay import Replay
 from sim.models.mcb import McbTiming
 
 __all__ = ["FastSystem", "ResponderBench", "dlpc410_side", "power_on_reset", "pin_layout", "SOURCES", "PLUSARGS",
-           "read_rate"]
+           "read_rate", "INGEST_BYTES_PER_S"]
 
 #: The Verilog models the top instantiates.
 SOURCES = [ROOT / "sim" / "hdl" / name for name in
@@ -48,8 +48,9 @@ ECP2_CYCLES = 4
 #: Cycles each domain stays in reset after its clock starts.
 RESET_CYCLES = 4
 
-#: GMII line rate in 64-bit words per second (the store's write traffic at most).
-_INGEST_WORDS_PER_S = 125e6 / 8
+#: GMII line rate in bytes per second: the store's write traffic at most (a pixel byte makes a
+#: byte of bit-planes).
+INGEST_BYTES_PER_S = 125e6
 
 
 def pin_layout(buses, beats=1):
@@ -66,9 +67,12 @@ def pin_layout(buses, beats=1):
 
 
 def read_rate(timing, dmd_hz):
-    """Words per ``dmd`` cycle the plane reader can count on: the DDR2's sustained bandwidth
-    (refresh taken off) less the store's writes (at most the GMII line rate)."""
-    return (timing.sustained_bytes_per_s / 8 - _INGEST_WORDS_PER_S) / dmd_hz
+    """64-bit words per ``dmd`` cycle the plane reader can count on: the DDR2's sustained
+    bandwidth (refresh taken off) less the store's writes at the GMII line rate. The memory
+    model gives the reader this much under that ingest (``store.read_words_per_dmd_cycle_with_
+    ingest``, :mod:`sim.bench.store`; a test holds the two together). On the Atlys (DDR2-800 x16,
+    1.6 GB/s peak) it is under one word a cycle at 200 MHz whatever the port's width."""
+    return (timing.sustained_bytes_per_s - INGEST_BYTES_PER_S) / 8 / dmd_hz
 
 
 def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cycles, flush,
@@ -211,13 +215,20 @@ class FastSystem(wiring.Component):
 
         ports = [core.mcb_write, core.mcb_read]
         connections = {}
-        for name, member in mcb.PortSignature().members.items():
-            both = Cat(*(getattr(p, name) for p in ports))
+        # the model gives each port the slots of the widest one: pad the narrower ports' members
+        for name, member in mcb.PortSignature(max(mcb.WIDTHS)).members.items():
+            slot = Shape.cast(member.shape).width
+            parts = []
+            for p in ports:
+                value = getattr(p, name)
+                pad = slot - len(Value.cast(value))
+                parts += [value, *([Signal(pad, name=f"{name}_pad")] if pad else [])]
             # Out members are driven by the core: inputs of the model
-            connections[("i_" if member.flow == wiring.Out else "o_") + name] = both
+            connections[("i_" if member.flow == wiring.Out else "o_") + name] = Cat(*parts)
         m.submodules.memory = Instance(
             "mcb_model",
             p_PORTS=2, p_WORDS=self._memory_words,
+            p_WIDTH=Const(sum(p.signature.width << (32 * i) for i, p in enumerate(ports)), 64),
             p_CALIB_CYCLES=cycles(t.calib_delay_s), p_CMD_LATENCY=cycles(t.command_latency_s),
             p_WORD_NS=t.word_s * 1e9, p_READ_LATENCY_NS=t.read_latency_s * 1e9,
             p_REFRESH_INTERVAL_NS=t.refresh_interval_s * 1e9, p_REFRESH_NS=t.refresh_s * 1e9,

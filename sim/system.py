@@ -138,7 +138,7 @@ SAVE_GROUPS = {
                                         "mcb_write__cmd_byte_addr[29:0]", "mcb_write__wr_en",
                                         "mcb_write__wr_data[63:0]", "mcb_write__wr_count[6:0]"],
     "store: MCB port 1 (read, dmd)": ["mcb_read__cmd_en", "mcb_read__cmd_byte_addr[29:0]", "mcb_read__rd_en",
-                                      "mcb_read__rd_data[63:0]", "mcb_read__rd_count[6:0]"],
+                                      "mcb_read__rd_data[127:0]", "mcb_read__rd_count[6:0]"],
     "sequencer: trigger and sync": ["trigger_in", "sync_out", "camera_out"],
     "sequencer: DLPC410 pins": ["dlpc__dvalid", "dlpc__rowmd[1:0]", "dlpc__rowad[10:0]", "dlpc__blkmd[1:0]",
                                 "dlpc__blkad[3:0]", "dlpc__din_a[31:0]", "dlpc__din_b[31:0]",

@@ -68,10 +68,10 @@ class Projector(wiring.Component):
         PHY transmit pins (``gmii_tx``).
     phy_reset_n, mdc, mdio_o, mdio_oe : Out(1); mdio_i : In(1)
         PHY reset and management (``sync``).
-    mcb_write : Out(mcb.PortSignature())
-        MCB port 0 (``sync``).
-    mcb_read : Out(mcb.PortSignature())
-        MCB port 1 (``dmd``).
+    mcb_write : Out(mcb.PortSignature(64))
+        MCB port 0 (``sync``), the store's writer.
+    mcb_read : Out(mcb.PortSignature(128))
+        MCB port 1 (``dmd``), the store's plane reader.
     dlpc : Out(dlpc410.interface.Signature)
         The DLPC410 applications interface (``dmd``).
     trigger_in, sync_in : In(1)
@@ -98,8 +98,8 @@ class Projector(wiring.Component):
             "mdio_o": Out(1),
             "mdio_oe": Out(1),
             "mdio_i": In(1),
-            "mcb_write": Out(mcb.PortSignature()),
-            "mcb_read": Out(mcb.PortSignature()),
+            "mcb_write": Out(mcb.PortSignature(64)),
+            "mcb_read": Out(mcb.PortSignature(128)),
             "dlpc": Out(interface.Signature(dmd.buses, beats)),
             "trigger_in": In(1),
             "sync_in": In(1),
@@ -126,7 +126,11 @@ class Projector(wiring.Component):
         # ---- Bit-plane serialiser and the store (sync, then dmd) -------------------------------
         m.submodules.serialiser = serialiser = Serialiser(dmd, lanes=1, frame_bits=FRAME_BITS)
         wiring.connect(m, ethernet.pixels, serialiser.pixels)
-        m.submodules.store = store = Store(dmd, slots=self._slots, frame_bits=FRAME_BITS)
+        # The reader reads 128-bit port words (two plane words); a sequencer that takes one word a
+        # cycle (two buses, one DCLK beat a cycle) gets them one at a time.
+        store_words = min(2, dmd.bits_per_dclk * self._beats // 64)
+        m.submodules.store = store = Store(dmd, slots=self._slots, frame_bits=FRAME_BITS, read_width=128,
+                                           plane_words=store_words)
         wiring.connect(m, serialiser.words, store.words)
         wiring.connect(m, serialiser.rows, store.rows)
         # The protocol counts a single streamed frame as a sequence of 1; the store calls streaming
@@ -145,7 +149,8 @@ class Projector(wiring.Component):
         wiring.connect(m, store.frames, broker.offered)
         wiring.connect(m, broker.store_occupancy, store.occupancy)
 
-        m.submodules.sequencer = seq = DomainRenamer("dmd")(Sequencer(dmd, beats=self._beats))
+        m.submodules.sequencer = seq = DomainRenamer("dmd")(Sequencer(dmd, beats=self._beats,
+                                                                      store_words=store_words))
         wiring.connect(m, broker.frames, seq.frames)
         m.d.comb += [seq.occupancy.eq(broker.occupancy), broker.occ_slot.eq(seq.occ_slot)]
         wiring.connect(m, seq.requests, store.requests)

@@ -92,7 +92,7 @@ class System:
     def __init__(self, dut, p):
         self.dut, self.p = dut, p
         self.dmd = DMDS[p["dmd"]]
-        self.memory = McbModel(p["memory_bytes"])
+        self.memory = McbModel(p["memory_bytes"], widths=CocotbPort.widths(dut, "mcb_write", "mcb_read"))
         self.plan = run_plan(p)
         self.dlpc = Dlpc410(self.dmd, clock_hz=1e9 / DMD_NS, rst_active_cycles=p["t_rst"],
                             settle_cycles=p["t_settle"], init_cycles=p["init_cycles"],
