@@ -30,6 +30,10 @@ def collect(modules=None, *, resources=True, log=print):
         log("bench: resources (yosys synth_xilinx -family xc6s) ...")
         for key, (value, unit) in res.figures(res.report()).items():
             figures[key] = {"value": value, "unit": unit}
+        from flow import timing
+        log("bench: logic depth per clock domain (yosys synth_xilinx -family xc6s) ...")
+        for key, (value, unit) in timing.figures(timing.report()).items():
+            figures[key] = {"value": value, "unit": unit}
     return figures
 
 

@@ -34,7 +34,10 @@ def count(cells):
     ff = sum(n for c, n in cells.items() if re.fullmatch(r"(FD\w*|LD\w*)", c))
     bram = cells.get("RAMB16BWER", 0) + 0.5 * cells.get("RAMB8BWER", 0)
     dsp = cells.get("DSP48A1", 0)
-    return {"lut": lut, "ff": ff, "bram18": bram, "dsp": dsp}
+    # the I/O serialisers of the DLPC410 lanes (DCLK 400 MHz) and the clocking that feeds them
+    io = {"oserdes2": cells.get("OSERDES2", 0), "pll": cells.get("PLL_ADV", 0) + cells.get("PLL_BASE", 0),
+          "bufpll": cells.get("BUFPLL", 0)}
+    return {"lut": lut, "ff": ff, "bram18": bram, "dsp": dsp, **io}
 
 
 def synthesise(verilog_path, top, *, iopads=False, blackboxes=(), flatten=False):
@@ -80,6 +83,9 @@ def figures(results):
     for name, counts in results.items():
         for key, unit in units.items():
             out[f"res.{name}.{key}"] = (counts[key], unit)
+    # the blocks are vendor-free; only the platform top has serialisers and PLLs
+    for key, unit in (("oserdes2", "OSERDES2"), ("pll", "PLL"), ("bufpll", "BUFPLL")):
+        out[f"res.total.{key}"] = (results["total"][key], unit)
     return out
 
 
@@ -93,6 +99,7 @@ def print_table(results):
     print(f"{'XC6SLX45':<16}{cap['lut']:>8}{cap['ff']:>8}{cap['bram18']:>8}{cap['dsp']:>6}")
     print(f"{'used':<16}" + "".join(f"{100 * total[k] / cap[k]:>7.1f}%" for k in ("lut", "ff", "bram18"))
           + f"{100 * total['dsp'] / cap['dsp']:>5.1f}%")
+    print(f"platform top: {total['oserdes2']} OSERDES2, {total['pll']} PLL, {total['bufpll']} BUFPLL")
 
 
 def main():

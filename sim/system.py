@@ -113,7 +113,8 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ):
           f"drops {drops or 'none'} (one datagram per frame goes to another UDP port on purpose); "
           f"{status['records_image']} image records, {status['rows']} rows; "
           f"triggers {status['triggers']} (held {status['triggers_held']}), overruns {status['trigger_overruns']}, "
-          f"frames shown {status['frames_shown']}")
+          f"frames shown {status['frames_shown']}, pulses late {status['pulses_late']}, row loads that waited "
+          f"for the store {status['row_underruns']}")
     print(f"grey error of the reconstructed images: max {max(f['max_error_lsb'] for f in shown):g} LSB "
           f"({sum(f['wrong_pixels'] for f in shown)} pixels wrong)")
     print(f"simulation speed: {r['dmd_cycles'] / r['sim_wall_s']:.0f} dmd cycles per wall second "

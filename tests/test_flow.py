@@ -40,8 +40,10 @@ def test_lint_reports_real_errors(tmp_path):
 
 def test_cell_counting():
     cells = {"LUT6": 10, "LUT2": 3, "LUT6_2": 1, "RAM32M": 2, "SRLC32E": 1, "FDRE": 40, "FDCE": 2,
-             "RAMB16BWER": 2, "RAMB8BWER": 3, "DSP48A1": 1, "CARRY4": 5, "IBUF": 9}
-    assert resources.count(cells) == {"lut": 10 + 3 + 1 + 8 + 1, "ff": 42, "bram18": 3.5, "dsp": 1}
+             "RAMB16BWER": 2, "RAMB8BWER": 3, "DSP48A1": 1, "CARRY4": 5, "IBUF": 9, "OSERDES2": 20,
+             "PLL_ADV": 2, "BUFPLL": 2}
+    assert resources.count(cells) == {"lut": 10 + 3 + 1 + 8 + 1, "ff": 42, "bram18": 3.5, "dsp": 1,
+                                      "oserdes2": 20, "pll": 2, "bufpll": 2}
 
 
 def test_serialiser_synthesises_to_its_registers():

@@ -6,7 +6,8 @@ clocking pulse of a group that is due (the lowest such group), else the next loa
 the ready load at the head (a row of an occupied block, ``row_period`` after the last row and
 with a whole row of beats buffered; or a clear of an empty block), if that group's settle time
 is over and no loaded group's pulse falls due before the operation would end; else nothing. A
-load whose row data has not arrived is counted as an underrun (one per decision that waits).
+load whose row data has not arrived is counted as an underrun (one per row that waits, however
+long).
 """
 
 from amaranth import Module, Mux, Signal
@@ -57,7 +58,7 @@ class Bus(wiring.Component):
     dvalid : Out(1); command : Out(Command); beat : Out(bits_per_dclk * beats)
         The registered pins of the row cycles.
     underruns : Out(COUNTER_BITS)
-        Decisions that waited for row data.
+        Row loads that waited for their data (one each, however long).
     """
 
     def __init__(self, dmd, *, beats=1):
@@ -126,8 +127,14 @@ class Bus(wiring.Component):
             do_clear.eq(can_load & ~self.imminent_clear & ~occupied),
         ]
         last_op = (cur_block == head.last) & (~occupied | (cur_row == rpb - 1))
+        # a row counts once however many cycles it waits for its data
+        waiting = Signal()
         with m.If(can_load & ~self.imminent & occupied & row_paced & ~self.row_ready):
-            m.d.sync += self.underruns.eq(self.underruns + 1)
+            m.d.sync += waiting.eq(1)
+            with m.If(~waiting):
+                m.d.sync += self.underruns.eq(self.underruns + 1)
+        with m.If(do_row):
+            m.d.sync += waiting.eq(0)
 
         with m.If(do_row | do_clear):
             with m.If(last_op):

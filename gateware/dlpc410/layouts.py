@@ -9,12 +9,11 @@ from amaranth.lib import data, stream
 from amaranth.utils import ceil_log2
 
 from ..registers import TIME_BITS
-from ..store.layouts import SLOT_BITS
+from ..store.layouts import COUNTER_BITS, SLOT_BITS
 from .interface import BlockMode, RowMode
 
 __all__ = ["group_bits", "block_bits", "load_job", "ready_load", "event", "Command", "Status", "COUNTER_BITS"]
 
-COUNTER_BITS = 16
 
 
 def group_bits(dmd):
@@ -58,7 +57,7 @@ class Status(data.Struct):
     ``triggers`` triggers obeyed; ``overruns`` triggers ignored because a frame was playing or
     the next one was not loaded yet; ``early`` triggers before initialisation ended; ``late``
     pulses made after their time (a parameter set the schedule model rejects); ``underruns``
-    bus decisions that waited for row data from the store; ``bad_frames`` frames offered with
+    row loads that waited for their data from the store (one each); ``bad_frames`` frames offered with
     a bit depth outside 1..8, dropped; ``held`` triggers held until every group was ready.
     """
     now: TIME_BITS

@@ -29,9 +29,12 @@ sequencer, so reading it from another clock domain is safe for every slot the se
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-__all__ = ["SLOT_BITS", "BLOCK_BITS", "PlaneRequest", "FrameInfo", "OccupancySignature"]
+__all__ = ["COUNTER_BITS", "SLOT_BITS", "BLOCK_BITS", "PlaneRequest", "FrameInfo", "OccupancySignature"]
 
 #: Frame slots are numbered in this many bits (16 slots; sequence mode spans slots).
+#: Width of every event counter: that of the status reply's fields, so that none wraps inside
+#: its field (at 65,536 a 16-bit count of frames shown wrapped after minutes).
+COUNTER_BITS = 32
 SLOT_BITS = 4
 #: DMD blocks are numbered in this many bits (16 blocks at most).
 BLOCK_BITS = 4

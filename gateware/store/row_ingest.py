@@ -19,7 +19,7 @@ from amaranth.utils import ceil_log2
 from gateware.bitplane.serialiser import row_flags_layout, word_layout
 
 from .addresses import PLANES
-from .layouts import BLOCK_BITS, SLOT_BITS
+from .layouts import BLOCK_BITS, COUNTER_BITS, SLOT_BITS
 from .slot_maps import RowLookupSignature, map_write_layout
 from .slot_table import Placement, PlacementSignature, opening_layout
 from .writer import write_word_layout
@@ -28,14 +28,15 @@ __all__ = ["RowIngest", "IngestCounters"]
 
 
 class IngestCounters(data.Struct):
-    """The ingest's counters (16 bits, wrapping); see :class:`~gateware.store.slots.SlotCounters`."""
-    frames_complete: 16
-    frames_abandoned: 16
-    rows_outside: 16
-    rows_stale: 16
-    rows_shown: 16
-    rows_duplicate: 16
-    rows_no_slot: 16
+    """The ingest's counters (``COUNTER_BITS`` wide, wrapping); see
+    :class:`~gateware.store.slots.SlotCounters`."""
+    frames_complete: COUNTER_BITS
+    frames_abandoned: COUNTER_BITS
+    rows_outside: COUNTER_BITS
+    rows_stale: COUNTER_BITS
+    rows_shown: COUNTER_BITS
+    rows_duplicate: COUNTER_BITS
+    rows_no_slot: COUNTER_BITS
 
 
 #: The placements that refuse a row, and the counter each one counts.

@@ -12,7 +12,7 @@ from amaranth import Array, Module, Signal
 from amaranth.lib import data, enum, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from .layouts import SLOT_BITS, FrameInfo
+from .layouts import COUNTER_BITS, SLOT_BITS, FrameInfo
 
 __all__ = ["SlotTable", "SlotState", "Placement", "PlacementSignature", "opening_layout", "TableCounters"]
 
@@ -76,9 +76,10 @@ def opening_layout(frame_bits):
 
 
 class TableCounters(data.Struct):
-    """The slot table's event counters (16 bits, wrapping); see :class:`~gateware.store.slots.SlotCounters`."""
-    frames_replaced: 16
-    bad_releases: 16
+    """The slot table's event counters (``COUNTER_BITS`` wide, wrapping); see
+    :class:`~gateware.store.slots.SlotCounters`."""
+    frames_replaced: COUNTER_BITS
+    bad_releases: COUNTER_BITS
 
 
 class SlotTable(wiring.Component):

@@ -38,7 +38,7 @@ from amaranth.lib import data, wiring
 from amaranth.lib.wiring import Out
 
 from ..compose import forward, members
-from .layouts import BLOCK_BITS, SLOT_BITS
+from .layouts import BLOCK_BITS, COUNTER_BITS, SLOT_BITS
 from .row_ingest import RowIngest
 from .slot_crossing import SlotCrossing
 from .slot_maps import SlotMaps
@@ -48,16 +48,16 @@ __all__ = ["FrameSlots", "SlotState", "SlotCounters"]
 
 
 class SlotCounters(data.Struct):
-    """Event counters (16 bits, wrapping)."""
-    frames_complete: 16     # every row arrived
-    frames_replaced: 16     # complete, freed unshown for a newer one (streaming)
-    frames_abandoned: 16    # receiving, interrupted by a newer frame before it was complete
-    rows_outside: 16        # row number beyond the frame: refused
-    rows_stale: 16          # frame id older than the frame receiving, or not in the sequence
-    rows_shown: 16          # frame id of a slot being shown: refused
-    rows_duplicate: 16      # row already received (overlapping records): refused
-    rows_no_slot: 16        # no slot free (the sequencer holds too many): refused
-    bad_releases: 16        # release of a slot that was not shown
+    """Event counters (``COUNTER_BITS`` wide, wrapping)."""
+    frames_complete: COUNTER_BITS     # every row arrived
+    frames_replaced: COUNTER_BITS     # complete, freed unshown for a newer one (streaming)
+    frames_abandoned: COUNTER_BITS    # receiving, interrupted by a newer frame before it was complete
+    rows_outside: COUNTER_BITS        # row number beyond the frame: refused
+    rows_stale: COUNTER_BITS          # frame id older than the frame receiving, or not in the sequence
+    rows_shown: COUNTER_BITS          # frame id of a slot being shown: refused
+    rows_duplicate: COUNTER_BITS      # row already received (overlapping records): refused
+    rows_no_slot: COUNTER_BITS        # no slot free (the sequencer holds too many): refused
+    bad_releases: COUNTER_BITS        # release of a slot that was not shown
 
 
 class FrameSlots(wiring.Component):
