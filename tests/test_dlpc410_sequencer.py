@@ -283,14 +283,15 @@ def test_stored_sequence_frames_wait_their_turn(test_name):
 
 
 @pytest.mark.verilog
-def test_sync_out_and_camera(test_name):
+@pytest.mark.parametrize("offset,width", [(100, 7), (0, 1)])     # (0, 1): the power-up values
+def test_sync_out_and_camera(offset, width, test_name):
     p = fast_plan().params
-    p.camera_offset, p.camera_width = 100, 7
+    p.camera_offset, p.camera_width = offset, width
     ready = next_ready(p, model_frames([(0, 8)], None), [])
     run, model = check(p, [(0, 8)], None, [ready], test_name)
     pulses = [t for t, k, _a in model.commands if k == "pulse"]
     assert run.sync_out == [(pulses[0], 1), (pulses[-1], 0)]
-    assert run.camera_out == [(pulses[0] + 1 + 100, 1), (pulses[0] + 1 + 107, 0)]
+    assert run.camera_out == [(pulses[0] + 1 + offset, 1), (pulses[0] + 1 + offset + width, 0)]
 
 
 @pytest.mark.verilog

@@ -40,5 +40,7 @@ class CameraTrigger(wiring.Component):
             m.d.sync += [at.eq(now + regs.camera_offset), armed.eq(1)]
         with m.Elif(armed & (diff(now, end) >= 0)):
             m.d.sync += armed.eq(0)
-        m.d.sync += self.out.eq(armed & (diff(now, at) >= 0) & (diff(now, end) < 0))
+        # an offset of 0 starts the pulse with the frame, before ``at`` is registered
+        starts_now = self.frame_start & (regs.camera_offset == 0) & (regs.camera_width != 0)
+        m.d.sync += self.out.eq(starts_now | (armed & (diff(now, at) >= 0) & (diff(now, end) < 0)))
         return m
