@@ -7,7 +7,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 JOBS   ?= 2
 
-.PHONY: setup test sim verilog resources bench waves lint clean
+.PHONY: setup test sim verilog resources formal bench waves lint clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -32,6 +32,10 @@ verilog: $(STAMP)
 # LUT/FF/BRAM/DSP per block and in total on XC6SLX45 (Yosys synth_xilinx -family xc6s).
 resources: $(STAMP)
 	$(PY) -m flow resources
+
+# Every formal property: k-induction proofs and deep bounded checks (SymbiYosys, Yices).
+formal: $(STAMP)
+	$(PY) -m flow formal
 
 # Every benchmark; writes build/bench.json and prints the figures.
 bench: $(STAMP)
