@@ -4,13 +4,14 @@ The top is :class:`gateware.store.Store` (frame slots, writer, reader) on a DMD 
 one word (:data:`DMD`; DMD block numbers of 2 bits while it is built), three slots and 2-bit
 frame ids, with its ``dmd`` side renamed into ``sync`` (one clock: the properties are about
 order, not clock ratios; the crossing's own stream rules are checked with free clocks in
-:mod:`sim.formal.blocks`). Everything at its boundary is free but for the stream rules and the
-serialiser's framing (the words of a row share its frame and row, their planes rise and plane 7
-ends the row; planes may be left out, which makes rows short and traces shallow; the pixel data
-are zero): the serialiser's words and row flags, the bit depth, the sequencer's asks and
-releases. The writer's MCB port is :class:`sim.formal.mcb.WritePortEnvelope`, whose
-``executed`` bursts are what reaches the memory. The mode is held: streaming
-(``sequence_length`` 0) or sequence (1 to 3, fixed).
+:mod:`sim.formal.blocks`). Everything at its boundary is free (the serialiser's words and row
+flags, the sequencer's asks and releases) but for the stream rules, a bit depth held from the
+start (any of 1 to 8), and the serialiser's framing: the words of a row share its frame and row,
+their planes rise, every stored plane is there and plane 7 ends the row (planes below the bit
+depth may be left out, which makes rows short and traces shallow; the pixel data are zero). The
+writer's MCB port is :class:`sim.formal.mcb.WritePortEnvelope`, whose ``executed`` bursts are
+what reaches the memory. The mode is held: streaming (``sequence_length`` 0) or sequence (1 to
+3, fixed).
 
 Properties (white box: the slot events are the parts' own ports):
 
@@ -29,7 +30,7 @@ Properties (white box: the slot events are the parts' own ports):
 import dataclasses
 from contextlib import contextmanager
 
-from amaranth import Array, DomainRenamer, Signal
+from amaranth import Array, DomainRenamer, Mux, Signal
 from amaranth.asserts import AnyConst
 from amaranth.hdl import Assert, Assume, Cover, Fragment
 from amaranth.lib import wiring
@@ -78,19 +79,28 @@ def _properties(store, mode):
         m.submodules.memory = port = WritePortEnvelope()
         wiring.connect(m, top.dut.mcb_write, port.port)
 
-        # -- the serialiser's framing: the words of a row share its frame and row, their planes
-        # rise, plane 7 ends the row (planes may be missing: the store writes what it is given)
+        # -- the bit depth, held; the serialiser's framing: the words of a row share its frame
+        # and row, their planes rise, every stored plane (from 8 - depth) is there and plane 7
+        # ends the row (planes below the depth may be left out: short rows, shallow traces)
+        depth = AnyConst(4)
+        m.d.comb += [Assume((depth != 0) & (depth <= PLANES)), Assume(store.bit_depth == depth)]
+        lowest = PLANES - depth
         words = top.dut.words
-        last = Signal.like(words.payload.as_value())
+        head = words.payload
+        last = Signal.like(head.as_value())
         in_row = Signal()
         with m.If(words.valid & words.ready):
-            m.d.sync += [last.eq(words.payload.as_value()), in_row.eq(words.payload.plane != PLANES - 1)]
-        previous = words.payload.shape()(last)
+            m.d.sync += [last.eq(head.as_value()), in_row.eq(head.plane != PLANES - 1)]
+        previous = head.shape()(last)
         # the pixels themselves play no part in where words go: zero, for a lighter model
-        m.d.comb += [Assume(words.payload.word == 0), Assume(words.payload.data == 0)]
-        with m.If(in_row & words.valid):
-            m.d.comb += Assume((words.payload.frame == previous.frame) & (words.payload.row == previous.row)
-                               & (words.payload.plane > previous.plane))
+        m.d.comb += [Assume(head.word == 0), Assume(head.data == 0)]
+        with m.If(words.valid & ~in_row):
+            m.d.comb += Assume(head.plane <= lowest)
+        with m.If(words.valid & in_row):
+            following = previous.plane + 1
+            m.d.comb += Assume((head.frame == previous.frame) & (head.row == previous.row)
+                               & (head.plane > previous.plane)
+                               & (head.plane <= Mux(following < lowest, lowest, following)))
 
         # -- the mode, held
         if mode == "streaming":
