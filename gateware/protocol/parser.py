@@ -16,6 +16,7 @@ from amaranth.utils import ceil_log2, exact_log2
 
 from spec import records, wire
 from spec.records import RecordType
+from spec.schedule import row_cycles
 
 from ..net.layouts import OFFSET_BITS, Datagram, Peer
 from ..registers import Registers, wire_registers
@@ -51,6 +52,8 @@ class Parser(wiring.Component):
     ----------
     dmd : :class:`spec.facts.DmdType`
         Rows and columns that image records must fit.
+    beats : int
+        DCLK beats per ``dmd`` cycle the sequencer is built for (its shortest ``row_period``).
     config : dict
         Initial configuration (:func:`config_init`).
     frame_bits : int
@@ -75,8 +78,8 @@ class Parser(wiring.Component):
         Records accepted per type, dropped per cause, sequence gaps, rows and bytes handed on.
     """
 
-    def __init__(self, dmd, config, *, frame_bits=4):
-        self._dmd = dmd
+    def __init__(self, dmd, config, *, frame_bits=4, beats=1):
+        self._dmd, self._beats = dmd, beats
         self._frame_bits = frame_bits
         super().__init__({
             "datagrams": In(stream.Signature(Datagram)),
@@ -165,7 +168,7 @@ class Parser(wiring.Component):
                        | (applies("sequence_length") & (control.sequence_length == 0)))):
             m.d.comb += cause.eq(1 + causes.index("value"))
         with m.Elif((header.type == RecordType.SEQUENCER)
-                    & Cat(records.register_faults(sequencer, dmd.dclk_per_row).values()).any()):
+                    & Cat(records.register_faults(sequencer, row_cycles(dmd, self._beats)).values()).any()):
             m.d.comb += cause.eq(1 + causes.index("value"))
 
         sequence_seen = Signal()
