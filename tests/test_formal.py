@@ -9,7 +9,7 @@ from amaranth import Module, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from sim.formal import blocks, store
+from sim.formal import blocks, sequencer, store
 from sim.formal.harness import Check, FormalFailure, FormalTop, run
 from sim.formal.streams import ready_paths, stream_rules
 from sim.harness.paths import build_dir
@@ -94,7 +94,29 @@ def test_ready_paths():
     *[c for c in store.store_checks()],
 ], ids=lambda c: c.key)
 def test_checks_quick(check):
-    depth = check.quick if check.block != "Store" else 16
     result = run(dataclasses.replace(check, induction=check.induction if check.block == "Queue" else None),
-                 depth=depth)
+                 depth=check.quick)
     assert result.status in ("proven", "checked")
+
+
+class Through(wiring.Component):
+    """A synchroniser without its flip-flops: the sequencer then sees the pins a cycle early."""
+
+    def __init__(self, i, o, **kwargs):
+        self._i, self._o = i, o
+        super().__init__({})
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.comb += self._o.eq(self._i)
+        return m
+
+
+def test_sequencer_init_rule(monkeypatch):
+    from gateware.dlpc410 import init
+    check, = sequencer.sequencer_checks()
+    assert run(check).status == "proven"
+    monkeypatch.setattr(init, "FFSynchronizer", Through)
+    with pytest.raises(FormalFailure) as failure:
+        run(dataclasses.replace(check, block="Sequencer-unsynchronised"))
+    assert "running before the controller was ready" in failure.value.result.failed

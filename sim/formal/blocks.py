@@ -11,6 +11,7 @@ domain are checked with free, unrelated clocks (a free enable per domain, see
 definition; :func:`register_crossing_check` that the sequencer's registers change only at rest.
 """
 
+import dataclasses
 from dataclasses import dataclass, field
 
 from amaranth import Signal
@@ -110,8 +111,15 @@ def _writer():
 
 
 def _reader():
+    # the product's 128-bit port, two plane words a transfer: rows of two words
     from gateware.store.reader import Reader
-    return Reader(FORMAL_DMD, slots=3, fifo_depth=64, domain="sync")
+    dmd = dataclasses.replace(FORMAL_DMD, columns=128, visible_columns=128)
+    return Reader(dmd, slots=3, fifo_depth=128, domain="sync", width=128)
+
+
+def _split():
+    from gateware.store.split import Split
+    return Split(8, 2)
 
 
 def _broker():
@@ -154,6 +162,7 @@ STREAM_BLOCKS = [
                 port_domains={"ask": "dmd", "release": "dmd", "frames": "dmd"}),
     StreamBlock("Writer", _writer, depth=24, induction=6),
     StreamBlock("Reader", _reader, depth=24, induction=6),
+    StreamBlock("Split", _split, depth=16, induction=2),
     StreamBlock("FrameBroker", _broker, depth=24, induction=6),
     # the slot table answers only for the slots its ingest opened and completed: its streams are
     # checked inside the frame slots, with every part's

@@ -36,7 +36,6 @@ from amaranth.hdl import Assert, Assume, Cover, Fragment
 from amaranth.lib import wiring
 
 from gateware.store.addresses import PLANES, AddressMap
-from gateware.store.mcb import WORD_BYTES
 
 from .geometry import FORMAL_DMD
 from .harness import Check, FormalTop
@@ -111,7 +110,7 @@ def _properties(store, mode):
 
         # -- events
         burst = port.executed
-        first, end = burst.addr, burst.addr + burst.words * WORD_BYTES
+        first, end = burst.addr, burst.addr + burst.words * top.dut.mcb_write.signature.word_bytes
         opened = ingest.opened
         admitted = ingest.store.valid & ingest.store.ready
         word = ingest.store.payload
@@ -182,7 +181,7 @@ def _properties(store, mode):
 def _top(mode):
     from gateware.store.store import Store
     with _short_blocks():
-        store = Store(DMD, slots=SLOTS, frame_bits=2, fifo_depth=64)
+        store = Store(DMD, slots=SLOTS, frame_bits=2, fifo_depth=64, read_width=64)
         top = FormalTop(DomainRenamer({"dmd": "sync"})(store), [stream_rules(), _properties(store, mode)],
                         driven=("mcb_write",))
         return Fragment.get(top, None)
@@ -191,4 +190,4 @@ def _top(mode):
 def store_checks():
     return [Check(f"store writes and frames given ({mode})", "Store", lambda mode=mode: _top(mode),
                   depth=depth, quick=quick)
-            for mode, depth, quick in (("streaming", 120, 30), ("sequence", 120, 30))]
+            for mode, depth, quick in (("streaming", 30, 16), ("sequence", 30, 16))]

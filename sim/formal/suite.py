@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 from sim.harness.paths import build_dir, slug
 
-from . import blocks, store
+from . import blocks, sequencer, store
 from .harness import run
 from .streams import ready_paths
 
@@ -20,7 +20,7 @@ __all__ = ["checks", "Row", "run_all", "figures"]
 
 
 def checks():
-    return [*blocks.checks(), *store.store_checks()]
+    return [*blocks.checks(), *store.store_checks(), *sequencer.sequencer_checks()]
 
 
 @dataclass
