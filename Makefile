@@ -7,7 +7,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 JOBS   ?= 2
 
-.PHONY: setup test sim verilog resources timing bench waves lint clean
+.PHONY: setup test sim verilog resources timing formal bench waves lint clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -37,6 +37,10 @@ resources: $(STAMP)
 # Logic depth (LUT levels, carry chains) between flip-flops per clock domain of the core.
 timing: $(STAMP)
 	$(PY) -m flow timing
+
+# Every formal property: k-induction proofs and deep bounded checks (SymbiYosys, Yices).
+formal: $(STAMP)
+	$(PY) -m flow formal
 
 # Every benchmark; writes build/bench.json and prints the figures.
 bench: $(STAMP)

@@ -1,4 +1,4 @@
-"""Command line: ``python -m flow <verilog|resources|timing|bench|sim|waves>``."""
+"""Command line: ``python -m flow <verilog|resources|timing|formal|bench|sim|waves>``."""
 
 import argparse
 import sys
@@ -12,6 +12,9 @@ def main(argv=None):
     sub.add_parser("verilog", help="write the Spartan-6 ISE tree and every block's Verilog to build/spartan6")
     sub.add_parser("resources", help="Yosys synth_xilinx -family xc6s: LUT/FF/BRAM/DSP per block and in total")
     sub.add_parser("timing", help="logic depth between flip-flops per clock domain (Yosys, xc6s)")
+    formal = sub.add_parser("formal", help="prove or check every formal property (SymbiYosys)")
+    formal.add_argument("--quick", action="store_true", help="BMC to the test suite's depths, no proofs")
+    formal.add_argument("--only", action="append", help="only this block (repeatable)")
     bench = sub.add_parser("bench", help="run the benchmarks and write build/bench.json")
     bench.add_argument("--only", action="append", help="run only this benchmark module (repeatable)")
     bench.add_argument("--no-resources", action="store_true", help="skip the synthesis figures")
@@ -30,6 +33,9 @@ def main(argv=None):
     if args.command == "timing":
         from flow.timing import main as run
         return run()
+    if args.command == "formal":
+        from flow.formal import main as run
+        return run(quick=args.quick, only=args.only)
     if args.command == "bench":
         from flow.bench import main as run
         return run(args.only, resources=not args.no_resources)

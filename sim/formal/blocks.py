@@ -1,0 +1,259 @@
+"""The stream rules on every block with stream ports, and the properties of the small blocks.
+
+Each entry of :data:`STREAM_BLOCKS` builds one block with small parameters (depths, geometry,
+counter widths: the rules do not depend on them) and says which domain each top-level port
+lives in; :func:`stream_checks` makes a :class:`~sim.formal.harness.Check` of each: the rules
+assumed of the block's input streams and asserted of its output streams. Blocks in more than one
+domain are checked with free, unrelated clocks (a free enable per domain, see
+:mod:`sim.formal.harness`).
+
+:func:`countdown_check` checks :class:`gateware.countdown.Countdown`'s flags against their
+definition; :func:`register_crossing_check` that the sequencer's registers change only at rest.
+"""
+
+import dataclasses
+from dataclasses import dataclass, field
+
+from amaranth import Signal
+from amaranth.hdl import Assert, Fragment
+
+from .geometry import FORMAL_DMD
+from .harness import Check, FormalTop
+from .streams import stream_rules
+
+__all__ = ["STREAM_BLOCKS", "stream_checks", "countdown_check", "register_crossing_check", "checks"]
+
+_ADDRESSES = {"mac": 0x02_00_00_00_00_01, "ip": 0xC0_A8_01_0A, "port": 5000}
+
+
+@dataclass(frozen=True)
+class StreamBlock:
+    """A block to check the stream rules on: ``make()`` builds it; ``port_domains`` maps its
+    ports to domains (default ``sync``); ``depth``/``induction`` as in :class:`Check`."""
+    name: str
+    make: object
+    depth: int
+    induction: int | None = None
+    domains: tuple = ("sync",)
+    port_domains: dict = field(default_factory=dict)
+    quick: int = 8
+    parts: object = None
+
+
+def _queue():
+    from gateware.queue import Queue
+    return Queue(8, 4)
+
+
+def _async_queue():
+    from gateware.queue import AsyncQueue
+    return AsyncQueue(8, 4, w_domain="sync", r_domain="dmd")
+
+
+def _rx_crossing():
+    from gateware.mac.cdc import RxCrossing
+    return RxCrossing(depth=8, max_frame=64, counter_width=4)
+
+
+def _tx_crossing():
+    from gateware.mac.cdc import TxCrossing
+    return TxCrossing(depth=8)
+
+
+def _receive_path():
+    from gateware.mac.path import ReceivePath
+    return ReceivePath(max_frame=64, depth=8, counter_width=4)
+
+
+def _frame_buffer():
+    from gateware.net.buffer import FrameBuffer
+    return FrameBuffer(16)
+
+
+def _net_transmitter():
+    from gateware.net.transmit import Transmitter
+    return Transmitter(sources=2)
+
+
+def _stack():
+    from gateware.net.stack import Stack
+    return Stack(buffer_depth=64, descriptors=2)
+
+
+def _parser():
+    from gateware.protocol.parser import Parser, config_init
+    return Parser(FORMAL_DMD, config_init(**_ADDRESSES), frame_bits=2)
+
+
+def _status_reply():
+    from gateware.protocol.status import StatusReply
+    return StatusReply()
+
+
+def _serialiser():
+    from gateware.bitplane.serialiser import Serialiser
+    return Serialiser(FORMAL_DMD, lanes=8, frame_bits=2)
+
+
+def _row_ingest():
+    from gateware.store.row_ingest import RowIngest
+    return RowIngest(FORMAL_DMD, slots=3, frame_bits=2)
+
+
+def _slot_crossing():
+    from gateware.store.slot_crossing import SlotCrossing
+    return SlotCrossing(depth=2)
+
+
+def _writer():
+    from gateware.store.writer import Writer
+    return Writer(FORMAL_DMD, slots=3, max_burst=2)
+
+
+def _reader():
+    # the product's 128-bit port, two plane words a transfer: rows of two words
+    from gateware.store.reader import Reader
+    dmd = dataclasses.replace(FORMAL_DMD, columns=128, visible_columns=128)
+    return Reader(dmd, slots=3, fifo_depth=128, domain="sync", width=128)
+
+
+def _split():
+    from gateware.store.split import Split
+    return Split(8, 2)
+
+
+def _broker():
+    from gateware.store.broker import FrameBroker
+    return FrameBroker(FORMAL_DMD, slots=3)
+
+
+def _frame_slots():
+    from gateware.store.slots import FrameSlots
+    return FrameSlots(FORMAL_DMD, slots=3, frame_bits=2)
+
+
+_SLOTS_DMD = {"ask": "dmd", "frames": "dmd", "release": "dmd", "occupancy": "dmd"}
+
+
+def _slot_parts(slots):
+    """The parts of :class:`~gateware.store.slots.FrameSlots` and their ports' domains."""
+    return [(name, part, _SLOTS_DMD if name in ("crossing", "maps") else {})
+            for name, part in slots._parts.items()]
+
+#: Every block with stream ports (the sequencer's parts are checked with the sequencer).
+STREAM_BLOCKS = [
+    StreamBlock("Queue", _queue, depth=24, induction=6),
+    StreamBlock("AsyncQueue", _async_queue, depth=40, domains=("sync", "dmd"),
+                port_domains={"r_stream": "dmd"}),
+    StreamBlock("RxCrossing", _rx_crossing, depth=40, domains=("gmii_rx", "sync"),
+                port_domains={"i": "gmii_rx", "dropped": "gmii_rx"}),
+    StreamBlock("TxCrossing", _tx_crossing, depth=40, domains=("sync", "gmii_tx"),
+                port_domains={"o": "gmii_tx"}),
+    StreamBlock("ReceivePath", _receive_path, depth=30, domains=("gmii_rx", "sync"),
+                port_domains={"gmii": "gmii_rx"}),
+    StreamBlock("FrameBuffer", _frame_buffer, depth=24, induction=4),
+    StreamBlock("Transmitter", _net_transmitter, depth=24, induction=4),
+    StreamBlock("Stack", _stack, depth=16),
+    StreamBlock("Parser", _parser, depth=20, induction=4),
+    StreamBlock("StatusReply", _status_reply, depth=20, induction=4),
+    StreamBlock("Serialiser", _serialiser, depth=24, induction=4),
+    StreamBlock("RowIngest", _row_ingest, depth=24, induction=4),
+    StreamBlock("SlotCrossing", _slot_crossing, depth=40, domains=("dmd", "sync"),
+                port_domains={"ask": "dmd", "release": "dmd", "frames": "dmd"}),
+    StreamBlock("Writer", _writer, depth=24, induction=6),
+    StreamBlock("Reader", _reader, depth=24, induction=6),
+    StreamBlock("Split", _split, depth=16, induction=2),
+    StreamBlock("FrameBroker", _broker, depth=24, induction=6),
+    # the slot table answers only for the slots its ingest opened and completed: its streams are
+    # checked inside the frame slots, with every part's
+    StreamBlock("FrameSlots", _frame_slots, depth=30, domains=("sync", "dmd"), port_domains=_SLOTS_DMD,
+                parts=_slot_parts),
+]
+
+
+def _top(block):
+    dut = block.make()
+    parts = block.parts(dut) if block.parts else ()
+    return FormalTop(dut, [stream_rules(parts=parts)], domains=block.domains, port_domains=block.port_domains)
+
+
+def stream_checks():
+    return [Check("stream rules", block.name, lambda block=block: _top(block), depth=block.depth,
+                  induction=block.induction, quick=block.quick)
+            for block in STREAM_BLOCKS]
+
+
+# -- Countdown --------------------------------------------------------------------------------
+
+#: Limbs of 3 bits instead of 16 make every limb's borrow reachable in a few cycles; the limb
+#: logic is the same at any limb width.
+_LIMB = 3
+
+
+def _countdown_top(width=7, within=(2, 5)):
+    """Elaborated with short limbs: a reference count of the cycles since the load says what
+    each flag must be."""
+    from gateware import countdown
+    saved = countdown.LIMB_BITS
+    countdown.LIMB_BITS = _LIMB
+    try:
+        dut = countdown.Countdown(width, within=within)
+
+        def definition(m, top):
+            # t - c, the cycles since the load, saturating past the longest value
+            loaded = Signal()
+            value = Signal(width)
+            elapsed = Signal(width + 1)
+            with m.If(dut.load):
+                m.d.sync += [loaded.eq(1), value.eq(dut.value), elapsed.eq(1)]
+            with m.Elif(elapsed != 2**(width + 1) - 1):
+                m.d.sync += elapsed.eq(elapsed + 1)
+            # before any load the timer's time has come (it starts done)
+            with m.If(loaded):
+                m.d.comb += [
+                    Assert(dut.done == (elapsed >= value), "done is t >= T"),
+                    Assert(dut.late == (elapsed > value), "late is t > T"),
+                ]
+                for i, k in enumerate(within):
+                    m.d.comb += Assert(dut.within[i] == (value < elapsed + k), f"within[{i}] is T - t < {k}")
+            with m.Else():
+                m.d.comb += Assert(dut.done & dut.late & dut.within.all(), "a timer never loaded is late")
+
+        return Fragment.get(FormalTop(dut, [definition]), None)
+    finally:
+        countdown.LIMB_BITS = saved
+
+
+def countdown_check():
+    return Check("flags against their definition", "Countdown", _countdown_top, depth=2**7 + 8,
+                 induction=2**7 + 4, quick=24)
+
+
+# -- RegisterCrossing ---------------------------------------------------------------------------
+
+def _register_crossing_top():
+    from gateware.dlpc410.register_crossing import RegisterCrossing
+    dut = RegisterCrossing({}, depth=2)
+
+    def at_rest_only(m, top):
+        # the registers the sequencer runs with change only in a dmd cycle it rests in
+        before = Signal.like(dut.regs.as_value())
+        rested = Signal()
+        m.d.dmd += [before.eq(dut.regs.as_value()), rested.eq(dut.at_rest)]
+        started = Signal()
+        m.d.dmd += started.eq(1)
+        with m.If(started & ~rested):
+            m.d.comb += Assert(dut.regs.as_value() == before, "regs changed while the sequencer ran")
+
+    return FormalTop(dut, [stream_rules(), at_rest_only], domains=("sync", "dmd"),
+                     port_domains={"at_rest": "dmd", "regs": "dmd", "reload": "dmd", "applied": "dmd"})
+
+
+def register_crossing_check():
+    return Check("registers change only at rest; stream rules", "RegisterCrossing", _register_crossing_top,
+                 depth=40, quick=12)
+
+
+def checks():
+    """Every check of this module."""
+    return [*stream_checks(), countdown_check(), register_crossing_check()]

@@ -1,0 +1,122 @@
+"""Formal checks (SymbiYosys, Yices, from PyPI) within the suite's budget: the harness catches
+what it must, a proof closes, the store's properties and the frame slots' streams hold to a
+short depth. ``make formal`` runs every property at its full depth."""
+
+import dataclasses
+
+import pytest
+from amaranth import Module, Signal
+from amaranth.lib import stream, wiring
+from amaranth.lib.wiring import In, Out
+
+from sim.formal import blocks, sequencer, store
+from sim.formal.harness import Check, FormalFailure, FormalTop, run
+from sim.formal.streams import ready_paths, stream_rules
+from sim.harness.paths import build_dir
+
+
+class Dropper(wiring.Component):
+    """Offers a count every fourth cycle for one cycle, whether taken or not: breaks the rule."""
+    o: Out(stream.Signature(8))
+
+    def elaborate(self, platform):
+        m = Module()
+        count = Signal(8)
+        m.d.sync += count.eq(count + 1)
+        m.d.comb += [self.o.valid.eq(count[:2] == 3), self.o.payload.eq(count)]
+        return m
+
+
+class Register(wiring.Component):
+    """A one-place register slice; ``leak`` makes its output valid wait for ready."""
+    i: In(stream.Signature(8))
+    o: Out(stream.Signature(8))
+
+    def __init__(self, leak=False):
+        self._leak = leak
+        super().__init__()
+
+    def elaborate(self, platform):
+        m = Module()
+        full = Signal()
+        m.d.comb += [self.o.valid.eq(full & (self.o.ready if self._leak else 1)),
+                     self.i.ready.eq(~full | self.o.ready)]
+        with m.If(self.i.valid & self.i.ready):
+            m.d.sync += [self.o.payload.eq(self.i.payload), full.eq(1)]
+        with m.Elif(self.o.ready):
+            m.d.sync += full.eq(0)
+        return m
+
+
+def _check(name, make, **kwargs):
+    return Check("stream rules", name, lambda: FormalTop(make(), [stream_rules()]), **kwargs)
+
+
+def test_broken_stream_fails_with_a_counterexample():
+    with pytest.raises(FormalFailure) as failure:
+        run(_check("Dropper", Dropper, depth=10))
+    result = failure.value.result
+    assert "o: valid fell before the transfer" in result.failed
+    assert result.vcd is not None and result.vcd.exists()
+
+
+def test_register_slice_is_proven():
+    result = run(_check("Register", Register, depth=10, induction=2))
+    assert result.status == "proven" and result.depth == 2
+
+
+class Wire(wiring.Component):
+    """Input to output, combinationally: it keeps the rules exactly when its producer does."""
+    i: In(stream.Signature(8))
+    o: Out(stream.Signature(8))
+
+    def elaborate(self, platform):
+        m = Module()
+        wiring.connect(m, wiring.flipped(self.i), wiring.flipped(self.o))
+        return m
+
+
+def test_input_rules_are_assumed():
+    assert run(_check("Wire", Wire, depth=6, induction=1)).status == "proven"
+    free_input = Check("stream rules", "Wire-free-input",
+                       lambda: FormalTop(Wire(), [stream_rules(exclude=("i",))]), depth=6)
+    with pytest.raises(FormalFailure):
+        run(free_input)
+
+
+def test_ready_paths():
+    assert ready_paths(Register(), build_dir("formal", "test-ready-good")) == {}
+    assert ready_paths(Register(leak=True), build_dir("formal", "test-ready-leak")) == {"o__valid": ["o__ready"]}
+
+
+@pytest.mark.parametrize("check", [
+    *[c for c in blocks.checks() if c.block in ("Queue", "Countdown")],
+    *[c for c in store.store_checks()],
+], ids=lambda c: c.key)
+def test_checks_quick(check):
+    result = run(dataclasses.replace(check, induction=check.induction if check.block == "Queue" else None),
+                 depth=check.quick)
+    assert result.status in ("proven", "checked")
+
+
+class Through(wiring.Component):
+    """A synchroniser without its flip-flops: the sequencer then sees the pins a cycle early."""
+
+    def __init__(self, i, o, **kwargs):
+        self._i, self._o = i, o
+        super().__init__({})
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.comb += self._o.eq(self._i)
+        return m
+
+
+def test_sequencer_init_rule(monkeypatch):
+    from gateware.dlpc410 import init
+    check, = sequencer.sequencer_checks()
+    assert run(check).status == "proven"
+    monkeypatch.setattr(init, "FFSynchronizer", Through)
+    with pytest.raises(FormalFailure) as failure:
+        run(dataclasses.replace(check, block="Sequencer-unsynchronised"))
+    assert "running before the controller was ready" in failure.value.result.failed
