@@ -1,9 +1,8 @@
 """The harnesses themselves: layouts round-trip, a failing cocotb test fails pytest, and runs of
 one build at the same time (pytest-xdist workers) each report their own result."""
 
-import threading
-
 import random
+import threading
 
 import pytest
 from amaranth import Module, signed
