@@ -8,6 +8,7 @@ each comes from a simulation or a synthesis run made by the benchmark itself.
 MODULES = [
     "sim.bench.bitplane",
     "sim.bench.dlpc410_model",
+    "sim.bench.host",
     "sim.bench.mac",
     "sim.bench.net",
     "sim.bench.store",
