@@ -24,3 +24,4 @@ def test_xga_frame_end_to_end():
     drops = {k: v for k, v in status.items() if k.startswith("drop") and k != "drop_udp_port" and v}
     assert not drops, drops
     assert status["triggers"] == 1 and status["trigger_overruns"] == 0
+    assert status["shown_frame"] == 0 and status["newest_frame"] == 0 and status["rows_incomplete"] == 0

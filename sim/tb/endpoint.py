@@ -140,7 +140,8 @@ async def mixed_traffic(dut):
     rng = random.Random(4)
     image = np.random.default_rng(2).integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8)
     model = Model(dmd, A.mac, A.ip, A.port)
-    good = [frames.udp(A, r) for r in codec.image_records(image, 6, rows=4)]
+    # records of 300 pixels: rows split across records
+    good = [frames.udp(A, r) for r in codec.image_records(image, 6, pixels=300)]
     bad = [builder(A, good[0][42:]) for builder, _ in frames.BAD_FRAMES.values()]
     traffic = [(raw, False) for raw in good]
     for raw in bad + [frames.arp_request(A), frames.icmp_echo(A, b"abc" * 9),
@@ -171,12 +172,12 @@ async def mixed_traffic(dut):
 
 @cocotb.test()
 async def line_rate(dut):
-    """Largest records back to back at GMII timing (24 idle cycles between frames): none lost."""
+    """Jumbo records back to back at GMII timing (24 idle cycles between frames): none lost."""
     await reset(dut)
     dmd = DMDS[params()["dmd"]]
     image = np.random.default_rng(3).integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8)
     before, _ = counters(dut)
-    encoded = codec.image_records(image, 1)
+    encoded = codec.image_records(image, 1, limit=records.MAX_RECORD)
     source = StreamSource(dut, "rx", ByteBeat, dut.clk)
     pixels = StreamSink(dut, "pixels", pixel_layout(dmd), dut.clk)
     TxCollector(dut, stall=0.0, seed=5)
