@@ -21,9 +21,10 @@ setup: $(STAMP)
 test: $(STAMP)
 	$(PY) -m pytest -n $(JOBS) -q
 
-# The main job: the system simulation on the default scene.
+# The main job: the system simulation on the default scene (DCLK 400 MHz; DCLK=200 for 200 MHz).
+DCLK ?= 400
 sim: $(STAMP)
-	$(PY) -m flow sim
+	$(PY) -m flow sim --dclk $(DCLK)
 
 # The Spartan-6 ISE tree (Verilog, UCF, ISE scripts) and each block's Verilog, in build/spartan6.
 verilog: $(STAMP)

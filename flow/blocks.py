@@ -52,6 +52,11 @@ def _reader():
     return Reader(DMDS["dlp7000"], slots=4)
 
 
+def _read_widener():
+    from gateware.platform.read_widener import ReadWidener
+    return ReadWidener()
+
+
 def _sequencer(dmd="dlp7000"):
     from gateware.dlpc410.sequencer import Sequencer
     return Sequencer(DMDS[dmd])
@@ -76,14 +81,14 @@ BLOCKS = {
     "frame_slots": _frame_slots,
     "writer": _writer,
     "reader": _reader,
+    "read_widener": _read_widener,
     "sequencer": _sequencer,
     "sequencer_dlp9500": lambda: _sequencer("dlp9500"),
     "register_crossing": _register_crossing,
 }
 
 
-def core(dmd="dlp7000"):
+def core(dmd="dlp7000", dclk_hz=400e6):
     """The projector's core as the board builds it (:func:`gateware.top.platform.core`)."""
-    from gateware.platform.clocks import Spartan6Clocks
     from gateware.top.platform import core as board_core
-    return board_core(DMDS[dmd], Spartan6Clocks.frequencies())
+    return board_core(DMDS[dmd], dclk_hz)

@@ -16,7 +16,8 @@ def main(argv=None):
     bench.add_argument("--only", action="append", help="run only this benchmark module (repeatable)")
     bench.add_argument("--no-resources", action="store_true", help="skip the synthesis figures")
     sim = sub.add_parser("sim", help="the system simulation on the default scene")
-    sim.add_argument("--frames", type=int, default=None, help="number of frames to stream")
+    sim.add_argument("--frames", type=int, default=None, help="number of frames to store and show")
+    sim.add_argument("--dclk", type=float, default=400, choices=(200, 400), help="DCLK in MHz (default 400)")
     sub.add_parser("waves", help="say where the latest VCD and its GTKWave save file are")
     args = parser.parse_args(argv)
 
@@ -34,7 +35,7 @@ def main(argv=None):
         return run(args.only, resources=not args.no_resources)
     if args.command == "sim":
         from sim.system import main as run
-        return run(frames=args.frames)
+        return run(frames=args.frames, dclk_hz=args.dclk * 1e6)
     if args.command == "waves":
         from sim.harness.waves import main as run
         return run()

@@ -271,7 +271,8 @@ class Client:
     def configure(self, plan, dmd):
         """Send the register set of a :func:`spec.schedule.plan` (checked as the
         projector checks it); the sequencer takes it when no frame is playing."""
-        self._send(codec.sequencer_record(plan.params.registers(dmd), self._next(), dmd=dmd))
+        self._send(codec.sequencer_record(plan.params.registers(dmd), self._next(), dmd=dmd,
+                                          beats=plan.params.beats))
 
     def status(self, retries=2):
         """Ask for a status reply and return its fields as a dict."""

@@ -4,6 +4,7 @@ import numpy as np
 
 from spec import records, wire
 from spec.records import Action, RecordType
+from spec.schedule import row_cycles
 
 __all__ = ["ProtocolError", "header", "image_record", "image_records", "sequence_records", "pixels_per_record",
            "control_record", "sequencer_record", "status_query", "status_reply", "decode", "SEQUENCE_MASK",
@@ -73,7 +74,7 @@ def control_record(sequence=0, *, software_trigger=False, **config):
     return header(RecordType.CONTROL, sequence) + body
 
 
-def sequencer_record(registers, sequence=0, *, dmd=None):
+def sequencer_record(registers, sequence=0, *, dmd=None, beats=1):
     """A sequencer record carrying a whole register set: ``registers`` as
     :meth:`spec.schedule.Params.registers` gives it (from
     :func:`spec.schedule.plan`), or already as wire values (ints).
@@ -85,7 +86,7 @@ def sequencer_record(registers, sequence=0, *, dmd=None):
     fields = registers if all(isinstance(registers.get(n), int) for n in names) \
         else records.register_wire(registers)
     if dmd is not None:
-        failed = [check for check, bad in records.register_faults(fields, dmd.dclk_per_row).items() if bad]
+        failed = [check for check, bad in records.register_faults(fields, row_cycles(dmd, beats)).items() if bad]
         if failed:
             raise ValueError(f"the sequencer cannot obey this register set: {', '.join(failed)}")
     body = wire.pack(records.SEQUENCER, fields)

@@ -21,7 +21,7 @@ an evaluation, and three 125 MHz clocks apart would cost three (the small-geomet
 
 import math
 
-from amaranth import Cat, ClockDomain, ClockSignal, Const, Instance, Module, ResetSignal, Signal, Value
+from amaranth import Cat, ClockDomain, ClockSignal, Const, Instance, Module, ResetSignal, Shape, Signal, Value
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -34,7 +34,7 @@ from sim.models.dlpc410_replay import Replay
 from sim.models.mcb import McbTiming
 
 __all__ = ["FastSystem", "ResponderBench", "dlpc410_side", "power_on_reset", "pin_layout", "SOURCES", "PLUSARGS",
-           "read_rate"]
+           "read_rate", "INGEST_BYTES_PER_S"]
 
 #: The Verilog models the top instantiates.
 SOURCES = [ROOT / "sim" / "hdl" / name for name in
@@ -48,16 +48,18 @@ ECP2_CYCLES = 4
 #: Cycles each domain stays in reset after its clock starts.
 RESET_CYCLES = 4
 
-#: GMII line rate in 64-bit words per second (the store's write traffic at most).
-_INGEST_WORDS_PER_S = 125e6 / 8
+#: GMII line rate in bytes per second: the store's write traffic at most (a pixel byte makes a
+#: byte of bit-planes).
+INGEST_BYTES_PER_S = 125e6
 
 
-def pin_layout(buses):
-    """One record of the DLPC410 pin trace: the pins the model reads, the controller's outputs
-    the responder drove, and the trigger, sync and camera pins."""
+def pin_layout(buses, beats=1):
+    """One record of the DLPC410 pin trace: the pins the model reads (data and DVALID on every
+    DCLK edge of the cycle), the controller's outputs the responder drove, and the trigger, sync
+    and camera pins."""
     return data.StructLayout({
-        **{f"din_{b}": 32 for b in "abcd"[:buses]},
-        "dvalid": 1, "rowmd": 2, "rowad": 11, "blkmd": 2, "blkad": 4, "rst2blkz": 1, "comp_data": 1,
+        **{f"din_{b}": 32 * beats for b in "abcd"[:buses]},
+        "dvalid": 2 * beats, "rowmd": 2, "rowad": 11, "blkmd": 2, "blkad": 4, "rst2blkz": 1, "comp_data": 1,
         "ns_flip": 1, "wdt_enblz": 1, "pwr_float": 1, "arstz": 1,
         "init_active": 1, "rst_active": 1, "ecp2_finished": 1,
         "trigger_in": 1, "sync_out": 1, "camera_out": 1,
@@ -65,9 +67,12 @@ def pin_layout(buses):
 
 
 def read_rate(timing, dmd_hz):
-    """Words per ``dmd`` cycle the plane reader can count on: the DDR2's sustained bandwidth
-    (refresh taken off) less the store's writes (at most the GMII line rate)."""
-    return (timing.sustained_bytes_per_s / 8 - _INGEST_WORDS_PER_S) / dmd_hz
+    """64-bit words per ``dmd`` cycle the plane reader can count on: the DDR2's sustained
+    bandwidth (refresh taken off) less the store's writes at the GMII line rate. The memory
+    model gives the reader this much under that ingest (``store.read_words_per_dmd_cycle_with_
+    ingest``, :mod:`sim.bench.store`; a test holds the two together). On the Atlys (DDR2-800 x16,
+    1.6 GB/s peak) it is under one word a cycle at 200 MHz whatever the port's width."""
+    return (timing.sustained_bytes_per_s - INGEST_BYTES_PER_S) / 8 / dmd_hz
 
 
 def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cycles, flush,
@@ -77,20 +82,22 @@ def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cyc
     controller's outputs (its cycle counts: ints, or signals set at run time), the recorder writes
     the pins and ``extra`` (``{field: signal}`` of ``layout``'s other fields; default layout
     :func:`pin_layout`) to the file of plusarg ``PLUSARGS["pins"]``, on every cycle with DVALID
-    or ``always`` high and every cycle something changed."""
+    or ``always`` high and every cycle something changed. The interface's ``beats`` (DCLK cycles
+    per cycle) set the row cycle's length in cycles and the trace's widths."""
+    beats = dlpc.signature.beats
     rst_active, init_active, ecp2 = Signal(), Signal(), Signal()
     timing = {name: Value.cast(Const(value, 32) if isinstance(value, int) else value)
               for name, value in (("rst_active_cycles", rst_active_cycles), ("init_cycles", init_cycles),
                                   ("init_grace_cycles", init_grace_cycles), ("ecp2_cycles", ecp2_cycles))}
     m.submodules.responder = Instance(
         "dlpc410_responder",
-        p_DCLK_PER_ROW=dmd.dclk_per_row, **{f"i_{name}": value for name, value in timing.items()},
-        i_clk=ClockSignal(domain), i_rst=ResetSignal(domain), i_arstz=dlpc.arstz, i_dvalid=dlpc.dvalid,
+        p_CYCLES_PER_ROW=dmd.dclk_per_row // beats, **{f"i_{name}": value for name, value in timing.items()},
+        i_clk=ClockSignal(domain), i_rst=ResetSignal(domain), i_arstz=dlpc.arstz, i_dvalid=dlpc.dvalid[0],
         i_blkmd=dlpc.blkmd,
         o_init_active=init_active, o_rst_active=rst_active, o_ecp2_finished=ecp2)
     m.d.comb += [dlpc.rst_active.eq(rst_active), dlpc.init_active.eq(init_active),
                  dlpc.ecp2_finished.eq(ecp2), dlpc.dmd_type.eq(dmd.dmd_type_code or 0)]
-    layout = pin_layout(dmd.buses) if layout is None else layout
+    layout = pin_layout(dmd.buses, beats) if layout is None else layout
     pins = Signal(layout)
     for name, _ in layout:
         if hasattr(dlpc, name):
@@ -100,7 +107,7 @@ def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cyc
     m.submodules.pin_trace = Instance(
         "trace_recorder", p_WIDTH=len(pins.as_value()), p_PLUSARG=PLUSARGS["pins"],
         i_clk=ClockSignal(domain), i_rst=ResetSignal(domain), i_value=pins.as_value(),
-        i_always_record=dlpc.dvalid if always is None else dlpc.dvalid | always, i_flush=flush)
+        i_always_record=dlpc.dvalid.any() if always is None else dlpc.dvalid.any() | always, i_flush=flush)
 
 
 def power_on_reset(m, domain, clock):
@@ -162,6 +169,8 @@ class FastSystem(wiring.Component):
         64-bit words of memory.
     timing : McbTiming, optional
         DDR2 timing (default :class:`sim.models.mcb.McbTiming`, the Python model's).
+    beats : int
+        DCLK cycles per ``dmd`` cycle (2: DCLK 400 MHz).
 
     Members
     -------
@@ -179,8 +188,8 @@ class FastSystem(wiring.Component):
     """
 
     def __init__(self, dmd, registers, *, mac, ip, port, clocks, init_cycles=200, init_grace_cycles=4,
-                 memory_words=1 << 21, timing=None):
-        self._dmd = dmd
+                 memory_words=1 << 21, timing=None, beats=1):
+        self._dmd, self._beats = dmd, beats
         self._registers = registers
         self._addresses = dict(mac=mac, ip=ip, port=port)
         self._clocks = clocks
@@ -206,13 +215,20 @@ class FastSystem(wiring.Component):
 
         ports = [core.mcb_write, core.mcb_read]
         connections = {}
-        for name, member in mcb.PortSignature().members.items():
-            both = Cat(*(getattr(p, name) for p in ports))
+        # the model gives each port the slots of the widest one: pad the narrower ports' members
+        for name, member in mcb.PortSignature(max(mcb.WIDTHS)).members.items():
+            slot = Shape.cast(member.shape).width
+            parts = []
+            for p in ports:
+                value = getattr(p, name)
+                pad = slot - len(Value.cast(value))
+                parts += [value, *([Signal(pad, name=f"{name}_pad")] if pad else [])]
             # Out members are driven by the core: inputs of the model
-            connections[("i_" if member.flow == wiring.Out else "o_") + name] = both
+            connections[("i_" if member.flow == wiring.Out else "o_") + name] = Cat(*parts)
         m.submodules.memory = Instance(
             "mcb_model",
             p_PORTS=2, p_WORDS=self._memory_words,
+            p_WIDTH=Const(sum(p.signature.width << (32 * i) for i, p in enumerate(ports)), 64),
             p_CALIB_CYCLES=cycles(t.calib_delay_s), p_CMD_LATENCY=cycles(t.command_latency_s),
             p_WORD_NS=t.word_s * 1e9, p_READ_LATENCY_NS=t.read_latency_s * 1e9,
             p_REFRESH_INTERVAL_NS=t.refresh_interval_s * 1e9, p_REFRESH_NS=t.refresh_s * 1e9,
@@ -235,7 +251,7 @@ class FastSystem(wiring.Component):
         self._clocks_and_resets(m)
         # The sequencer's registers for the run are the core's power-up registers.
         m.submodules.core = core = Projector(dmd, **self._addresses, regs=self._registers,
-                                             sync_hz=self._clocks["sync"], mdio_cycles=(40, 10))
+                                             sync_hz=self._clocks["sync"], mdio_cycles=(40, 10), beats=self._beats)
         m.d.comb += [core.trigger_in.eq(self.trigger_in), core.sync_in.eq(0), core.mdio_i.eq(1)]
 
         rx = Signal(gmii.RxPins)

@@ -75,11 +75,11 @@ def event_layout():
     return data.StructLayout({"at": TIME_BITS, "on_cycle": 1, **{name: HOLD_BITS for name in INPUTS}})
 
 
-def rig_layout(buses):
+def rig_layout(buses, beats=1):
     """The pin trace's record: :func:`sim.fast_top.pin_layout`'s fields, ``running`` (the time
     base counts: ``now`` is 1 on the first cycle it is high) and the release stream (``ready``
     is always high: each cycle with ``release_valid`` hands ``release_slot`` back)."""
-    return data.StructLayout({**{name: field.shape for name, field in pin_layout(buses)},
+    return data.StructLayout({**{name: field.shape for name, field in pin_layout(buses, beats)},
                               "running": 1, "release_valid": 1, "release_slot": SLOT_BITS})
 
 
@@ -144,6 +144,8 @@ class SequencerRig(wiring.Component):
     Parameters
     ----------
     dmd : DmdType
+    beats, store_words : int
+        As :class:`gateware.dlpc410.sequencer.Sequencer`'s.
 
     Members
     -------
@@ -166,9 +168,9 @@ class SequencerRig(wiring.Component):
         The time base counts (``status.now`` is not 0).
     """
 
-    def __init__(self, dmd):
-        self._dmd = dmd
-        self._core = SourcedSequencer(dmd)
+    def __init__(self, dmd, *, beats=1, store_words=1):
+        self._dmd, self._beats, self._store_words = dmd, beats, store_words
+        self._core = SourcedSequencer(dmd, beats=beats, store_words=store_words)
         super().__init__({
             "clk": In(1),
             **members(self._core, ("regs", "reload", "trigger_in", "seed", "reseed", "at_rest", "sync_out",
@@ -196,11 +198,11 @@ class SequencerRig(wiring.Component):
             self.at_rest.eq(core.at_rest), self.sync_out.eq(core.sync_out), self.status.eq(core.status),
             self.running.eq(core.status.now != 0),
         ]
-        depths = table_depths(dmd)
+        depths = table_depths(dmd, self._store_words)
         for name in TABLES:
             _file_table(m, name, getattr(core, name), depths[name])
         _file_table(m, "events", player.table, MAX_EVENTS)
-        dlpc410_side(m, dmd, core.pins, flush=self.flush, domain="sync", layout=rig_layout(dmd.buses),
+        dlpc410_side(m, dmd, core.pins, flush=self.flush, domain="sync", layout=rig_layout(dmd.buses, self._beats),
                      always=core.release.valid,
                      extra={"trigger_in": core.trigger_in, "sync_out": core.sync_out,
                             "camera_out": core.camera_out, "running": self.running,
@@ -220,15 +222,17 @@ def _file_table(m, name, port, depth):
 
 # --- running it ----------------------------------------------------------------------------------
 
-def build_key(dmd):
-    """The build's key for ``dmd``: its name in the facts table."""
-    return next((key for key, known in DMDS.items() if known is dmd), slug(dmd.name))
+def build_key(dmd, beats=1, store_words=1):
+    """The build's key: ``dmd``'s name in the facts table, and the beats and store words a
+    cycle when not 1."""
+    name = next((key for key, known in DMDS.items() if known is dmd), slug(dmd.name))
+    return name + (f"-{beats}beats" if beats != 1 else "") + (f"-{store_words}words" if store_words != 1 else "")
 
 
 @functools.cache
-def rig_verilog(dmd):
-    """The rig's Verilog for ``dmd``, converted once per process."""
-    return cocotb_run.emit_verilog(SequencerRig(dmd), TOPLEVEL)
+def rig_verilog(dmd, beats=1, store_words=1):
+    """The rig's Verilog, converted once per process."""
+    return cocotb_run.emit_verilog(SequencerRig(dmd, beats=beats, store_words=store_words), TOPLEVEL)
 
 
 def _write_hex(path, words, width):
@@ -252,11 +256,11 @@ def event_table(pins=(), sync_pins=(), soft=(), early_pins=()):
             for (by_now, at), entry in sorted(holds.items())]
 
 
-def _stimulus(directory, dmd, frames, images, events):
+def _stimulus(directory, dmd, frames, images, events, store_words=1):
     """Write the tables and the events; the plusargs naming them and the trace."""
-    c = contents(dmd, frames, images)
+    c = contents(dmd, frames, images, store_words)
     files = {name: directory / f"{name}.hex" for name in (*TABLES, "events")}
-    for name, words, width in (("planes", c.planes, 64), ("occupancy_map", c.occupancy, 8 * dmd.blocks),
+    for name, words, width in (("planes", c.planes, 64 * store_words), ("occupancy_map", c.occupancy, 8 * dmd.blocks),
                                ("offered", c.offered, OfferedFrame.as_shape().size),
                                ("events", events, event_layout().size)):
         _write_hex(files[name], words, width)
@@ -265,16 +269,18 @@ def _stimulus(directory, dmd, frames, images, events):
 
 
 def run_script(dmd, params, frames, images=None, *, script, name, model=None, seed=None, events=(),
-               max_cycles, until_now=None, key=None):
+               max_cycles, until_now=None, key=None, store_words=1):
     """Run the rig for ``dmd`` on a testbench ``script`` (:mod:`sim.tb.seq_rig`); returns the
     :class:`Run` (:func:`analyse`, up to ``until_now``) with the testbench's report: its
     ``observed`` values, the clock ``cycles`` simulated and the simulation's ``wall_s``.
     ``model``: the controller (default :func:`sim.tb.seq_sim.dlpc410_for`), whose cycle counts
     the responder takes; ``events``: the event table (:func:`event_table`); ``max_cycles``: the
-    script's time limit; ``key``: the build's (default: one per geometry)."""
+    script's time limit; ``key``: the build's (default: one per geometry, beats and store words:
+    the sequencer is built for ``params.beats`` beats a cycle and ``store_words`` words a
+    transfer from its store)."""
     model = dlpc410_for(dmd, params) if model is None else model
     directory = build_dir("seq_rig", slug(name))
-    files, plusargs = _stimulus(directory, dmd, frames, images, list(events))
+    files, plusargs = _stimulus(directory, dmd, frames, images, list(events), store_words)
     report = directory / "report.json"
     report.unlink(missing_ok=True)
     timing = {"rst_active_cycles": model.rst_active_cycles, "init_cycles": model.init_cycles,
@@ -282,7 +288,8 @@ def run_script(dmd, params, frames, images=None, *, script, name, model=None, se
     p = {"regs": pack(Registers, params.registers(dmd)), "timing": pack(Timing, timing),
          "seed": seed, "script": script, "report": str(report), "max_cycles": max_cycles,
          "status": [(n, f.offset, f.width) for n, f in data.Layout.cast(Status)]}
-    cocotb_run.run(rig_verilog(dmd), toplevel=TOPLEVEL, module="sim.tb.seq_rig", key=key or build_key(dmd),
+    cocotb_run.run(rig_verilog(dmd, params.beats, store_words), toplevel=TOPLEVEL, module="sim.tb.seq_rig",
+                   key=key or build_key(dmd, params.beats, store_words),
                    params=p, extra_sources=SOURCES, plusargs=plusargs, run_dir=directory / "run")
     run = analyse(model, trace.read(files["pins"]), dmd, until_now=until_now)
     run.report = json.loads(report.read_text())
@@ -290,7 +297,7 @@ def run_script(dmd, params, frames, images=None, *, script, name, model=None, se
 
 
 def run_rig(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, name, early_pins=(), sync_pins=(),
-            seed=None, model=None, key=None):
+            seed=None, model=None, key=None, store_words=1):
     """:func:`sim.tb.seq_sim.run_bench` on the rig: the same arguments, the same :class:`Run`.
 
     Runs until the sequencer's time base reaches ``cycles``. ``pins``: ``now`` values at which
@@ -303,7 +310,7 @@ def run_rig(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, name,
     script = [{"op": "until_now", "now": cycles}, {"op": "observe", "name": "end", "signals": ["status"]}]
     run = run_script(dmd, params, frames, images, script=script, name=name, model=model, seed=seed,
                      events=event_table(pins, sync_pins, soft, early_pins), max_cycles=cycles + 100_000,
-                     until_now=cycles, key=key)
+                     until_now=cycles, key=key, store_words=store_words)
     run.status = run.report["observed"]["end"]["status"]
     return run
 
@@ -311,7 +318,7 @@ def run_rig(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, name,
 def analyse(model, pins, dmd, *, until_now=None):
     """Replay the trace ``pins`` through ``model`` (up to the cycle on which the time base was
     ``until_now``, default all of it) and gather the :class:`Run` (without status)."""
-    layout = rig_layout(dmd.buses)
+    layout = rig_layout(dmd.buses, model.beats)
     unpack = {name: (offset, mask) for name, offset, mask in trace.fields(layout)}
 
     def field(value, name):

@@ -1,16 +1,21 @@
 """The full-XGA system run: the projector's core on the DLP7000 at TI timing, end to end.
 
 :func:`run` encodes the default scene (1024x768, 8 bits) with the host encoder into scapy-built
-datagrams, writes one GMII replay file per frame, builds :class:`sim.fast_top.FastSystem` with
-Verilator and runs :mod:`sim.tb.system_fast` (no Python per cycle). After the run it replays the
-DLPC410 pin trace through the rule-checking model (every rule, and the Verilog responder's
-outputs against the model's), reconstructs each triggered frame with the camera model, decodes
-the status reply from the transmit trace, and returns the figures.
+datagrams, writes GMII replay files (a control record making the store keep the frames as a
+sequence, then each frame), builds :class:`sim.fast_top.FastSystem` with Verilator and runs
+:mod:`sim.tb.system_fast` (no Python per cycle). The testbench first triggers a few frames one by
+one, at different phases of the trigger against the clock (the latency), then triggers faster
+than frames can be shown: each trigger is held until the sequencer is ready (``trigger_hold``),
+so the stored frames play back to back at the rate the gateware reaches, and the frame period is
+read from the pins. After the run it replays the DLPC410 pin trace through the rule-checking
+model (every rule, and the Verilog responder's outputs against the model's), reconstructs each
+frame with the camera model, checks the back-to-back frame starts against the schedule model's,
+decodes the status reply from the transmit trace, and returns the figures.
 
-Timing: DCLK 200 MHz, RST_ACTIVE and settle from the facts table (no scaling); only the
-DLPC410's initialisation (220 ms) is shortened, to ``INIT_CYCLES``. The schedule comes from
-:func:`spec.schedule.plan` with the read bandwidth the memory model gives the plane
-reader.
+Timing: DCLK 400 MHz (two beats per 200 MHz ``dmd`` cycle) by default, or 200 MHz; RST_ACTIVE and
+settle from the facts table (no scaling); only the DLPC410's initialisation (220 ms) is shortened,
+to ``INIT_CYCLES``. The schedule comes from :func:`spec.schedule.plan` with the read bandwidth
+the memory model gives the plane reader.
 """
 
 import json
@@ -26,7 +31,7 @@ from host import codec
 from sim.fast_top import PLUSARGS, SOURCES, FastSystem, pin_layout, read_rate
 from sim.harness import cocotb_run
 from sim.harness.paths import build_dir
-from sim.models import gmii, trace
+from sim.models import bitplane, gmii, trace
 from sim.models.camera import Camera, to_lsb
 from sim.models.dlpc410 import Dlpc410
 from sim.models.mcb import McbTiming
@@ -34,10 +39,14 @@ from sim.scene import default_scene
 from spec import records, schedule
 from spec.facts import DMDS, TIMING
 
-__all__ = ["run", "plan", "DMD", "DMD_HZ"]
+__all__ = ["run", "plan", "DMD", "DMD_HZ", "DCLK_HZ"]
 
 DMD = DMDS["dlp7000"]
-DMD_HZ, SYNC_HZ = 200e6, 125e6
+DMD_HZ, SYNC_HZ = schedule.FABRIC_HZ, 125e6
+#: DCLK of the run unless told otherwise.
+DCLK_HZ = 400e6
+#: Triggers in the back-to-back phase come this much faster than the model's frame period.
+FASTER = 0.95
 MAC, IP_ADDR, PORT = 0x02_00_00_00_00_01, 0x0A_00_00_02, 5000
 HOST_MAC, HOST_IP = "02:00:00:00:00:99", "10.0.0.1"
 INIT_CYCLES, INIT_GRACE = 200, 4
@@ -46,16 +55,17 @@ TOPLEVEL = "fast_system"
 WAVE_WINDOW = (1000, 40000)
 
 
-def plan():
+def plan(dclk_hz=DCLK_HZ):
     """The schedule for the run: global reset, MSB first, rows paced to the read bandwidth the
-    memory leaves the plane reader."""
-    return schedule.plan(DMD, DMD_HZ, depth=8, words_per_cycle=read_rate(McbTiming(), DMD_HZ))
+    memory leaves the plane reader, early triggers held."""
+    return schedule.plan(DMD, dclk_hz, depth=8, words_per_cycle=read_rate(McbTiming(), DMD_HZ),
+                         trigger_hold=True)
 
 
 def top(the_plan):
     return FastSystem(DMD, the_plan.params.registers(DMD), mac=MAC, ip=IP_ADDR, port=PORT,
                       clocks={"sync": SYNC_HZ, "dmd": DMD_HZ}, init_cycles=INIT_CYCLES,
-                      init_grace_cycles=INIT_GRACE)
+                      init_grace_cycles=INIT_GRACE, beats=the_plan.params.beats)
 
 
 def _datagrams(payloads, port=PORT):
@@ -66,9 +76,14 @@ def _datagrams(payloads, port=PORT):
 
 
 def _replay_files(directory, images):
-    """One GMII replay file per frame (its image records, then the first record again addressed
-    to another UDP port, which the stack must drop and count) and one with a status query."""
+    """GMII replay files: a control record that makes the store keep the frames as a sequence,
+    then one per frame (its image records, then the first record again addressed to another UDP
+    port, which the stack must drop and count), and one with a status query."""
     files, sequence, datagrams = [], 0, 0
+    setup = directory / "sequence.bin"
+    gmii.replay_file(setup, _datagrams([codec.control_record(sequence, sequence_length=len(images))]))
+    sequence, datagrams = 1, 1
+    files.append(str(setup))
     for index, image in enumerate(images):
         payloads = codec.image_records(image, frame=index, sequence=sequence)
         sequence += len(payloads)
@@ -93,11 +108,14 @@ def _status(tx_trace):
     raise AssertionError("no status reply on the transmit pins")
 
 
-def run(key="xga", frames=3, *, log=print):
-    """Build and run the XGA system simulation on ``frames`` frames of the default scene;
-    returns the report (dict). Raises on a broken DLPC410 or memory rule, a responder mismatch
-    or a missing status reply; the images' errors are in the report."""
-    the_plan = plan()
+def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, log=print):
+    """Build and run the XGA system simulation on ``frames`` frames of the default scene, stored
+    as a sequence; ``one_by_one`` frames triggered each when the sequencer is ready, then
+    ``back_to_back`` frames triggered faster than they can be shown. Returns the report (dict).
+    Raises on a broken DLPC410 or memory rule, a responder mismatch, back-to-back frames that
+    start other than the schedule model's, or a missing status reply; the images' errors are in
+    the report."""
+    the_plan = plan(dclk_hz)
     directory = build_dir("system", key)
     t0 = time.monotonic()
     images = default_scene(frames, DMD.rows, DMD.columns)
@@ -106,7 +124,8 @@ def run(key="xga", frames=3, *, log=print):
     files = {name: directory / f"{name}.txt" for name in ("pins", "tx")}
     report_path = directory / "stimulus.json"
     p = {"frames": frames, "replays": replays, "status_query": query, "replay": str(directory / "replay.bin"),
-         "period_cycles": the_plan.frame_cycles,
+         "period_cycles": the_plan.frame_cycles, "one_by_one": one_by_one, "back_to_back": back_to_back,
+         "fast_period_cycles": round(FASTER * the_plan.frame_cycles),
          # at or just after the first frame's last pulse: its first pulse comes within 8 cycles
          "last_pulse_cycles": _model_span(the_plan) + 8,
          # a frame's first plane is loaded about 155 us after its last byte (the stack forwards the
@@ -116,37 +135,74 @@ def run(key="xga", frames=3, *, log=print):
     plusargs = [f"+{PLUSARGS['replay']}={p['replay']}", f"+{PLUSARGS['pins']}={files['pins']}",
                 f"+{PLUSARGS['tx']}={files['tx']}"]
     t_build = time.monotonic()
-    build = cocotb_run.run(top(the_plan), toplevel=TOPLEVEL, module="sim.tb.system_fast", key="dlp7000",
+    build = cocotb_run.run(top(the_plan), toplevel=TOPLEVEL, module="sim.tb.system_fast",
+                           key=f"dlp7000-{the_plan.params.beats}beats",
                            params=p, extra_sources=SOURCES, plusargs=plusargs, waves=False,
                            top_signals_only=True)
     stimulus = json.loads(report_path.read_text())
     sim_wall = stimulus["wall_s"]
     log(f"simulation done: build and run {time.monotonic() - t_build:.0f} s, of which the run {sim_wall:.0f} s; "
         f"checking the pins")
-    return analyse(the_plan, images, stimulus, files, build=build)
+    return analyse(the_plan, images, stimulus, files, one_by_one=one_by_one, back_to_back=back_to_back,
+                   build=build)
 
 
-def analyse(the_plan, images, stimulus, files, *, build=None):
+def _frames_shown(pins, layout, pulses):
+    """``(first pulse, last pulse)`` of every frame: sync out is high from a frame's first pulse
+    to its last group's final dark pulse (it rises one cycle after the decision)."""
+    rises = trace.rising_edges(pins, layout, "sync_out")
+    frames = []
+    for k, rise in enumerate(rises):
+        end = rises[k + 1] if k + 1 < len(rises) else float("inf")
+        mine = [c for c in pulses if rise - 1 <= c < end - 1]
+        assert mine, f"frame {k}: sync out rose with no clocking pulse"
+        frames.append((mine[0], mine[-1]))
+    return frames
+
+
+def _model_back_to_back(the_plan, images, first, strobes):
+    """The schedule model's frame starts for the stored frames ``first, first + 1, ..`` of the
+    sequence triggered at ``strobes`` (relative cycles, the first when every group is ready)."""
+    p = the_plan.params
+    occupancy = [tuple(int(x) for x in bitplane.occupancy(image, DMD.rows_per_block)) for image in images]
+    frames = [schedule.Frame(k % len(images), 8, occupancy[k % len(images)], sequence=True)
+              for k in range(first, first + len(strobes))]
+    ready = schedule.ready_cycle(DMD, p, frames[0])
+    r = schedule.simulate(DMD, p, frames, [ready + s for s in strobes])
+    assert r.late == 0 and r.overruns == 0, (r.late, r.overruns)
+    return [t - r.frame_starts[0] for t in r.frame_starts]
+
+
+def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, build=None):
     t0 = time.monotonic()
-    layout = pin_layout(DMD.buses)
+    p = the_plan.params
+    layout = pin_layout(DMD.buses, p.beats)
     pins = trace.read(files["pins"])
-    model = Dlpc410(DMD, dclk=DMD_HZ, init_cycles=INIT_CYCLES, init_grace_cycles=INIT_GRACE)
+    model = Dlpc410(DMD, beats=p.beats, clock_hz=DMD_HZ, init_cycles=INIT_CYCLES, init_grace_cycles=INIT_GRACE)
     trace.replay_dlpc410(model, pins, layout)
     triggers = trace.rising_edges(pins, layout, "trigger_in")
     pulses = [c.cycle for c in model.log if c.kind == "pulse"]
-    period, lsb = the_plan.frame_cycles, the_plan.params.lsb
+    period, lsb = the_plan.frame_cycles, p.lsb
     camera = Camera(model, ramp_cycles=0)
+    frames = _frames_shown(pins, layout, pulses)
+    assert len(frames) == len(triggers) == one_by_one + back_to_back, (len(frames), len(triggers))
     shown = []
-    for index, pin in enumerate(triggers):
-        end = triggers[index + 1] if index + 1 < len(triggers) else model.cycle
-        mine = [c for c in pulses if pin <= c < end]
-        assert mine, f"trigger {index} produced no clocking pulse"
-        first = mine[0]
+    for index, (first, last) in enumerate(frames):
+        image = images[index % len(images)]
         light = to_lsb(camera.image(first, first + period), lsb)
-        error = np.abs(light - images[index].astype(np.float64))
-        shown.append({"trigger_cycle": pin, "latency_cycles": first - pin, "pulses": len(mine),
-                      "span_cycles": mine[-1] - first, "max_error_lsb": float(error.max()),
-                      "wrong_pixels": int((error > 1e-9).sum())})
+        error = np.abs(light - image.astype(np.float64))
+        trigger = triggers[index]
+        shown.append({"trigger_cycle": trigger, "start_cycle": first, "latency_cycles": first - trigger,
+                      "held": index >= one_by_one + 1, "span_cycles": last - first,
+                      "max_error_lsb": float(error.max()), "wrong_pixels": int((error > 1e-9).sum())})
+    # back to back: the frame starts the gateware made, against the schedule model's for the same
+    # triggers (the first one found every group ready, the others were held)
+    fast = shown[one_by_one:]
+    starts = [f["start_cycle"] - fast[0]["start_cycle"] for f in fast]
+    want = _model_back_to_back(the_plan, images, one_by_one,
+                               [f["trigger_cycle"] - fast[0]["trigger_cycle"] for f in fast])
+    assert starts == want, f"back-to-back frame starts {starts}, the schedule model's {want}"
+    periods = [b - a for a, b in zip(starts, starts[1:], strict=False)]
     status = _status(trace.read(files["tx"]))
     waves = None
     if triggers:
@@ -154,15 +210,18 @@ def analyse(the_plan, images, stimulus, files, *, build=None):
                                 start=triggers[0] - WAVE_WINDOW[0], end=triggers[0] + WAVE_WINDOW[1],
                                 ns_per_cycle=1e9 / DMD_HZ)
     sends = stimulus["sends"]
-    first_frame = sends[0]
+    first_frame = sends[1]
     return {
         "frames": shown,
+        "dclk_hz": DMD_HZ * p.beats,
         "period_cycles": period,
+        "periods_measured": periods,
         "rate_hz": the_plan.rate_hz,
         "model_span_cycles": _model_span(the_plan),
         "lsb_cycles": lsb,
         "row_period": the_plan.params.row_period,
         "pulse_to_mirror_cycles": round(TIMING["t_pulse_to_mirror"].value * DMD_HZ),
+        "back_to_back_model": want,
         "status": status,
         "sends": sends,
         "dmd_cycles": stimulus["sim_ns"] / (1e9 / DMD_HZ),
@@ -185,4 +244,4 @@ def _model_span(the_plan):
 
 
 if __name__ == "__main__":
-    print(json.dumps(run(frames=1), indent=1, default=str))
+    print(json.dumps(run(frames=2, one_by_one=1, back_to_back=2), indent=1, default=str))

@@ -22,7 +22,8 @@ forum       TI E2E forum answers (quoting the datasheet); Mathews et al., IEEE Q
 import enum
 from dataclasses import dataclass
 
-__all__ = ["Fact", "TIMING", "PHY", "DmdType", "DMDS", "RowMode", "BlockMode", "TEST_DMD", "TEST_DMD4"]
+__all__ = ["Fact", "TIMING", "PHY", "DmdType", "DMDS", "RowMode", "BlockMode", "TEST_DMD", "TEST_DMD4",
+           "TEST_DMD_400", "TEST_DMD4_400"]
 
 
 @dataclass(frozen=True)
@@ -115,6 +116,13 @@ DMDS["test"] = TEST_DMD
 TEST_DMD4 = DmdType("test four-bus 256x80", 256, 80, 256, 5, 16, 4, 128, 2, None, 3,
                     "test geometry, DLP9500-style")
 DMDS["test4"] = TEST_DMD4
+#: Small DMDs for DCLK 400 MHz tests, where a row cycle is half its DCLK cycles: four DCLK per
+#: row (two ``dmd`` cycles), on two buses (256x96 in 4 blocks) and four (512x80 in 5 blocks).
+TEST_DMD_400 = DmdType("test 256x96", 256, 96, 256, 4, 24, 2, 64, 4, None, 1, "test geometry, four DCLK per row")
+DMDS["test_400"] = TEST_DMD_400
+TEST_DMD4_400 = DmdType("test four-bus 512x80", 512, 80, 512, 5, 16, 4, 128, 4, None, 3,
+                        "test geometry, DLP9500-style, four DCLK per row")
+DMDS["test4_400"] = TEST_DMD4_400
 
 
 class RowMode(enum.IntEnum):

@@ -172,6 +172,7 @@ SYSTEM_STATUS = [
     ("store_frames_replaced", 32),   # complete, replaced unshown by a newer one
     ("store_frames_abandoned", 32),  # incomplete, abandoned for a newer frame (a lost record)
     ("store_rows_refused", 32),      # rows the store refused (outside, stale, shown, duplicate, no slot)
+    ("triggers_held", 32),     # triggers that came too early, held and obeyed once every group was ready
 ]
 
 #: Status reply body (after :data:`HEADER`).

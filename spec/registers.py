@@ -108,6 +108,9 @@ FIELDS = [
     Field("camera_width", 16, doc="camera-trigger pulse length"),
     Field("ns_flip", 1, doc="NS_FLIP pin"),
     Field("park", 1, doc="PWR_FLOAT (park the mirrors)"),
+    Field("trigger_hold", 1, doc="1: a trigger that comes while a frame plays or loads is held and "
+                                 "obeyed on the first cycle every group is ready (one at a time; a "
+                                 "second one meanwhile is an overrun); 0: it is an overrun"),
 ]
 
 _BY_NAME = {f.name: f for f in FIELDS}

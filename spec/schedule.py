@@ -131,6 +131,7 @@ class Params:
     chain: bool = False
     strict_rst: bool = True
     trigger: TriggerMode = TriggerMode.EXTERNAL
+    trigger_hold: bool = False
     source: Source = Source.STORE
     stagger: int = 0
     row_period: int = 0          # 0: DCLK-per-row of the DMD
@@ -149,6 +150,7 @@ class Params:
             "camera_offset", "camera_width")}
         regs.update(reset_mode=self.reset_mode, order=self.order, order_table=list(self.order_table),
                     chain=int(self.chain), strict_rst=int(self.strict_rst), trigger=self.trigger,
+                    trigger_hold=int(self.trigger_hold),
                     source=self.source, row_period=self.row_period or row_cycles(dmd, self.beats),
                     ns_flip=int(self.ns_flip), park=int(self.park))
         return regs
@@ -162,6 +164,7 @@ class Frame:
     depth: int
     occupancy: tuple = None      # None: every block full
     ready: int = 0               # cycle from which the store offers it
+    sequence: bool = False       # the next of a stored sequence: never replaces a waiting frame
 
     def occupied(self, plane, block):
         return self.occupancy is None or bool((self.occupancy[block] >> plane) & 1)
@@ -173,8 +176,9 @@ class Result:
     pulses: list                 # (cycle, group, kind, frame_index, exponent or None for dark)
     late: int = 0
     overruns: int = 0
+    held: int = 0                # triggers held until every group was ready
     bad_frames: int = 0
-    accepted: list = field(default_factory=list)   # strobe cycles obeyed
+    accepted: list = field(default_factory=list)   # cycles triggers were obeyed (strobe or held)
     frame_starts: list = field(default_factory=list)
     shown: list = field(default_factory=list)        # frames taken, in order
 
@@ -282,6 +286,7 @@ class _Model:
         self.queued_at = self.G + 1         # the first planes are queued one group a cycle
         self.bus_free = 0
         self.t = 0
+        self.holding = False                # a trigger held until every group is ready
         self.idle_take = not p.chain and p.source != Source.PRNG
 
     # -- the planner -------------------------------------------------------------------------
@@ -357,16 +362,36 @@ class _Model:
             self.st[g].writable = max(self.st[g].writable, t + self.p.reload_lead + wait)
             self.enqueue(g, fi, 0)
 
+    def obey(self, t):
+        """Every group's first pulse from ``even(t + 1)``, staggered."""
+        self.res.accepted.append(t)
+        start = even(t + 1)
+        for g, s in enumerate(self.st):
+            s.pending = True
+            s.pulse_at = start + g * self.p.stagger
+
+    def release_held(self, t):
+        """A held trigger is obeyed on the first cycle every group is ready."""
+        if self.holding and self.waiting(t):
+            self.holding = False
+            self.obey(t)
+
     def strobe(self, s_t):
-        """A trigger strobe at ``s_t`` (reads the state before this cycle's decision)."""
+        """A trigger strobe at ``s_t`` (reads the state before this cycle's decision): obeyed,
+        held (``trigger_hold``, one at a time) or an overrun."""
         if self.waiting(s_t):
-            self.res.accepted.append(s_t)
-            start = even(s_t + 1)
-            for g, s in enumerate(self.st):
-                s.pending = True
-                s.pulse_at = start + g * self.p.stagger
+            self.obey(s_t)
+        elif self.p.trigger_hold and not self.holding:
+            self.holding = True
+            self.res.held += 1
         else:
             self.res.overruns += 1
+
+    def ready_at(self):
+        """The cycle every group is ready (no group plays, every one loaded), or None."""
+        if any(s.pending or s.loaded_at is None for s in self.st):
+            return None
+        return max(s.loaded_at for s in self.st)
 
     # -- the bus -----------------------------------------------------------------------------
 
@@ -429,15 +454,21 @@ class _Model:
             cands.append(max(st[g].writable, self.next_row) if ops[i][0] == "row" else st[g].writable)
         nxt = self.frames.offer()
         take_at = None
-        if self.idle_take and nxt is not None and not self.playing():
+        if self.idle_take and nxt is not None and not self.playing() and not self.frames.offered[nxt[0]].sequence:
             take_at = max(nxt[1], self.queued_at, t + 1)
             cands.append(take_at)
+        hold_at = None
+        if self.holding and self.ready_at() is not None:
+            hold_at = max(self.ready_at(), t + 1)
+            cands.append(hold_at)
         if not cands:
             return None
         nt = max(t + 1, min(cands), self.bus_free)
-        if take_at is not None and t < take_at < nt:
-            nt = take_at
-        if nt % 2 and not (self.si < len(self.strobes) and self.strobes[self.si] == nt) and nt != take_at:
+        for exact in (take_at, hold_at):
+            if exact is not None and t < exact < nt:
+                nt = exact
+        strobe_next = self.si < len(self.strobes) and self.strobes[self.si] == nt
+        if nt % 2 and not strobe_next and nt not in (take_at, hold_at):
             nt += 1
         return nt
 
@@ -447,12 +478,13 @@ class _Model:
             t = self.t
             nxt = self.frames.offer()
             take_now = (self.idle_take and nxt is not None and nxt[1] <= t and t >= self.queued_at
-                        and not self.playing())
+                        and not self.playing() and not self.frames.offered[nxt[0]].sequence)
             if t % 2 == 0 and t >= self.bus_free and self.decide(t):
                 if max_frames is not None and len(self.res.frame_starts) > max_frames:
                     break
             if take_now:
                 self.take_while_waiting(t)
+            self.release_held(t)
             while self.si < len(self.strobes) and self.strobes[self.si] <= t:
                 self.si += 1
                 self.strobe(self.strobes[self.si - 1])
@@ -474,7 +506,8 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
         Offered in turn from their ``ready`` cycle (one frame per cycle at most; a frame with a
         bad bit depth is dropped the cycle it is offered): each time group 0 needs a new frame
         it takes the offered one, else shows the current one again; triggered and not chained,
-        one offered while every group waits loaded for a trigger is taken at once.
+        one offered while every group waits loaded for a trigger is taken at once (unless it is
+        the next frame of a stored sequence).
     strobes : iterable of int
         Cycles at which the trigger block signals a trigger (see :mod:`gateware.dlpc410.trigger`).
     until : int
@@ -541,7 +574,7 @@ def _lattice_ok(M, s, G, sep):
 def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetMode.GLOBAL,
          exposure_s=0.0, strict_rst=True, chain=False, words_per_cycle=1.0, source=Source.STORE,
          t_rst_s=None, t_settle_s=None, frame=None, order_table=(7, 6, 5, 4, 3, 2, 1, 0),
-         reload_lead=RELOAD_LEAD):
+         reload_lead=RELOAD_LEAD, trigger_hold=False):
     """A parameter set that shows every plane exactly on time, and the rate it reaches.
 
     ``exposure_s`` asks for a least significant plane at least that long (0: the shortest legal
@@ -556,6 +589,8 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     For triggered multi-bit frames the plan with groups spread apart (:func:`_spread`) is taken
     instead when it is faster; ``binds`` then names the load queue order.
     ``reload_lead``: the store's latency to a row's first words, in cycles (see :class:`Params`).
+    ``trigger_hold``: a trigger that comes too early is held until every group is ready, rather
+    than counted as an overrun.
     """
     beats = beats_at(dclk_hz)
     R = row_cycles(dmd, beats)
@@ -594,7 +629,7 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
             p = Params(lsb=lsb, t_rst=t_rst, t_settle=t_settle, hide=hide, dark_gap=dark_gap,
                        reset_mode=reset_mode, order=order, order_table=order_table, chain=chain,
                        strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period,
-                       reload_lead=reload_lead, beats=beats)
+                       reload_lead=reload_lead, beats=beats, trigger_hold=trigger_hold)
             fr = frame or Frame(0, depth)
             r = simulate(dmd, p, [replace(fr, ready=0)] * (3 if chain else 1), [ready_cycle(dmd, p, fr)],
                          max_frames=2)

@@ -13,10 +13,10 @@ T = timing_cycles(200e6)
 R, S = T["rst_active_cycles"], T["settle_cycles"]
 
 
-def started(dmd=TEST_DMD, **kw):
+def started(dmd=TEST_DMD, beats=1, **kw):
     """A model and a driver past initialisation, DVALID allowed from the driver's cycle on."""
-    model = Dlpc410(dmd, init_cycles=INIT, **kw)
-    driver = Driver(dmd)
+    model = Dlpc410(dmd, beats=beats, init_cycles=INIT, **kw)
+    driver = Driver(dmd, beats)
     driver.start(INIT)
     model.run(driver.items)
     driver.items.clear()
@@ -89,6 +89,48 @@ def test_load_and_global_pulse():
     assert rows[0].mode == "FIRST" and {c.mode for c in rows[1:]} == {"NEXT"}
     assert all(model.pulse_cycles[b] == [p] for b in range(TEST_DMD.blocks))
     assert model.outputs()["rst_active"] == 1
+
+
+@pytest.mark.parametrize("dmd", ["dlp7000", "dlp9500"])
+def test_two_beats_per_cycle(dmd):
+    """DCLK 400 MHz: a row cycle is half the cycles, each carrying two beats in edge order; the
+    training pattern spans one cycle; the plane read back exactly, global pulse and clears
+    (1080p: with their no-op rows) counted in cycles."""
+    dmd = DMDS[dmd]
+    model, d = started(dmd, beats=2)
+    plane, = planes(dmd, 5)
+    first = d.cycle
+    d.load(plane)
+    p = d.pulse("global")
+    d.idle(2)
+    model.run(d.items)
+    assert np.array_equal(model.memory, plane) and np.array_equal(model.mirrors, plane)
+    rows = [c for c in model.log if c.kind == "row"]
+    per_row = dmd.dclk_per_row // 2
+    assert [c.cycle for c in rows] == list(range(first, first + per_row * dmd.rows, per_row))
+    assert p == first + per_row * dmd.rows
+    d.items.clear()
+    after_settle(d, p)
+    c = d.clear(3)
+    d.idle(2)
+    model.run(d.items)
+    assert not model.memory[3 * dmd.rows_per_block:4 * dmd.rows_per_block].any()
+    assert model.log[-1] == Command(c, "clear", (3,))
+
+
+def test_two_beats_rules_in_dclk_cycles():
+    """At two beats a cycle the row-cycle rule counts DCLK cycles, and the training pattern
+    repeats within a cycle."""
+    model, d = started(DMDS["dlp7000"], beats=2)
+    d.row(RowMode.ADDRESSED, rowad=3, cut=3)
+    d.idle(2)
+    breaks("row_cycle", model, d.items, "DVALID fell after 6 of 16 DCLK cycles")
+    model = Dlpc410(DMDS["dlp7000"], beats=2, init_cycles=INIT)
+    d = Driver(DMDS["dlp7000"], 2)
+    d.hold_reset(4)
+    d.training(6)
+    d.items[-2]["din_a"] ^= 1 << 16            # pin 0 high on a falling edge where 0 is due
+    breaks("init_training", model, d.items, "DIN_A\\(0\\) does not repeat 0100")
 
 
 def test_row_modes_addressed_flip_and_complement():
@@ -308,7 +350,7 @@ def test_rule_row_cycle_cut_short():
     start = d.row(RowMode.ADDRESSED, rowad=1, cut=9)
     d.idle(2)
     e = breaks("row_cycle", model, d.items,
-               f"DVALID fell after 9 of 16 cycles of the row cycle from cycle {start}")
+               f"DVALID fell after 9 of 16 DCLK cycles of the row cycle from cycle {start}")
     assert e.cycle == start + 9
 
 
@@ -316,7 +358,7 @@ def test_rule_row_hold():
     model, d = started()
     d.row(RowMode.ADDRESSED, rowad=7)
     d.items[-1] = {**d.items[-1], "rowad": 8, "blkmd": 1}
-    breaks("row_hold", model, d.items, "ROWAD, BLKMD changed in cycle 2 of the row cycle")
+    breaks("row_hold", model, d.items, "ROWAD, BLKMD changed in DCLK cycle 2 of the row cycle")
 
 
 def test_rule_row_address():

@@ -1,8 +1,9 @@
-"""The sequencer (TEST_DMD, TEST_DMD4): its command stream equals the schedule model's cycle for
-cycle, and every pixel receives exactly its grey level in LSB units, under the rule-checking
-DLPC410 model. The runs are on the generated Verilog (:mod:`sim.seq_rig`: one Verilator build per
-geometry, the trace replayed through the model after the run); the Amaranth simulator keeps the
-short tests it is the right tool for, and one scenario run on both must give the same run."""
+"""The sequencer (TEST_DMD, TEST_DMD4; at DCLK 400 MHz TEST_DMD_400, TEST_DMD4_400): its command
+stream equals the schedule model's cycle for cycle, and every pixel receives exactly its grey
+level in LSB units, under the rule-checking DLPC410 model. The runs are on the generated Verilog
+(:mod:`sim.seq_rig`: one Verilator build per geometry, the trace replayed through the model after
+the run); the Amaranth simulator keeps the short tests it is the right tool for, and one scenario
+run on both must give the same run."""
 
 import numpy as np
 import pytest
@@ -14,7 +15,7 @@ from sim.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import INIT_CYCLES, dlpc410_for, frame_lights, run_bench
 from spec import prng, schedule
-from spec.facts import TEST_DMD, TEST_DMD4
+from spec.facts import TEST_DMD, TEST_DMD4, TEST_DMD4_400, TEST_DMD_400
 from spec.registers import PlaneOrder, ResetMode, Source, TriggerMode
 
 DMD = TEST_DMD
@@ -22,17 +23,17 @@ DMD = TEST_DMD
 FAST = {"t_rst_s": 20 / 200e6, "t_settle_s": 30 / 200e6}
 
 
-def fast_plan(dmd=DMD, **kw):
-    return schedule.plan(dmd, 200e6, **FAST, **kw)
+def fast_plan(dmd=DMD, dclk=200e6, **kw):
+    return schedule.plan(dmd, dclk, **FAST, **kw)
 
 
 def model_frames(frames, images, dmd=DMD):
-    """Model frames of (slot, depth) or (slot, depth, ready) tuples."""
+    """Model frames of (slot, depth), (slot, depth, ready) or (slot, depth, ready, sequence)."""
     out = []
-    for slot, depth, *ready in frames:
+    for slot, depth, *rest in frames:
         occ = None if images is None else \
             tuple(int(x) for x in bitplane.occupancy(images[slot], dmd.rows_per_block))
-        out.append(schedule.Frame(slot, depth, occ, *ready))
+        out.append(schedule.Frame(slot, depth, occ, *rest[:1], *map(bool, rest[1:])))
     return out
 
 
@@ -62,7 +63,7 @@ def same_commands(run, model):
 
 
 def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), early_pins=(),
-          offered=None, dmd=DMD):
+          offered=None, dmd=DMD, store_words=1):
     """Run gateware and model; assert equal commands, counters, and exact light per frame.
     ``frames``: the frames expected on the DMD; ``offered``: what the store offers (default:
     the same). The rule model logs no no-op rows (a 1080p clear's), the schedule model does."""
@@ -75,11 +76,12 @@ def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), ea
     model = schedule.simulate(dmd, p, mframes, strobes)
     end = max(c[0] for c in model.commands) + extra
     run = run_rig(dmd, p, offered, images, pins=pins, soft=soft, sync_pins=sync_pins,
-                  early_pins=early_pins, cycles=end, name=name)
+                  early_pins=early_pins, cycles=end, name=name, store_words=store_words)
     assert run.commands == model.decoded()
     assert run.status["late"] == 0 == model.late
     assert run.status["underruns"] == 0
     assert run.status["overruns"] == model.overruns
+    assert run.status["held"] == model.held
     assert run.status["triggers"] == len(model.accepted)
     assert run.status["early"] == len(early_pins)
     # the camera model on the rule model's mirror history, the window holding each frame
@@ -107,6 +109,36 @@ def test_every_level_exact(mode, strict, order, test_name):
     ready = next_ready(p, model_frames([(0, 8)], None), [])
     run, _ = check(p, [(0, 8)], None, [ready + 10], test_name)
     assert len(run.lights) == 1
+
+
+@pytest.mark.verilog
+@pytest.mark.parametrize("dmd,mode,order,store_words", [
+    (TEST_DMD_400, ResetMode.GLOBAL, PlaneOrder.MSB_FIRST, 2),    # a row every row cycle
+    (TEST_DMD_400, ResetMode.DUAL, PlaneOrder.LSB_FIRST, 1),      # the store paces the rows
+    (TEST_DMD4_400, ResetMode.QUAD, PlaneOrder.MSB_FIRST, 2),     # four buses, two beats of two words
+])
+def test_two_beats_per_cycle(dmd, mode, order, store_words, test_name):
+    """DCLK 400 MHz: two DCLK beats per cycle (a row cycle of half the cycles); a ramp frame then
+    a random frame with empty blocks; commands equal the model's cycle for cycle, every grey
+    level exact under the rule model, which reads two beats a cycle. With two words a transfer
+    from the store, a row loads every row cycle."""
+    rng = np.random.default_rng(6)
+    noisy = rng.integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8) & 0b10110111
+    noisy[dmd.rows_per_block:2 * dmd.rows_per_block] = 0
+    images = {0: ramp_image(dmd, 0), 1: noisy}
+    plan = fast_plan(dmd, 400e6, reset_mode=mode, order=order, words_per_cycle=store_words)
+    p = plan.params
+    assert p.beats == 2
+    row = dmd.dclk_per_row // 2
+    assert p.row_period == (row if store_words * 64 >= dmd.bits_per_dclk * 2 else 2 * row)
+    frames = [(0, 8), (1, 6)]
+    offered, pins = [], []
+    for slot, depth in frames:
+        offered.append((slot, depth, pins[-1] + PIN_TO_STROBE + 4 if pins else 0))
+        strobes = [t + PIN_TO_STROBE for t in pins]
+        pins.append(next_ready(p, model_frames(offered, images, dmd), strobes, dmd) - PIN_TO_STROBE)
+    run, _ = check(p, frames, images, pins, test_name, offered=offered, dmd=dmd, store_words=store_words)
+    assert len(run.lights) == 2
 
 
 @pytest.mark.verilog
@@ -207,6 +239,47 @@ def test_triggers(test_name):
                        early_pins=(3, 9), offered=frames)
     assert model.overruns == 5 and len(model.accepted) == 3
     assert run.status["frames"] == 3 and run.status["bad_frames"] == model.bad_frames == 2
+
+
+@pytest.mark.verilog
+@pytest.mark.parametrize("mode", [ResetMode.GLOBAL, ResetMode.DUAL])
+def test_early_triggers_held(mode, test_name):
+    """With ``trigger_hold``, a trigger during a frame is held and obeyed on the first cycle
+    every group is ready (the frame after it starts at once), a second one meanwhile is an
+    overrun, and a trigger while a newer frame's first plane reloads is held too: no frame is
+    lost. Triggers come faster than frames: the frames play back to back."""
+    plan = fast_plan(reset_mode=mode, depth=4)
+    p = plan.params
+    p.trigger_hold = True
+    first = next_ready(p, model_frames([(0, 4)], None), []) - PIN_TO_STROBE
+    frames = [(0, 4, 0), (1, 4, first + PIN_TO_STROBE + 4), (0, 3, first + PIN_TO_STROBE + 4)]
+    # triggers at 0.6 of the frame period: each one early, held, a burst's second an overrun
+    period = plan.frame_cycles
+    pins = [first + round(k * 0.6 * period) for k in range(5)] + [first + round(1.2 * period) + 30]
+    # the frames shown, in order (a frame repeats when no newer one is there at its end)
+    result = schedule.simulate(DMD, p, model_frames(frames, None), [t + PIN_TO_STROBE for t in pins])
+    fi = {t: f for t, g, kind, f, _e in result.pulses if g == 0}
+    shown = [(result.shown[fi[t]].slot, result.shown[fi[t]].depth) for t in result.frame_starts]
+    run, model = check(p, shown, None, pins, test_name, offered=frames, extra=period)
+    assert model.held >= 2 and model.overruns >= 1 and len(model.accepted) >= 3
+    # a held trigger is obeyed the cycle every group is ready: frames back to back
+    starts = model.frame_starts
+    assert all(b > a for a, b in zip(starts, starts[1:], strict=False))
+
+
+@pytest.mark.verilog
+def test_stored_sequence_frames_wait_their_turn(test_name):
+    """Frames of a stored sequence offered while the first waits for its trigger do not replace
+    it (a newer streamed frame would): each trigger shows the next frame in order."""
+    rng = np.random.default_rng(9)
+    images = {s: rng.integers(0, 256, (DMD.rows, DMD.columns), dtype=np.uint8) for s in range(2)}
+    p = fast_plan(depth=4).params
+    frames = [(0, 4, 0, 1), (1, 4, 0, 1), (0, 4, 0, 1)]
+    first = next_ready(p, model_frames(frames[:1], images), []) + 200
+    period = schedule.plan(DMD, 200e6, **FAST, depth=4).frame_cycles
+    pins = [first + k * (period + 300) for k in range(3)]
+    run, model = check(p, [(0, 4), (1, 4), (0, 4)], images, pins, test_name, offered=frames)
+    assert [f.slot for f in model.shown] == [0, 1, 0] and len(run.lights) == 3
 
 
 @pytest.mark.verilog

@@ -17,6 +17,7 @@ LAYERS = [
     ("gateware.bitplane",),
     ("gateware.store",),
     ("gateware.dlpc410",),
+    ("gateware.sync",),
     ("gateware.platform",),
     ("gateware.top",),
     ("host",),

@@ -39,6 +39,50 @@ def test_write_then_read_back():
     assert model.ports[0].words_written == 65
 
 
+def test_ports_of_other_widths_share_the_memory():
+    """64-bit words written on one port read back as 128-bit words on another, the first in the
+    low bits, and 32-bit words as halves; 128-bit words written with byte masks read back as
+    64-bit words with the masked bytes unchanged (numbers worked out by hand from the byte
+    order)."""
+    model = McbModel(1 << 16, ports=3, widths=(64, 128, 32))
+    drivers = narrow, wide, half = [PortDriver(model, i) for i in range(3)]
+
+    def on(driver):
+        """``driver``, its clock brought to the others' time (one clock for all three)."""
+        driver.cycle = max(d.cycle for d in drivers)
+        return driver
+
+    for port in drivers:
+        on(port).until_calibrated()
+    words = [0x1111111111111111 * (i + 1) for i in range(8)]
+    on(narrow).write(0x100, words)
+    assert on(wide).read(0x100, 4) == [words[i] | words[i + 1] << 64 for i in range(0, 8, 2)]
+    assert on(half).read(0x108, 2) == [0x2222_2222, 0x2222_2222]
+    on(wide).write(0x200, [0xAAAA_AAAA_AAAA_AAAA_BBBB_BBBB_BBBB_BBBB], masks=[0x80FF])   # keep bytes 0-7, 15
+    assert on(narrow).read(0x200, 2) == [0, 0x00AA_AAAA_AAAA_AAAA]
+    on(wide).write(0x200, [0x0102_0304_0506_0708_090A_0B0C_0D0E_0F10], masks=[0xFEFF])   # byte 8 only
+    assert on(narrow).read(0x200, 2) == [0, 0x00AA_AAAA_AAAA_AA08]
+    with pytest.raises(McbError) as error:                  # 8-byte aligned, not 16
+        wide.tick(cmd_en=1, cmd_instr=READ, cmd_bl=0, cmd_byte_addr=0x108)
+    assert error.value.kind == "misaligned"
+
+
+def test_a_wide_word_takes_its_bytes_of_memory_time():
+    """The DRAM sets the bandwidth: 128-bit words move at half the word rate of 64-bit ones,
+    the same bytes per second (within refresh and latency)."""
+    def rate(width):
+        model = McbModel(1 << 20, widths=(width,), ports=1)
+        clk = PortDriver(model, period=5e-9)
+        clk.until_calibrated()
+        start = clk.cycle
+        clk.read(0, 64 * 64 * 64 // width)              # 32 KiB
+        return 32768 / ((clk.cycle - start) * 5e-9)
+
+    narrow, wide = rate(64), rate(128)
+    assert wide == pytest.approx(narrow, rel=0.02)
+    assert wide < McbTiming().peak_bytes_per_s * McbTiming().efficiency
+
+
 def test_bandwidth_and_refresh():
     """A long stream of reads runs at the sustained rate; refreshes happen every 7.8 us."""
     timing = McbTiming()

@@ -1,102 +1,24 @@
 """The endpoint (network stack + protocol parser + status reply) in the Amaranth simulator.
 
-Frames are built by scapy and the host encoder; expectations come from the reference model in
-:mod:`sim.models.net`; replies are parsed back by scapy.
+Frames are built by scapy and the host encoder (:mod:`sim.models.endpoint_traffic`); expectations
+come from the reference model in :mod:`sim.models.net`; replies are parsed back by scapy. The long
+runs (the randomized mix with its ledger, records back to back at line rate) run on the generated
+Verilog (:mod:`sim.tb.endpoint`, ``tests/test_protocol_endpoint_verilog.py``).
 """
 
-import random
-
-import numpy as np
 import pytest
 from scapy.layers.inet import ICMP, IP, UDP
 from scapy.layers.l2 import ARP, Ether
 
-import host
 from host import codec
 from sim.models import frames
+from sim.models.endpoint_traffic import BAD_CASES, GOOD_WIRE, IMAGE, A, image_frame, sequencer_record
 from sim.models.frames import Addresses
 from sim.models.net import Model
 from sim.tb import endpoint_sim
-from spec import records, schedule, wire
+from spec import records
 from spec.facts import TEST_DMD
-from spec.registers import PlaneOrder, ResetMode, TriggerMode
-
-A = Addresses()
-COLUMNS = TEST_DMD.columns
-PIXELS = TEST_DMD.rows * COLUMNS
-IMAGE = np.random.default_rng(5).integers(0, 256, (TEST_DMD.rows, COLUMNS), dtype=np.uint8)
-HEADER = wire.size(records.HEADER)
-
-
-def image_frame(first_row, rows=1, frame=1, sequence=0):
-    """Rows ``first_row`` .. of :data:`IMAGE` in one record."""
-    pixels = IMAGE[first_row:first_row + rows].tobytes()
-    return frames.udp(A, codec.image_record(frame, first_row * COLUMNS, pixels, sequence))
-
-
-def app_frame(record):
-    return frames.udp(A, record)
-
-
-def _record(record_type=records.RecordType.IMAGE, body=b"", **head):
-    values = {"magic": records.MAGIC, "version": records.VERSION, "type": record_type, "sequence": 0, **head}
-    return wire.pack(records.HEADER, values) + body
-
-
-def _image_body(offset=0, count=COLUMNS):
-    return wire.pack(records.IMAGE, {"frame": 2, "offset": offset}) + bytes(count)
-
-
-#: A register set the sequencer can obey (a plan for the test DMD), as the record's wire values.
-PLAN = schedule.plan(TEST_DMD, 200e6, t_rst_s=200e-9, t_settle_s=300e-9, reset_mode=ResetMode.DUAL)
-GOOD_WIRE = records.register_wire(PLAN.params.registers(TEST_DMD))
-
-
-def sequencer_record(sequence=0, **changes):
-    return codec.sequencer_record({**GOOD_WIRE, **changes}, sequence)
-
-
-#: Sequencer records the sequencer could not obey: ``name -> changes to a good set``.
-BAD_REGISTERS = {
-    "lsb_odd": {"lsb": GOOD_WIRE["lsb"] + 1},
-    "lsb_zero": {"lsb": 0},
-    "order_unknown": {"order": 3},
-    "reset_mode_too_wide": {"reset_mode": 4},
-    "chain_not_a_bit": {"chain": 2},
-    "stagger_odd": {"stagger": 3},
-    "dark_gap_odd": {"dark_gap": GOOD_WIRE["dark_gap"] + 1},
-    "row_period_short": {"row_period": TEST_DMD.dclk_per_row - 1},
-    "periodic_without_period": {"trigger": TriggerMode.PERIODIC.value, "period": 0},
-}
-
-#: Malformed records: ``name -> (record bytes, counter)``.
-BAD_RECORDS = {
-    "bad_magic": (_record(body=_image_body(), magic=0x1234), "drop_app_magic"),
-    "unknown_version": (_record(body=_image_body(), version=records.VERSION + 1), "drop_app_version"),
-    "unknown_type": (_record(record_type=9), "drop_app_type"),
-    "image_without_pixels": (_record(body=_image_body(count=0)), "drop_app_empty"),
-    "truncated_header": (_record()[:4], "drop_app_length"),
-    "truncated_image_header": (_record(body=_image_body())[:HEADER + 4], "drop_app_length"),
-    "status_query_too_long": (codec.status_query() + b"\0", "drop_app_length"),
-    "pixels_beyond_frame": (_record(body=_image_body(offset=PIXELS - COLUMNS + 1)), "drop_app_rows"),
-    "offset_beyond_frame": (_record(body=_image_body(offset=PIXELS, count=1)), "drop_app_rows"),
-    "bit_depth_out_of_range": (codec.control_record(bit_depth=9, armed=1), "drop_app_value"),
-    "armed_not_a_bit": (codec.control_record(armed=2), "drop_app_value"),
-    "sequence_length_zero": (codec.control_record(sequence_length=0), "drop_app_value"),
-    "control_too_long": (codec.control_record(armed=1) + b"\0", "drop_app_length"),
-    "sequencer_too_long": (sequencer_record() + b"\0", "drop_app_length"),
-    "sequencer_truncated": (_record(records.RecordType.SEQUENCER, body=sequencer_record()[HEADER:-1]),
-                            "drop_app_length"),
-    **{f"sequencer_{name}": (sequencer_record(**changes), "drop_app_value")
-       for name, changes in BAD_REGISTERS.items()},
-}
-
-PAYLOAD = codec.image_record(1, 0, IMAGE[0].tobytes())
-BAD_CASES = {name: (builder(A, PAYLOAD), False, counter)
-             for name, (builder, counter) in frames.BAD_FRAMES.items()}
-BAD_CASES["mac_verdict_bad"] = (frames.udp(A, PAYLOAD), True, "drop_mac")
-BAD_CASES.update({name: (app_frame(record), False, counter)
-                  for name, (record, counter) in BAD_RECORDS.items()})
+from spec.registers import PlaneOrder
 
 
 @pytest.fixture(scope="module")
@@ -252,78 +174,6 @@ def test_status_query_answered(replies):
     assert first["records_control"] == 1 and first["records_status"] == 1
     assert first["arp_replies"] == 1 and first["icmp_replies"] == 1
     assert out["net"]["drop_ip_dst"] == 1 and out["net"]["drop_udp_port"] == 1
-
-
-def test_randomized_mix_ledger(test_name):
-    """Hundreds of frames, good and bad interleaved, random gaps, backpressure on both outputs:
-    every counter equals the model's, every accepted row arrives, nothing else does."""
-    rng = random.Random(11)
-    model = Model(TEST_DMD, A.mac, A.ip, A.port)
-    sequence = []
-    seq = 0
-    bad_cases = list(BAD_CASES.values())
-    flat = IMAGE.tobytes()
-    offset, frame = 0, 1
-    for _ in range(260):
-        roll = rng.random()
-        if roll < 0.5:
-            # mostly the next piece of the frame (rows split anywhere), sometimes a jump or a new frame
-            if rng.random() < 0.1:
-                offset, frame = rng.randrange(PIXELS), frame + rng.choice([0, 1, 7])
-            count = min(rng.choice([1, 5, COLUMNS - 1, COLUMNS, 2 * COLUMNS + 9, 500]), PIXELS - offset)
-            record = codec.image_record(frame, offset, flat[offset:offset + count], seq)
-            offset = (offset + count) % PIXELS
-            raw, bad = frames.udp(A, record), False
-            seq += 1 if rng.random() < 0.95 else 2
-        elif roll < 0.56:
-            raw, bad = frames.arp_request(A), False
-        elif roll < 0.62:
-            raw, bad = frames.icmp_echo(A, rng.randbytes(rng.randrange(0, 64))), False
-        elif roll < 0.65:
-            raw, bad = frames.udp(A, codec.status_query(seq)), False
-            seq += 1
-        elif roll < 0.69:
-            control = codec.control_record(seq, bit_depth=rng.randrange(0, 10),
-                                             sequence_length=rng.randrange(0, 3),
-                                             software_trigger=rng.random() < 0.7)
-            raw, bad = frames.udp(A, control), False
-            seq += 1
-        elif roll < 0.74:
-            changes = rng.choice([{"lsb": 2 * rng.randrange(1, 1 << 20)}, rng.choice(list(BAD_REGISTERS.values()))])
-            raw, bad = frames.udp(A, sequencer_record(seq, **changes)), False
-            seq += 1
-        else:
-            raw, bad, _ = rng.choice(bad_cases)
-        sequence.append((raw, bad))
-        model.frame(raw, bad)
-    out = endpoint_sim.run(sequence, name=test_name, gap=(0, 30), seed=3, pixel_stall=0.2,
-                         tx_stall=0.2, waves=False)
-    assert out["net"] == {name: model.counters[name] for name, _ in records.NET_COUNTERS}
-    assert out["app"] == {name: model.counters[name] for name, _ in records.APP_COUNTERS}
-    assert out["rows"] == model.rows and out["app"]["rows_incomplete"] > 0
-    assert out["triggers"] == model.triggers > 0
-    assert out["config"] == model.config
-    assert out["registers"] == [records.registers_bits(wire) for wire in model.registers] and model.registers
-    # Status replies and ARP/ICMP replies come from two sources that take turns: the kinds
-    # match one for one, the order between the two sources may differ.
-    sent = sorted("arp" if ARP in Ether(raw) else "icmp" if ICMP in Ether(raw) else "status"
-                  for raw in out["tx"])
-    assert sent == sorted(kind for kind, _ in model.replies)
-    assert sum(1 for k, _ in model.replies if k == "status") >= 5
-
-
-@pytest.mark.parametrize("mtu", [1500, 9000])
-def test_line_rate_no_drops(mtu, test_name):
-    """Records as large as the MTU lets back to back at the minimum gap: none is lost and the
-    stack never holds off the MAC (its decision cycles fit in the gap)."""
-    encoded = host.image_records(IMAGE, 4, limit=records.record_limit(mtu))
-    assert len(encoded[0]) == min(records.record_limit(mtu), records.IMAGE_HEADER + PIXELS)
-    sequence = [(frames.udp(A, record), False) for record in encoded]
-    out = endpoint_sim.run(sequence, name=test_name, gap=(24, 24), waves=False)
-    assert out["net"]["accepted"] == len(sequence) and out["net"]["drop_overflow"] == 0
-    assert out["rx_stalls"] == 0
-    assert [r for _f, r, _d in out["rows"]] == list(range(TEST_DMD.rows))
-    assert all(d == IMAGE[r].tobytes() for _f, r, d in out["rows"])
 
 
 def test_buffer_overflow_drops_whole_frames(test_name):

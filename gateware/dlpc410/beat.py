@@ -20,7 +20,7 @@ beat, rising edge before falling edge, bus A before bus B, pin 0 first; that is:
 A four-bus DMD (DLP9500) takes two words per beat: the first on A/B as above, the second on C/D.
 """
 
-__all__ = ["LANES", "word_to_lanes", "lanes_to_word", "beat_lanes", "PINS_PER_BUS"]
+__all__ = ["LANES", "word_to_lanes", "lanes_to_word", "beat_lanes", "cycle_lanes", "PINS_PER_BUS"]
 
 PINS_PER_BUS = 16
 
@@ -39,6 +39,15 @@ def beat_lanes(buses):
     pairs = ("AB", "CD")[:buses // 2]
     return tuple((pair["AB".index(bus)], edge, 64 * i + lsb)
                  for i, pair in enumerate(pairs) for bus, edge, lsb in LANES)
+
+
+def cycle_lanes(buses, beats):
+    """(bus, edge index, first bit) of every 16-bit lane of a ``dmd`` cycle of ``beats`` beats:
+    beat ``b`` (bits ``b * 32 * buses`` up of the cycle's words) travels on edges ``2b``
+    (rising) and ``2b + 1`` (falling) of :func:`gateware.dlpc410.interface.din_layout`."""
+    width = 32 * buses
+    return tuple((bus, 2 * b + (0 if edge == "rise" else 1), b * width + lsb)
+                 for b in range(beats) for bus, edge, lsb in beat_lanes(buses))
 
 
 def word_to_lanes(word):

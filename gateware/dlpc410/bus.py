@@ -14,6 +14,8 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
 
+from spec.schedule import row_cycles
+
 from ..registers import TIME_BITS, Registers, ResetMode
 from .interface import BlockMode, RowMode
 from .layouts import COUNTER_BITS, Command, event, group_bits, ready_load
@@ -28,8 +30,10 @@ class Bus(wiring.Component):
     Parameters
     ----------
     dmd : :class:`spec.facts.DmdType`
-        A row cycle is ``dclk_per_row`` cycles; a clear takes ``clear_row_cycles`` of them (the
-        clear, then no-op rows with DVALID high).
+        A clear takes ``clear_row_cycles`` row cycles (the clear, then no-op rows with DVALID
+        high).
+    beats : int
+        DCLK beats per cycle: a row cycle is ``dclk_per_row // beats`` cycles.
 
     Members
     -------
@@ -44,20 +48,20 @@ class Bus(wiring.Component):
         From the planner.
     loads : In(stream.Signature(ready_load))
         Ready loads from the requester, taken when their last operation is made.
-    beats : In(stream.Signature(bits_per_dclk)); row_ready : In(1)
-        Row data, one beat taken per cycle of a row cycle that loads a row.
+    beats : In(stream.Signature(bits_per_dclk * beats)); row_ready : In(1)
+        Row data, one cycle's beats taken per cycle of a row cycle that loads a row.
     pulse : Out(event(group))
         A clocking pulse of this group is made this cycle.
     loaded : Out(event(group))
         This group's load ended this cycle (its last operation's last row cycle).
-    dvalid : Out(1); command : Out(Command); beat : Out(bits_per_dclk)
+    dvalid : Out(1); command : Out(Command); beat : Out(bits_per_dclk * beats)
         The registered pins of the row cycles.
     underruns : Out(COUNTER_BITS)
         Decisions that waited for row data.
     """
 
-    def __init__(self, dmd):
-        self._dmd = dmd
+    def __init__(self, dmd, *, beats=1):
+        self._dmd, self._beats = dmd, beats
         gb = group_bits(dmd)
         super().__init__({
             "regs": In(Registers),
@@ -70,20 +74,20 @@ class Bus(wiring.Component):
             "imminent": In(1),
             "imminent_clear": In(1),
             "loads": In(stream.Signature(ready_load(dmd))),
-            "beats": In(stream.Signature(dmd.bits_per_dclk)),
+            "beats": In(stream.Signature(dmd.bits_per_dclk * beats)),
             "row_ready": In(1),
             "pulse": Out(event(gb)),
             "loaded": Out(event(gb)),
             "dvalid": Out(1),
             "command": Out(Command),
-            "beat": Out(dmd.bits_per_dclk),
+            "beat": Out(dmd.bits_per_dclk * beats),
             "underruns": Out(COUNTER_BITS),
         })
 
     def elaborate(self, platform):
         m = Module()
         dmd, regs, now = self._dmd, self.regs, self.now
-        R = dmd.dclk_per_row
+        R = row_cycles(dmd, self._beats)
         rpb = dmd.rows_per_block
         gb = group_bits(dmd)
 

@@ -57,9 +57,10 @@ class FrameControl(wiring.Component):
         The groups run (pulses and loads may be made).
     flushing : Out(1)
         Stale loads are being dropped.
-    triggers, overruns, early : Out(COUNTER_BITS)
-        Triggers obeyed; ignored because a frame played or was not loaded yet; before the groups
-        ran.
+    triggers, overruns, early, held : Out(COUNTER_BITS)
+        Triggers obeyed; ignored because a frame played or was not loaded yet (and one was held
+        already, or ``trigger_hold`` is low); before the groups ran; held until every group was
+        ready (``trigger_hold``).
     """
 
     def __init__(self, dmd):
@@ -86,6 +87,7 @@ class FrameControl(wiring.Component):
             "triggers": Out(COUNTER_BITS),
             "overruns": Out(COUNTER_BITS),
             "early": Out(COUNTER_BITS),
+            "held": Out(COUNTER_BITS),
         })
 
     def elaborate(self, platform):
@@ -131,11 +133,12 @@ class FrameControl(wiring.Component):
                 m.d.comb += self.running.eq(1)
                 queue_first_planes()
 
-        # A newer frame offered while no group plays replaces the preloaded first planes; nothing
+        # A newer streamed frame offered while no group plays replaces the preloaded first planes (the
+        # next frame of a stored sequence waits for its turn); nothing
         # abandoned is pulsed (no trigger is obeyed before every group is loaded again), and the
         # settle times of the last pulses still hold. With ``reload`` at rest, the same frame is
         # loaded again under new registers.
-        newer = ~use_prng & ~regs.chain & self.offer.valid
+        newer = ~use_prng & ~regs.chain & self.offer.valid & ~self.offer.sequence
         idle = fsm.ongoing("RUN") & ~self.playing
         resting = fsm.ongoing("RUN") & self.all_ready
         m.d.comb += [take_idle.eq((idle & newer) | (resting & self.reload)),
@@ -146,12 +149,26 @@ class FrameControl(wiring.Component):
                          self.retake.payload.lead.eq(now + regs.reload_lead + wait)]
             m.d.sync += [start_group.eq(0), flush_until.eq(now + wait)]
 
+        # a trigger is obeyed when every group is ready; one that comes sooner is held (with
+        # ``trigger_hold``) and obeyed on the first cycle they are, before any new one
+        holding = Signal()
+        ready = self.running & self.all_ready & ~take_idle
+        release = holding & ready
+
+        def obey():
+            m.d.comb += [self.trigger.valid.eq(1), self.trigger.payload.eq((now + 2) & ~1)]
+            m.d.sync += self.triggers.eq(self.triggers + 1)
+
+        with m.If(release):
+            obey()
+            m.d.sync += holding.eq(0)
         with m.If(self.strobe):
             with m.If(~self.running):
                 m.d.sync += self.early.eq(self.early + 1)
-            with m.Elif(self.all_ready & ~take_idle):
-                m.d.comb += [self.trigger.valid.eq(1), self.trigger.payload.eq((now + 2) & ~1)]
-                m.d.sync += self.triggers.eq(self.triggers + 1)
+            with m.Elif(ready & ~release):
+                obey()
+            with m.Elif(regs.trigger_hold & (~holding | release)):
+                m.d.sync += [holding.eq(1), self.held.eq(self.held + 1)]
             with m.Else():
                 m.d.sync += self.overruns.eq(self.overruns + 1)
         return m

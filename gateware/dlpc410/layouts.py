@@ -59,7 +59,7 @@ class Status(data.Struct):
     the next one was not loaded yet; ``early`` triggers before initialisation ended; ``late``
     pulses made after their time (a parameter set the schedule model rejects); ``underruns``
     bus decisions that waited for row data from the store; ``bad_frames`` frames offered with
-    a bit depth outside 1..8, dropped.
+    a bit depth outside 1..8, dropped; ``held`` triggers held until every group was ready.
     """
     now: TIME_BITS
     frames: COUNTER_BITS
@@ -69,3 +69,4 @@ class Status(data.Struct):
     late: COUNTER_BITS
     underruns: COUNTER_BITS
     bad_frames: COUNTER_BITS
+    held: COUNTER_BITS

@@ -14,7 +14,7 @@ from amaranth import Array, Cat, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from spec.schedule import INIT_TO_DVALID
+from spec.schedule import INIT_TO_DVALID, row_cycles
 
 from ..registers import TIME_BITS, Registers, Source
 from ..store.layouts import SLOT_BITS, FrameInfo
@@ -25,10 +25,13 @@ __all__ = ["Planner", "Offer"]
 
 
 class Offer(data.Struct):
-    """The frame the store offers now: ``valid`` when it has a bit depth the sequencer plays."""
+    """The frame the store offers now: ``valid`` when it has a bit depth the sequencer plays;
+    ``sequence`` when it is the next frame of a stored sequence (it does not replace a frame
+    waiting for its trigger)."""
     valid: 1
     slot: SLOT_BITS
     depth: 4
+    sequence: 1
 
 
 class Planner(wiring.Component):
@@ -37,6 +40,8 @@ class Planner(wiring.Component):
     Parameters
     ----------
     dmd : :class:`spec.facts.DmdType`
+    beats : int
+        DCLK beats per cycle (a row cycle's length in cycles).
 
     Members
     -------
@@ -86,8 +91,8 @@ class Planner(wiring.Component):
         Frames started; pulses made after their time; frames dropped for their bit depth.
     """
 
-    def __init__(self, dmd):
-        self._dmd = dmd
+    def __init__(self, dmd, *, beats=1):
+        self._dmd, self._beats = dmd, beats
         groups = dmd.blocks
         gb = group_bits(dmd)
         super().__init__({
@@ -120,7 +125,7 @@ class Planner(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         dmd, regs, now = self._dmd, self.regs, self.now
-        R = dmd.dclk_per_row
+        R = row_cycles(dmd, self._beats)
         G = dmd.blocks
         use_prng = regs.source == Source.PRNG
 
@@ -163,7 +168,8 @@ class Planner(wiring.Component):
         depth_in = self.frames.payload.bit_depth
         frame_ok = (depth_in != 0) & (depth_in <= 8)
         m.d.comb += [self.offer.valid.eq(self.frames.valid & frame_ok),
-                     self.offer.slot.eq(self.frames.payload.slot), self.offer.depth.eq(depth_in)]
+                     self.offer.slot.eq(self.frames.payload.slot), self.offer.depth.eq(depth_in),
+                     self.offer.sequence.eq(self.frames.payload.sequence)]
         with m.If(self.frames.valid & ~frame_ok):
             m.d.comb += self.frames.ready.eq(1)
             m.d.sync += self.bad_frames.eq(self.bad_frames + 1)

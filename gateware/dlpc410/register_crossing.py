@@ -59,19 +59,20 @@ class RegisterCrossing(wiring.Component):
         m = Module()
         m.submodules.fifo = crossing = fifo.AsyncFIFO(width=Registers.as_shape().size, depth=self._depth,
                                                       w_domain="sync", r_domain="dmd")
+        into, out = crossing.w_stream, crossing.r_stream
         # ---- sync: the mailbox, newest first ----
         pending = Signal(Registers)
         full = Signal()
-        m.d.comb += [crossing.w_data.eq(pending), crossing.w_en.eq(full), self.sets.ready.eq(1)]
+        m.d.comb += [into.payload.eq(pending), into.valid.eq(full), self.sets.ready.eq(1)]
         with m.If(self.sets.valid):
             m.d.sync += [pending.eq(self.sets.payload), full.eq(1)]
-            with m.If(full & ~crossing.w_rdy):
+            with m.If(full & ~into.ready):
                 m.d.sync += self.superseded.eq(self.superseded + 1)
-        with m.Elif(crossing.w_rdy):
+        with m.Elif(into.ready):
             m.d.sync += full.eq(0)
 
         # ---- dmd: applied whole, while the sequencer rests ----
-        with m.If(crossing.r_rdy & self.at_rest):
-            m.d.comb += [crossing.r_en.eq(1), self.reload.eq(1)]
-            m.d.dmd += [self.regs.eq(crossing.r_data), self.applied.eq(self.applied + 1)]
+        with m.If(out.valid & self.at_rest):
+            m.d.comb += [out.ready.eq(1), self.reload.eq(1)]
+            m.d.dmd += [self.regs.eq(out.payload), self.applied.eq(self.applied + 1)]
         return m

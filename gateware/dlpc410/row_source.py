@@ -10,11 +10,11 @@ The row source also counts the words asked of the store and not yet taken: when 
 control flushes stale loads, those still owed are discarded as they arrive.
 """
 
-from amaranth import Cat, Module, Mux, Signal
+from amaranth import Array, Cat, Module, Mux, Signal
 from amaranth.lib import fifo, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from spec.schedule import WORD_FIFO_ROWS
+from spec.schedule import WORD_FIFO_ROWS, row_cycles
 
 from ..registers import Registers, Source
 from .prng import Prng
@@ -39,24 +39,26 @@ class RowSource(wiring.Component):
         A request for ``rows_per_block`` rows was taken by the store this cycle.
     flushing : In(1)
         Discard the words still owed (while the bus reads none).
-    beats : Out(stream.Signature(bits_per_dclk))
-        One beat per DCLK cycle of a row; the bus takes one a cycle through a row.
+    beats : Out(stream.Signature(bits_per_dclk * beats))
+        One cycle's beats of a row; the bus takes one a cycle through a row.
     row_ready : Out(1)
-        A whole row of beats is there (always, from the pattern source).
+        A whole row is there (always, from the pattern source).
     owed : Out(range(...))
         Words asked of the store and not yet taken.
     seed, reseed : In(64), In(1)
         Seed of the pattern source.
     """
 
-    def __init__(self, dmd):
-        self._dmd = dmd
+    def __init__(self, dmd, *, beats=1, store_words=1):
+        width = dmd.bits_per_dclk * beats
+        assert width % (64 * store_words) == 0
+        self._dmd, self._beats, self._store_words = dmd, beats, store_words
         super().__init__({
             "regs": In(Registers),
-            "words": In(stream.Signature(64)),
+            "words": In(stream.Signature(64 * store_words)),
             "asked": In(1),
             "flushing": In(1),
-            "beats": Out(stream.Signature(dmd.bits_per_dclk)),
+            "beats": Out(stream.Signature(width)),
             "row_ready": Out(1),
             "owed": Out(range((dmd.blocks + 2) * dmd.words_per_plane + 1)),
             "seed": In(64),
@@ -66,24 +68,29 @@ class RowSource(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         dmd = self._dmd
-        R = dmd.dclk_per_row
-        wpb = dmd.bits_per_dclk // 64         # words per beat
+        R = row_cycles(dmd, self._beats)
+        width = dmd.bits_per_dclk * self._beats
+        wpc = width // 64                      # words per cycle
         use_prng = self.regs.source == Source.PRNG
 
-        m.submodules.prng = prng = Prng(words=wpb)
-        m.submodules.fifo = buffer = fifo.SyncFIFOBuffered(width=dmd.bits_per_dclk, depth=WORD_FIFO_ROWS * R)
+        m.submodules.prng = prng = Prng(words=wpc)
+        m.submodules.fifo = buffer = fifo.SyncFIFOBuffered(width=width, depth=WORD_FIFO_ROWS * R)
         m.d.comb += [prng.seed.eq(self.seed), prng.reseed.eq(self.reseed)]
-        if wpb == 1:
+        transfers = wpc // self._store_words   # store transfers per cycle of the row
+        if transfers == 1:
             wiring.connect(m, wiring.flipped(self.words), buffer.w_stream)
         else:
-            # four buses: the first word of a beat waits for the second (A/B, then C/D)
-            first = Signal(64)
-            have = Signal()
-            m.d.comb += [buffer.w_stream.payload.eq(Cat(first, self.words.payload)),
-                         buffer.w_stream.valid.eq(self.words.valid & have),
-                         self.words.ready.eq(~have | buffer.w_stream.ready)]
+            # the first transfers of a cycle wait for its last one (a cycle's words in order)
+            held = Array(Signal(64 * self._store_words, name=f"held{i}") for i in range(transfers - 1))
+            count = Signal(range(transfers))
+            last = count == transfers - 1
+            m.d.comb += [buffer.w_stream.payload.eq(Cat(*held, self.words.payload)),
+                         buffer.w_stream.valid.eq(self.words.valid & last),
+                         self.words.ready.eq(~last | buffer.w_stream.ready)]
             with m.If(self.words.valid & self.words.ready):
-                m.d.sync += [first.eq(self.words.payload), have.eq(~have)]
+                m.d.sync += count.eq(Mux(last, 0, count + 1))
+                with m.If(~last):
+                    m.d.sync += held[count].eq(self.words.payload)
 
         out = buffer.r_stream
         discard = self.flushing & ~self.beats.ready & (self.owed != 0)
@@ -95,5 +102,5 @@ class RowSource(wiring.Component):
             self.row_ready.eq(use_prng | (buffer.level >= R)),
         ]
         asked = Mux(self.asked, dmd.rows_per_block * dmd.words_per_row, 0)
-        m.d.sync += self.owed.eq(self.owed + asked - Mux(out.ready & out.valid, wpb, 0))
+        m.d.sync += self.owed.eq(self.owed + asked - Mux(out.ready & out.valid, wpc, 0))
         return m

@@ -28,7 +28,7 @@ from ..queue import Queue
 from ..registers import Registers, ResetMode
 from ..store.layouts import SLOT_BITS, FrameInfo, PlaneRequest
 from . import interface
-from .beat import beat_lanes
+from .beat import cycle_lanes
 from .bus import Bus
 from .camera import CameraTrigger
 from .control import FrameControl
@@ -51,8 +51,13 @@ class Sequencer(wiring.Component):
         Geometry: a beat of ``bits_per_dclk`` bits per DCLK cycle (one 64-bit word on A/B, and
         a second on C/D for four buses), ``dclk_per_row`` beats per row; a block clear takes
         ``clear_row_cycles`` row cycles (1080p: the clear and two no-op rows; facts table).
-        The store gives one word per cycle at most, so a four-bus DMD loads a row every two
-        row cycles at best (the plan's ``row_period``).
+    beats : int
+        DCLK cycles per ``dmd`` cycle: 1 (DCLK = the ``dmd`` clock, 200 MHz) or 2 (400 MHz,
+        through the platform's 4:1 serialisers). A row cycle is ``dclk_per_row // beats`` cycles.
+    store_words : int
+        64-bit words per transfer on ``words`` (1 or 2). A row loads every row cycle when the
+        store keeps up with ``bits_per_dclk * beats / 64`` words a cycle; else the plan's
+        ``row_period`` spaces the rows.
 
     Members
     -------
@@ -83,8 +88,8 @@ class Sequencer(wiring.Component):
         first plane is then loaded again from the new frame (a trigger meanwhile is an overrun).
     requests : Out(stream.Signature(PlaneRequest))
         Rows to read, one block of one plane per request, in load order.
-    words : In(stream.Signature(64))
-        The requested rows' words, in order (paired into beats for four buses).
+    words : In(stream.Signature(64 * store_words))
+        The requested rows' words, in order, the first in the low bits.
     occ_slot : Out(SLOT_BITS), occupancy : In(ArrayLayout(8, blocks))
         Occupancy read port: per block a byte, bit k set when stored plane k has a bit set
         in the block, for slot ``occ_slot`` as it was one cycle earlier.
@@ -96,12 +101,13 @@ class Sequencer(wiring.Component):
     status : Out(Status)
     """
 
-    def __init__(self, dmd):
+    def __init__(self, dmd, *, beats=1, store_words=1):
         assert dmd.buses in (2, 4) and dmd.bits_per_dclk == 32 * dmd.buses
         assert dmd.words_per_row * 64 == dmd.dclk_per_row * dmd.bits_per_dclk
-        self._dmd = dmd
+        assert beats in (1, 2) and dmd.dclk_per_row % beats == 0 and dmd.dclk_per_row // beats >= 2
+        self._dmd, self._beats, self._store_words = dmd, beats, store_words
         super().__init__({
-            "pins": Out(interface.Signature(dmd.buses)),
+            "pins": Out(interface.Signature(dmd.buses, beats)),
             "regs": In(Registers),
             "at_rest": Out(1),
             "reload": In(1),
@@ -112,7 +118,7 @@ class Sequencer(wiring.Component):
             "camera_out": Out(1),
             "frames": In(stream.Signature(FrameInfo)),
             "requests": Out(stream.Signature(PlaneRequest)),
-            "words": In(stream.Signature(64)),
+            "words": In(stream.Signature(64 * store_words)),
             "occ_slot": Out(SLOT_BITS),
             "occupancy": In(data.ArrayLayout(8, dmd.blocks)),
             "seed": In(64),
@@ -123,18 +129,18 @@ class Sequencer(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        dmd, regs = self._dmd, self.regs
+        dmd, regs, beats = self._dmd, self.regs, self._beats
         G = dmd.blocks
 
         m.submodules.init = init = Init()
         m.submodules.trigger = trig = Trigger()
-        m.submodules.planner = planner = Planner(dmd)
+        m.submodules.planner = planner = Planner(dmd, beats=beats)
         m.submodules.control = control = FrameControl(dmd)
         m.submodules.jobs = jobs = Queue(load_job(dmd), depth=G + 1)
         m.submodules.requester = requester = Requester(dmd)
         m.submodules.loads = loads = Queue(ready_load(dmd), depth=G + 1)
-        m.submodules.row_source = source = RowSource(dmd)
-        m.submodules.bus = bus = Bus(dmd)
+        m.submodules.row_source = source = RowSource(dmd, beats=beats, store_words=self._store_words)
+        m.submodules.bus = bus = Bus(dmd, beats=beats)
         m.submodules.camera = camera = CameraTrigger()
         m.d.comb += [
             init.ecp2_finished.eq(self.pins.ecp2_finished),
@@ -224,28 +230,31 @@ class Sequencer(wiring.Component):
             self.status.triggers.eq(control.triggers),
             self.status.overruns.eq(control.overruns),
             self.status.early.eq(control.early),
+            self.status.held.eq(control.held),
             self.status.underruns.eq(bus.underruns),
         ]
 
         # ---- pins ----
-        toggle = Signal()
-        m.d.sync += toggle.eq(~toggle)
         pins = self.pins
+        edges = 2 * beats
         m.d.comb += [pins.arstz.eq(1), pins.wdt_enblz.eq(1), pins.comp_data.eq(0),
                      pins.ns_flip.eq(regs.ns_flip), pins.pwr_float.eq(regs.park)]
         with m.If(init.training):
-            # the four edges of the pattern over two cycles; DVALID (one bit per cycle in the
-            # core) carries the falling-edge bits, the platform layer's DDR output the rest
-            rise = Mux(toggle, TRAINING_EDGES[2], TRAINING_EDGES[0])
-            fall = Mux(toggle, TRAINING_EDGES[3], TRAINING_EDGES[1])
-            for bus_name in "abcd"[:dmd.buses]:
-                m.d.comb += [getattr(pins, f"din_{bus_name}").rise.eq(rise.replicate(16)),
-                             getattr(pins, f"din_{bus_name}").fall.eq(fall.replicate(16))]
-            m.d.comb += [pins.dvalid.eq(fall), pins.rst2blkz.eq(1)]
+            # the pattern's four edges span two DCLK cycles: one dmd cycle at two beats, two
+            # cycles at one beat (the phase alternates); every data pin and DVALID carry it
+            phase = Signal()
+            m.d.sync += phase.eq(~phase)
+            for e in range(edges):
+                bit = Mux(phase, TRAINING_EDGES[(e + 2) % 4], TRAINING_EDGES[e]) if beats == 1 else TRAINING_EDGES[e]
+                for bus_name in "abcd"[:dmd.buses]:
+                    m.d.comb += getattr(pins, f"din_{bus_name}")[e].eq(Mux(bit, 0xFFFF, 0))
+                m.d.comb += pins.dvalid[e].eq(bit)
+            m.d.comb += pins.rst2blkz.eq(1)
         with m.Else():
-            for bus_name, edge, lsb in beat_lanes(dmd.buses):
-                m.d.comb += getattr(getattr(pins, f"din_{bus_name.lower()}"), edge).eq(bus.beat[lsb:lsb + 16])
+            for bus_name, edge, lsb in cycle_lanes(dmd.buses, beats):
+                m.d.comb += getattr(pins, f"din_{bus_name.lower()}")[edge].eq(bus.beat[lsb:lsb + 16])
             cmd = bus.command
-            m.d.comb += [pins.dvalid.eq(bus.dvalid), pins.rowmd.eq(cmd.rowmd), pins.rowad.eq(cmd.rowad),
-                         pins.blkmd.eq(cmd.blkmd), pins.blkad.eq(cmd.blkad), pins.rst2blkz.eq(cmd.rst2blkz)]
+            m.d.comb += [pins.dvalid.eq(bus.dvalid.replicate(edges)), pins.rowmd.eq(cmd.rowmd),
+                         pins.rowad.eq(cmd.rowad), pins.blkmd.eq(cmd.blkmd), pins.blkad.eq(cmd.blkad),
+                         pins.rst2blkz.eq(cmd.rst2blkz)]
         return m

@@ -89,6 +89,9 @@ class RxCrossing(wiring.Component):
         w = self._w_domain
         m.submodules.fifo = fifo = AsyncFIFO(width=len(self.i.payload.as_value()), depth=self._depth,
                                              w_domain=w, r_domain=self._r_domain)
+        # The write side takes no notice of ``ready``: room is judged from the level (see above).
+        into = fifo.w_stream
+        wiring.connect(m, fifo.r_stream, wiring.flipped(self.o))
 
         free = Signal(range(self._depth + 1))
         m.d.comb += free.eq(self._depth - fifo.w_level)
@@ -102,27 +105,21 @@ class RxCrossing(wiring.Component):
             with m.If(writing):
                 with m.If(free <= self._MARGIN):
                     # Out of room mid-frame: this byte ends the frame, marked bad.
-                    m.d.comb += [cut.eq(1), fifo.w_en.eq(1)]
+                    m.d.comb += [cut.eq(1), into.valid.eq(1)]
                     m.d[w] += [writing.eq(0), discarding.eq(~beat.last), self.dropped.eq(self.dropped + 1)]
                 with m.Else():
-                    m.d.comb += fifo.w_en.eq(1)
+                    m.d.comb += into.valid.eq(1)
                     m.d[w] += writing.eq(~beat.last)
             with m.Elif(discarding):
                 m.d[w] += discarding.eq(~beat.last)
             with m.Elif(free > self._room):
-                m.d.comb += fifo.w_en.eq(1)
+                m.d.comb += into.valid.eq(1)
                 m.d[w] += writing.eq(~beat.last)
             with m.Else():
                 m.d[w] += [discarding.eq(~beat.last), self.dropped.eq(self.dropped + 1)]
 
         marked = ByteBeat.const({"data": 0, "last": 1, "user": 1}).as_value()
-        m.d.comb += fifo.w_data.eq(Mux(cut, beat.as_value() | marked, beat.as_value()))
-
-        m.d.comb += [
-            self.o.valid.eq(fifo.r_rdy),
-            self.o.payload.eq(fifo.r_data),
-            fifo.r_en.eq(self.o.ready),
-        ]
+        m.d.comb += into.payload.eq(Mux(cut, beat.as_value() | marked, beat.as_value()))
         return m
 
 
@@ -158,11 +155,8 @@ class TxCrossing(wiring.Component):
         w, r = self._w_domain, self._r_domain
         m.submodules.fifo = fifo = AsyncFIFO(width=len(self.i.payload.as_value()), depth=self._depth,
                                              w_domain=w, r_domain=r)
-        m.d.comb += [
-            fifo.w_en.eq(self.i.valid),
-            fifo.w_data.eq(self.i.payload),
-            self.i.ready.eq(fifo.w_rdy),
-        ]
+        wiring.connect(m, wiring.flipped(self.i), fifo.w_stream)
+        out = fifo.r_stream
 
         # Complete frames written, and taken; at most ``depth`` frames are ever in flight.
         width = ceil_log2(self._depth) + 2
@@ -181,8 +175,8 @@ class TxCrossing(wiring.Component):
         whole_frame = written.o != taken
         full = fifo.r_level >= self._depth - 1
         m.d.comb += [
-            self.o.valid.eq(fifo.r_rdy & (sending | whole_frame | full)),
-            self.o.payload.eq(fifo.r_data),
-            fifo.r_en.eq(self.o.ready & self.o.valid),
+            self.o.valid.eq(out.valid & (sending | whole_frame | full)),
+            self.o.payload.eq(out.payload),
+            out.ready.eq(self.o.ready & self.o.valid),
         ]
         return m

@@ -115,13 +115,14 @@ class Stack(wiring.Component):
         connect(m, transmitter.tx, wiring.flipped(self.tx))
 
         counters = self.counters
-        self._receive(m, tap, buffer, fifo, desc_layout, eth, arp_check, ip, icmp_check, udp_check, counters)
-        self._dispatch(m, buffer, fifo, desc_layout, transmitter, counters)
+        self._receive(m, tap, buffer, fifo.w_stream, desc_layout, eth, arp_check, ip, icmp_check, udp_check,
+                      counters)
+        self._dispatch(m, buffer, fifo.r_stream, desc_layout, transmitter, counters)
         connect(m, wiring.flipped(self.reply_request), transmitter.requests[1])
         connect(m, wiring.flipped(self.reply_body), transmitter.bodies[1])
         return m
 
-    def _receive(self, m, tap, buffer, fifo, desc_layout, eth, arp_check, ip, icmp_check, udp_check,
+    def _receive(self, m, tap, buffer, descriptors, desc_layout, eth, arp_check, ip, icmp_check, udp_check,
                  counters):
         offset = Signal(OFFSET_BITS)
         mac_bad = Signal()
@@ -210,10 +211,11 @@ class Stack(wiring.Component):
                     ]
                 m.next = "COMMIT"
             with m.State("COMMIT"):
-                keep = accept & fifo.w_rdy
+                # a frame is kept only if its descriptor fits: written now or dropped
+                keep = accept & descriptors.ready
                 m.d.comb += [
-                    fifo.w_en.eq(keep),
-                    fifo.w_data.eq(descriptor),
+                    descriptors.valid.eq(keep),
+                    descriptors.payload.eq(descriptor),
                     buffer.commit.eq(keep),
                     buffer.discard.eq(~keep),
                 ]
@@ -230,7 +232,7 @@ class Stack(wiring.Component):
                             m.d.sync += counter.eq(counter + 1)
                 m.next = "RECEIVE"
 
-    def _dispatch(self, m, buffer, fifo, desc_layout, transmitter, counters):
+    def _dispatch(self, m, buffer, descriptors, desc_layout, transmitter, counters):
         descriptor = Signal(desc_layout)
         request = transmitter.requests[0]
         body = transmitter.bodies[0]
@@ -248,9 +250,9 @@ class Stack(wiring.Component):
         out = buffer.data
         with m.FSM():
             with m.State("IDLE"):
-                m.d.comb += fifo.r_en.eq(1)
-                with m.If(fifo.r_rdy):
-                    m.d.sync += descriptor.eq(fifo.r_data)
+                m.d.comb += descriptors.ready.eq(1)
+                with m.If(descriptors.valid):
+                    m.d.sync += descriptor.eq(descriptors.payload)
                     m.next = "START"
             with m.State("START"):
                 with m.If(descriptor.kind == ReplyKind.UDP):

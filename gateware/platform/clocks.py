@@ -1,36 +1,58 @@
-"""Clocks of the projector on a Spartan-6: one PLL from the board oscillator.
+"""Clocks of the projector on a Spartan-6: PLLs from the board oscillator.
 
 =========  ==========  ===========================================
 domain     frequency   use
 =========  ==========  ===========================================
 sync       125 MHz     protocol, serialiser, DDR2 writer, status
-dmd        200 MHz     plane reader, sequencer, DIN/DVALID output registers
-dclk       200 MHz     DCLK forwarding only: 90 degrees after ``dmd``, so that each
-                       DCLK edge falls in the middle of a DIN bit
 gmii_tx    125 MHz     MAC transmit (forwarded to GTX_CLK)
+dmd        200 MHz     plane reader, sequencer, the DLPC410 link's parallel side
 =========  ==========  ===========================================
 
+The DLPC410 link, by DCLK:
+
+* **400 MHz** (the default; the DLPC410's newer PROM takes nothing else): a second PLL, VCO 800
+  MHz, gives ``dmd`` and two 800 MHz I/O clocks, each through a BUFPLL (``DIVIDE=4``) that makes
+  the serdes strobe: one for the data lanes (DIN, DVALID), one half a bit later (its PLL output
+  at 180 degrees, 625 ps: 90 degrees of DCLK) for the DCLK lanes (:mod:`.serdes`). ``dmd`` comes
+  from the same PLL, so the 4:1 serialisers' parallel and serial clocks are phase-aligned.
+* **200 MHz**: one PLL (VCO 1 GHz) gives every domain, and ``dclk``, 90 degrees after ``dmd``,
+  for DCLK forwarded through an ODDR2 so that each DCLK edge falls in the middle of a bit.
+
 ``gmii_rx`` comes from the PHY's RX_CLK and is made by the platform top. Each domain's reset is
-held until the PLL locks and released synchronously (:class:`amaranth.lib.cdc.ResetSynchronizer`).
-The domains belong to the top (``m.domains += Spartan6Clocks.domains()``); this block drives them.
+held until its PLL locks and released synchronously (:class:`amaranth.lib.cdc.ResetSynchronizer`).
+The domains belong to the top (``m.domains += Spartan6Clocks.domains(dclk_hz)``); this block
+drives them.
+
+To check on hardware (nothing here has been through ISE): both PLLs take the oscillator's input
+buffer (ISE may want a BUFIO2 or BUFG before the second), and both BUFPLLs must reach the bank of
+the DLPC410 adapter's pins.
 """
 
 from amaranth import ClockDomain, ClockSignal, Elaboratable, Instance, Module, Signal
 from amaranth.lib.cdc import ResetSynchronizer
 
-__all__ = ["Spartan6Clocks", "PLL_PLAN"]
+__all__ = ["Spartan6Clocks", "PLANS", "DCLK_HZ"]
 
-#: VCO = 100 MHz x 10 = 1 GHz (inside Spartan-6 -3's 400-1080 MHz range); outputs divide it.
-PLL_PLAN = {
-    "input_mhz": 100.0,
-    "mult": 10,
-    "outputs": {"sync": 8, "dmd": 5, "dclk": 5, "gmii_tx": 8},
-    "phases": {"dclk": 90.0},
+#: The default DCLK.
+DCLK_HZ = 400e6
+
+#: PLLs by DCLK: each ``{"mult", "outputs": {name: divide}, "phases": {name: degrees}}`` from a
+#: 100 MHz input (VCO inside Spartan-6 -3's 400-1080 MHz). Outputs named ``io_*`` feed BUFPLLs,
+#: the others BUFGs that drive the domain of that name.
+PLANS = {
+    200e6: [
+        {"mult": 10, "outputs": {"sync": 8, "dmd": 5, "dclk": 5, "gmii_tx": 8}, "phases": {"dclk": 90.0}},
+    ],
+    400e6: [
+        {"mult": 10, "outputs": {"sync": 8, "gmii_tx": 8}, "phases": {}},
+        {"mult": 8, "outputs": {"io_data": 1, "io_dclk": 1, "dmd": 4}, "phases": {"io_dclk": 180.0}},
+    ],
 }
+INPUT_MHZ = 100.0
 
 
 class Spartan6Clocks(Elaboratable):
-    """PLL_BASE + BUFGs for ``sync``, ``dmd`` and ``gmii_tx``.
+    """PLL_BASEs, BUFGs and (at DCLK 400 MHz) BUFPLLs.
 
     Parameters
     ----------
@@ -38,44 +60,66 @@ class Spartan6Clocks(Elaboratable):
         The board oscillator (100 MHz on the Atlys).
     rst_in : Signal
         Board reset button (active high).
+    dclk_hz : float
+        DCLK: 400 MHz or 200 MHz.
+
+    Attributes
+    ----------
+    locked : Signal
+        Every PLL locked.
+    io : dict
+        At 400 MHz: ``{"data": (ioclk, strobe), "dclk": (ioclk, strobe)}`` of the BUFPLLs.
     """
 
-    def __init__(self, clk_in, rst_in):
+    def __init__(self, clk_in, rst_in, dclk_hz=DCLK_HZ):
         self.clk_in = clk_in
         self.rst_in = rst_in
+        self.dclk_hz = dclk_hz
         self.locked = Signal()
+        self.io = {name: (Signal(name=f"ioclk_{name}"), Signal(name=f"strobe_{name}"))
+                   for name in ("data", "dclk")} if dclk_hz == 400e6 else {}
 
     @staticmethod
-    def domains():
+    def domains(dclk_hz=DCLK_HZ):
         """The clock domains this block drives; the top that owns them adds them."""
-        return [ClockDomain(name) for name in PLL_PLAN["outputs"]]
+        return [ClockDomain(name) for plan in PLANS[dclk_hz] for name in plan["outputs"]
+                if not name.startswith("io_")]
 
     @staticmethod
-    def frequencies():
+    def frequencies(dclk_hz=DCLK_HZ):
         """``{domain: Hz}`` of the plan."""
-        vco = PLL_PLAN["input_mhz"] * PLL_PLAN["mult"]
-        return {name: vco / div * 1e6 for name, div in PLL_PLAN["outputs"].items()}
+        return {name: INPUT_MHZ * plan["mult"] / div * 1e6 for plan in PLANS[dclk_hz]
+                for name, div in plan["outputs"].items() if not name.startswith("io_")}
 
     def elaborate(self, platform):
         m = Module()
-        feedback = Signal()
-        names = list(PLL_PLAN["outputs"])
-        raw = {name: Signal(name=f"pll_{name}") for name in names}
-        params = dict(
-            p_BANDWIDTH="OPTIMIZED", p_CLK_FEEDBACK="CLKFBOUT", p_COMPENSATION="INTERNAL",
-            p_CLKIN_PERIOD=1000 / PLL_PLAN["input_mhz"], p_DIVCLK_DIVIDE=1,
-            p_CLKFBOUT_MULT=PLL_PLAN["mult"], p_CLKFBOUT_PHASE=0.0,
-            i_CLKIN=self.clk_in, i_RST=self.rst_in, i_CLKFBIN=feedback,
-            o_CLKFBOUT=feedback, o_LOCKED=self.locked,
-        )
-        for i, name in enumerate(names):
-            params[f"p_CLKOUT{i}_DIVIDE"] = PLL_PLAN["outputs"][name]
-            params[f"p_CLKOUT{i}_PHASE"] = PLL_PLAN["phases"].get(name, 0.0)
-            params[f"p_CLKOUT{i}_DUTY_CYCLE"] = 0.5
-            params[f"o_CLKOUT{i}"] = raw[name]
-        m.submodules.pll = Instance("PLL_BASE", **params)
+        plans = PLANS[self.dclk_hz]
+        locks = []
+        clk_in = self.clk_in
+        raw = {}
+        for index, plan in enumerate(plans):
+            feedback, lock = Signal(name=f"pll{index}_feedback"), Signal(name=f"pll{index}_locked")
+            params = dict(
+                p_BANDWIDTH="OPTIMIZED", p_CLK_FEEDBACK="CLKFBOUT", p_COMPENSATION="INTERNAL",
+                p_CLKIN_PERIOD=1000 / INPUT_MHZ, p_DIVCLK_DIVIDE=1, p_CLKFBOUT_MULT=plan["mult"],
+                p_CLKFBOUT_PHASE=0.0, i_CLKIN=clk_in, i_RST=self.rst_in, i_CLKFBIN=feedback,
+                o_CLKFBOUT=feedback, o_LOCKED=lock,
+            )
+            for i, (name, divide) in enumerate(plan["outputs"].items()):
+                raw[name] = Signal(name=f"pll_{name}")
+                params.update({f"p_CLKOUT{i}_DIVIDE": divide, f"p_CLKOUT{i}_DUTY_CYCLE": 0.5,
+                               f"p_CLKOUT{i}_PHASE": plan["phases"].get(name, 0.0), f"o_CLKOUT{i}": raw[name]})
+            m.submodules[f"pll{index}"] = Instance("PLL_BASE", **params)
+            locks.append(lock)
+        m.d.comb += self.locked.eq(sum(locks) == len(locks))
 
-        for name in names:
-            m.submodules[f"bufg_{name}"] = Instance("BUFG", i_I=raw[name], o_O=ClockSignal(name))
-            m.submodules[f"rst_{name}"] = ResetSynchronizer(~self.locked, domain=name)
+        for name, signal in raw.items():
+            if not name.startswith("io_"):
+                m.submodules[f"bufg_{name}"] = Instance("BUFG", i_I=signal, o_O=ClockSignal(name))
+                m.submodules[f"rst_{name}"] = ResetSynchronizer(~self.locked, domain=name)
+        for name, (ioclk, strobe) in self.io.items():
+            m.submodules[f"bufpll_{name}"] = Instance(
+                "BUFPLL", p_DIVIDE=4, p_ENABLE_SYNC="TRUE",
+                i_PLLIN=raw[f"io_{name}"], i_GCLK=ClockSignal("dmd"), i_LOCKED=self.locked,
+                o_IOCLK=ioclk, o_SERDESSTROBE=strobe)
         return m

@@ -5,12 +5,14 @@ The core gives plain signals per clock cycle; here they become IOB registers, DD
 vendor primitives, and these adapters are checked by building the Spartan-6 tree.
 """
 
-from amaranth import ClockSignal, Elaboratable, Instance, Module, Signal
+from amaranth import ClockSignal, Const, Elaboratable, Instance, Module, ResetSignal, Signal
 from amaranth.lib import io
 from amaranth.lib.cdc import FFSynchronizer, ResetSynchronizer
 
 from gateware.dlpc410.interface import Signature as Dlpc410Signature
 from gateware.mac.gmii import RxPins, TxPins
+
+from .serdes import DCLK_BITS, Oserdes4, lane_bits
 
 __all__ = ["GmiiPins", "Dlpc410Pins", "TriggerPins"]
 
@@ -82,41 +84,72 @@ class GmiiPins(Elaboratable):
 class Dlpc410Pins(Elaboratable):
     """The DLPC410 interface on the adapter board's pins.
 
-    Data and DVALID leave through ODDR2s clocked by ``dmd`` (rising-edge bit first); DCLK is
-    forwarded from ``dclk``, 90 degrees later, so its edges sit in the middle of each bit.
-    Inputs are registered in the IOBs and synchronised into ``dmd``.
+    DCLK 400 MHz (two beats a ``dmd`` cycle): data and DVALID leave through 4:1 OSERDES2s
+    (:mod:`.serdes`: four edges a cycle, edge 0 first), DCLK through one more whose I/O clock is
+    half a bit later. DCLK 200 MHz (one beat): data and DVALID through ODDR2s clocked by ``dmd``
+    (rising-edge bit first), DCLK forwarded from ``dclk``, 90 degrees later. Either way DCLK's
+    edges sit in the middle of each bit. Inputs are registered in the IOBs and synchronised into
+    ``dmd``.
 
     On a board without the adapter's second port (``platform.dlpc410_complete`` false) only
     bus A, DCLK and DVALID exist: the core's other outputs go nowhere and ECP2_FINISHED reads
     low, so the sequencer never leaves its initialisation wait.
+
+    Parameters
+    ----------
+    buses, beats : int
+        As :class:`gateware.dlpc410.interface.Signature`'s.
+    io : dict
+        At two beats, :attr:`gateware.platform.clocks.Spartan6Clocks.io`: the BUFPLLs' I/O clocks
+        and strobes for the data lanes and for DCLK.
 
     Attributes
     ----------
     bus : interface of :class:`gateware.dlpc410.interface.Signature`, flipped: the core drives it
     """
 
-    def __init__(self, buses=2):
-        self.bus = Dlpc410Signature(buses).flip().create()
+    def __init__(self, buses=2, beats=1, io=None):
+        assert beats == 1 or io, "two beats a cycle need the serialisers' I/O clocks"
+        self._beats, self._io = beats, io or {}
+        self.bus = Dlpc410Signature(buses, beats).flip().create()
 
-    def _ddr(self, m, name, port, rise, fall, domain="dmd"):
-        m.submodules[name] = buf = io.DDRBuffer("o", port, o_domain=domain)
-        m.d.comb += [buf.o[0].eq(rise), buf.o[1].eq(fall)]
+    def _lanes(self, m, name, port, edges):
+        """A pin bus (``port``, one pin per bit) sending ``edges`` (per edge, one bit per pin)."""
+        if self._beats == 1:
+            m.submodules[name] = buf = io.DDRBuffer("o", port, o_domain="dmd")
+            m.d.comb += [buf.o[0].eq(edges[0]), buf.o[1].eq(edges[1])]
+            return
+        ioclk, strobe = self._io["data"]
+        for pin in range(len(port)):
+            m.submodules[f"{name}_{pin}"] = buf = io.Buffer("o", port[pin])
+            m.submodules[f"{name}_{pin}_serdes"] = Oserdes4(
+                lane_bits(edges, pin), ioclk=ioclk, strobe=strobe, reset=ResetSignal("dmd"), out=buf.o)
+
+    def _dclk(self, m, name, port):
+        if self._beats == 1:
+            m.submodules[name] = buf = io.DDRBuffer("o", port, o_domain="dclk")
+            m.d.comb += [buf.o[0].eq(1), buf.o[1].eq(0)]
+            return
+        ioclk, strobe = self._io["dclk"]
+        m.submodules[name] = buf = io.Buffer("o", port)
+        m.submodules[f"{name}_serdes"] = Oserdes4([Const(b) for b in DCLK_BITS], ioclk=ioclk, strobe=strobe,
+                                                  reset=ResetSignal("dmd"), out=buf.o)
 
     def elaborate(self, platform):
         m = Module()
         bus = self.bus
         fast = platform.request("dlpc410", 0, dir="-")
-        self._ddr(m, "din_a", fast.din_a, bus.din_a.rise, bus.din_a.fall)
+        self._lanes(m, "din_a", fast.din_a, bus.din_a)
         for clk in ("dclk_a", "dclk_b"):
-            self._ddr(m, clk, getattr(fast, clk), 1, 0, domain="dclk")
+            self._dclk(m, clk, getattr(fast, clk))
         for valid in ("dvalid_a", "dvalid_b"):
-            self._ddr(m, valid, getattr(fast, valid), bus.dvalid, bus.dvalid)
+            self._lanes(m, valid, getattr(fast, valid), [bus.dvalid[e] for e in range(2 * self._beats)])
 
         if not getattr(platform, "dlpc410_complete", False):
             return m
 
         ext = platform.request("dlpc410_ext", 0, dir="-")
-        self._ddr(m, "din_b", ext.din_b, bus.din_b.rise, bus.din_b.fall)
+        self._lanes(m, "din_b", ext.din_b, bus.din_b)
         for name in ("rowmd", "rowad", "blkmd", "blkad", "rst2blkz", "comp_data", "ns_flip",
                      "wdt_enblz", "pwr_float", "arstz"):
             m.submodules[name] = buf = io.FFBuffer("o", getattr(ext, name), o_domain="dmd")

@@ -42,6 +42,8 @@ class Endpoint(wiring.Component):
         Width of the frame tag on ``pixels``.
     buffer_depth : int
         Bytes of the receive ring.
+    beats : int
+        DCLK beats per ``dmd`` cycle of the sequencer (see :class:`~gateware.protocol.parser.Parser`).
 
     Members
     -------
@@ -63,7 +65,8 @@ class Endpoint(wiring.Component):
     app_counters : Out(layout(records.APP_COUNTERS))
     """
 
-    def __init__(self, dmd, *, mac, ip, port, armed=False, frame_bits=4, buffer_depth=16384):
+    def __init__(self, dmd, *, mac, ip, port, armed=False, frame_bits=4, buffer_depth=16384, beats=1):
+        self._beats = beats
         self._dmd = dmd
         self._config = config_init(mac=mac, ip=ip, port=port, armed=armed)
         self._frame_bits = frame_bits
@@ -83,7 +86,7 @@ class Endpoint(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         m.submodules.stack = stack = Stack(buffer_depth=self._depth)
-        m.submodules.parser = parser = Parser(self._dmd, self._config)
+        m.submodules.parser = parser = Parser(self._dmd, self._config, beats=self._beats)
         m.submodules.rows = rows = RowAssembler(self._dmd, frame_bits=self._frame_bits)
         m.submodules.status_reply = reply = StatusReply()
 

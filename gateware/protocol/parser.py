@@ -16,6 +16,7 @@ from amaranth.lib.wiring import In, Out
 
 from spec import records, wire
 from spec.records import RecordType
+from spec.schedule import row_cycles
 
 from ..net.layouts import OFFSET_BITS, Datagram, Peer
 from ..registers import Registers, wire_registers
@@ -52,6 +53,8 @@ class Parser(wiring.Component):
     ----------
     dmd : :class:`spec.facts.DmdType`
         Rows and columns that image records must fit.
+    beats : int
+        DCLK beats per ``dmd`` cycle the sequencer is built for (its shortest ``row_period``).
     config : dict
         Initial configuration (:func:`config_init`).
 
@@ -75,8 +78,8 @@ class Parser(wiring.Component):
         Records accepted per type, dropped per cause, sequence gaps.
     """
 
-    def __init__(self, dmd, config):
-        self._dmd = dmd
+    def __init__(self, dmd, config, *, beats=1):
+        self._dmd, self._beats = dmd, beats
         super().__init__({
             "datagrams": In(stream.Signature(Datagram)),
             "pieces": Out(stream.Signature(piece_layout(dmd))),
@@ -164,7 +167,7 @@ class Parser(wiring.Component):
                        | (applies("sequence_length") & (control.sequence_length == 0)))):
             m.d.comb += cause.eq(1 + causes.index("value"))
         with m.Elif((header.type == RecordType.SEQUENCER)
-                    & Cat(records.register_faults(sequencer, dmd.dclk_per_row).values()).any()):
+                    & Cat(records.register_faults(sequencer, row_cycles(dmd, self._beats)).values()).any()):
             m.d.comb += cause.eq(1 + causes.index("value"))
 
         sequence_seen = Signal()

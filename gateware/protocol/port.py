@@ -25,7 +25,7 @@ class EthernetPort(wiring.Component):
     Parameters
     ----------
     dmd : :class:`spec.facts.DmdType`
-    mac, ip, port, armed, frame_bits, buffer_depth
+    mac, ip, port, armed, frame_bits, buffer_depth, beats
         As :class:`~gateware.protocol.endpoint.Endpoint`'s.
     max_frame : int
         Longest frame the receive MAC accepts, FCS included.
@@ -54,11 +54,11 @@ class EthernetPort(wiring.Component):
     """
 
     def __init__(self, dmd, *, mac, ip, port, armed=False, frame_bits=4, max_frame=gmii.MAX_JUMBO_FRAME_BYTES,
-                 rx_depth=16384, tx_depth=2048, buffer_depth=16384):
+                 rx_depth=16384, tx_depth=2048, buffer_depth=16384, beats=1):
         self._rx = ReceivePath(max_frame=max_frame, depth=rx_depth)
         self._tx = TransmitPath(depth=tx_depth)
         self._endpoint = Endpoint(dmd, mac=mac, ip=ip, port=port, armed=armed, frame_bits=frame_bits,
-                                  buffer_depth=buffer_depth)
+                                  buffer_depth=buffer_depth, beats=beats)
         super().__init__({
             "gmii_rx": In(gmii.RxPins),
             "gmii_tx": Out(gmii.TxPins),

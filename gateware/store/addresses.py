@@ -16,15 +16,17 @@ Byte addresses (``word_bytes`` = 8)::
 
 An XGA plane is 12,288 words (0x3000 words, 0x18000 bytes) as in the seed design. The same
 function computes addresses for the gateware (Amaranth values) and for the models (integers).
+Every row starts on a 16-byte boundary when ``words_per_row`` is even (every DMD here), so a
+128-bit memory port reads whole rows.
 """
 
-from .mcb import WORD_BYTES
-
-__all__ = ["AddressMap", "MEMORY_BYTES", "PLANES"]
+__all__ = ["AddressMap", "MEMORY_BYTES", "PLANES", "WORD_BYTES"]
 
 #: The Atlys DDR2 (MT47H64M16): 64 Mi x 16 bit = 128 MiB.
 MEMORY_BYTES = 128 * 2**20
 PLANES = 8
+#: Bytes in a plane word (64 columns); the memory ports move one, two or half of one at a time.
+WORD_BYTES = 8
 
 
 class AddressMap:

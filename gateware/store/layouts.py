@@ -46,10 +46,13 @@ class PlaneRequest(data.Struct):
 
 
 class FrameInfo(data.Struct):
-    """A complete frame the sequencer may show."""
+    """A complete frame the sequencer may show. A frame of a stored sequence (``sequence``) is
+    the next one to show, in order; a streamed one is the newest, which replaces a frame
+    waiting for its trigger."""
     slot: SLOT_BITS
     frame_id: 16
     bit_depth: 4      # 1..8 planes stored, most significant first: planes 8-bit_depth..7
+    sequence: 1
 
 
 class OccupancySignature(wiring.Signature):

@@ -2,14 +2,17 @@
 
 A :class:`~gateware.store.layouts.PlaneRequest` names a slot, a plane and a run of rows; the
 rows of a plane are one contiguous run of memory (:mod:`gateware.store.addresses`), so the
-reader cuts it into read commands of up to 64 words and gives them through MCB port 1, clocked
-by ``dmd``. The words go through a FIFO to the sequencer, in order, requests one after another.
+reader cuts it into read commands of up to 64 port words and gives them through MCB port 1,
+clocked by ``dmd``. The port is 64 or 128 bits wide: a 128-bit port word is two plane words, the
+first in its low bits, and the reader hands it on as it is, so that a sequencer taking two words
+a transfer gets them as fast as the memory gives them. The words go through a FIFO to the
+sequencer, in order, requests one after another.
 
 Look-ahead: the reader keeps issuing commands, across request boundaries, as long as the words
-it has asked for and not yet handed on fit in its FIFO (``fifo_depth`` words, several commands
-outstanding), so the memory's latency is hidden and one word per ``dmd`` cycle leaves whenever
-the memory delivers that fast. Because those words always have room, the reader takes every
-word from the MCB's read FIFO as soon as it is there: that FIFO never overflows.
+it has asked for and not yet handed on fit in its FIFO (``fifo_depth`` plane words, several
+commands outstanding), so the memory's latency is hidden and a port word per ``dmd`` cycle
+leaves whenever the memory delivers that fast. Because those words always have room, the reader
+takes every word from the MCB's read FIFO as soon as it is there: that FIFO never overflows.
 
 A request that does not fit the frame (slot beyond the slots, no rows, rows past the last) is
 dropped and counted; it produces no words.
@@ -21,7 +24,7 @@ from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.lib.wiring import In, Out
 
 from . import mcb
-from .addresses import AddressMap
+from .addresses import WORD_BYTES, AddressMap
 from .layouts import PlaneRequest
 
 __all__ = ["Reader"]
@@ -36,44 +39,53 @@ class Reader(wiring.Component):
     slots : int
         Frame slots in the memory (the address map).
     fifo_depth : int
-        Words of look-ahead and buffering (a multiple of 64; 256 = four commands in flight).
+        Plane words of look-ahead and buffering (a multiple of 64 port words; 256 = four
+        commands of a 64-bit port, or two of a 128-bit port, in flight).
     domain : str
         Clock domain of the reader and of its MCB port.
+    width : int
+        The MCB port's width: 64 or 128 bits, one or two plane words a transfer.
 
     Members
     -------
     requests : In(stream.Signature(PlaneRequest))
         What to read.
-    planes : Out(stream.Signature(64))
-        The rows' words in order, ``words_per_row`` per row, word 0 first.
-    mcb : Out(mcb.PortSignature())
+    planes : Out(stream.Signature(width))
+        The rows' words in order, ``words_per_row * 64 / width`` transfers per row, word 0 first
+        (in the low bits of the first transfer).
+    mcb : Out(mcb.PortSignature(width))
         MCB port 1; only the read half is used.
     bad_requests : Out(16)
         Requests dropped because they do not fit the frame.
     """
 
-    def __init__(self, dmd, *, slots=16, fifo_depth=256, domain="dmd"):
-        assert fifo_depth % mcb.MAX_BURST == 0
-        self._dmd, self._slots = dmd, slots
+    def __init__(self, dmd, *, slots=16, fifo_depth=256, domain="dmd", width=128):
+        assert width in (64, 128)
+        words = width // 64                      # plane words per port word
+        assert dmd.words_per_row % words == 0, "rows must start on a port word"
+        assert fifo_depth % (mcb.MAX_BURST * words) == 0
+        self._dmd, self._slots, self._width = dmd, slots, width
         self._map = AddressMap(dmd, slots)
         self._fifo_depth, self._domain = fifo_depth, domain
         super().__init__({
             "requests": In(stream.Signature(PlaneRequest)),
-            "planes": Out(stream.Signature(64)),
-            "mcb": Out(mcb.PortSignature()),
+            "planes": Out(stream.Signature(width)),
+            "mcb": Out(mcb.PortSignature(width)),
             "bad_requests": Out(16),
         })
 
     def elaborate(self, platform):
         m = Module()
-        dmd, depth = self._dmd, self._fifo_depth
-        port = self.mcb
+        dmd, port = self._dmd, self.mcb
+        words = self._width // 64
+        depth = self._fifo_depth // words        # port words
+        port_words_per_row = dmd.words_per_row // words
 
-        m.submodules.fifo = fifo = SyncFIFOBuffered(width=64, depth=depth)
+        m.submodules.fifo = fifo = SyncFIFOBuffered(width=self._width, depth=depth)
         wiring.connect(m, fifo.r_stream, wiring.flipped(self.planes))
 
         address = Signal(30)
-        remaining = Signal(range(dmd.words_per_plane + 1))
+        remaining = Signal(range(dmd.words_per_plane // words + 1))     # port words
         reserved = Signal(range(depth + 1))      # asked for and not yet handed on
         burst = Signal(range(mcb.MAX_BURST + 1))
         m.d.comb += burst.eq(Mux(remaining > mcb.MAX_BURST, mcb.MAX_BURST, remaining))
@@ -106,7 +118,7 @@ class Reader(wiring.Component):
                     with m.If(fits):
                         m.d.sync += [
                             address.eq(self._map.address(request.slot, request.plane, request.first_row)),
-                            remaining.eq(request.row_count * dmd.words_per_row),
+                            remaining.eq(request.row_count * port_words_per_row),
                         ]
                         m.next = "ISSUE"
                     with m.Else():
@@ -114,7 +126,7 @@ class Reader(wiring.Component):
             with m.State("ISSUE"):
                 with m.If(port.calib_done & ~port.cmd_full & (reserved + burst <= depth)):
                     m.d.comb += issue.eq(1)
-                    m.d.sync += [address.eq(address + burst * mcb.WORD_BYTES),
+                    m.d.sync += [address.eq(address + burst * (words * WORD_BYTES)),
                                  remaining.eq(remaining - burst)]
                     with m.If(remaining == burst):
                         m.next = "IDLE"

@@ -13,7 +13,6 @@ from amaranth.lib import data, enum, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from .layouts import SLOT_BITS, FrameInfo
-from .slot_crossing import Command
 
 __all__ = ["SlotTable", "SlotState", "Placement", "PlacementSignature", "opening_layout", "TableCounters"]
 
@@ -104,8 +103,10 @@ class SlotTable(wiring.Component):
         From the writer: the completing row of this slot is in memory.
     sequence_length : In(5)
         0: streaming; N: sequence of N frames in slots 0..N-1 (at most ``slots``).
-    commands : In(stream.Signature(Command))
-        Asks and releases from the sequencer, in order.
+    asks : In(stream.Signature(0))
+        Each transfer asks for one frame; an ask waits until a frame can be given.
+    releases : In(stream.Signature(SLOT_BITS))
+        Slots the sequencer hands back (taken before an ask waiting beside them).
     answers : Out(stream.Signature(FrameInfo))
         One answer per ask: the frame the sequencer now holds.
     counters : Out(TableCounters)
@@ -119,7 +120,8 @@ class SlotTable(wiring.Component):
             "completed": In(stream.Signature(SLOT_BITS, always_ready=True)),
             "written": In(stream.Signature(SLOT_BITS)),
             "sequence_length": In(5),
-            "commands": In(stream.Signature(Command)),
+            "asks": In(stream.Signature(0)),
+            "releases": In(stream.Signature(SLOT_BITS)),
             "answers": Out(stream.Signature(FrameInfo)),
             "counters": Out(TableCounters),
         })
@@ -178,13 +180,14 @@ class SlotTable(wiring.Component):
             self.answers.payload.slot.eq(answer_slot),
             self.answers.payload.frame_id.eq(frame_id[answer_slot]),
             self.answers.payload.bit_depth.eq(depth[answer_slot]),
+            self.answers.payload.sequence.eq(sequence),
         ]
 
         # -- housekeeping: one event per cycle. An answer offered and not taken (the answer FIFO
         # full) stays offered, unchanged: nothing else happens until it is taken.
         offered = Signal()
         m.d.sync += offered.eq(self.answers.valid & ~self.answers.ready)
-        command = self.commands.payload
+        released = self.releases.payload
         with m.If(mode_pending & self.placement.between_rows & ~offered):
             m.d.sync += [seq_len.eq(wanted_len), play.eq(0), t.recv_active.eq(0), t.last_valid.eq(0)]
             for s in range(n_slots):
@@ -202,18 +205,18 @@ class SlotTable(wiring.Component):
                               & (done != s)):
                         m.d.sync += [state[s].eq(SlotState.FREE),
                                      count.frames_replaced.eq(count.frames_replaced + 1)]
-        with m.Elif(self.commands.valid & command.release):
-            m.d.comb += self.commands.ready.eq(1)
-            with m.If(state[command.slot] != SlotState.SHOWN):
+        with m.Elif(self.releases.valid):
+            m.d.comb += self.releases.ready.eq(1)
+            with m.If(state[released] != SlotState.SHOWN):
                 m.d.sync += count.bad_releases.eq(count.bad_releases + 1)
-            with m.Elif(in_sequence[command.slot] & sequence):
-                m.d.sync += state[command.slot].eq(SlotState.READY)
+            with m.Elif(in_sequence[released] & sequence):
+                m.d.sync += state[released].eq(SlotState.READY)
             with m.Else():
-                m.d.sync += state[command.slot].eq(SlotState.FREE)
-        with m.Elif(self.commands.valid & can_answer):
+                m.d.sync += state[released].eq(SlotState.FREE)
+        with m.Elif(self.asks.valid & can_answer):
             m.d.comb += self.answers.valid.eq(1)
             with m.If(self.answers.ready):
-                m.d.comb += self.commands.ready.eq(1)
+                m.d.comb += self.asks.ready.eq(1)
                 m.d.sync += state[answer_slot].eq(SlotState.SHOWN)
                 with m.If(sequence):
                     m.d.sync += play.eq(play + 1)

@@ -130,7 +130,8 @@ class FrameSlots(wiring.Component):
         wiring.connect(m, ingest.completed, table.completed)
         wiring.connect(m, ingest.map_writes, maps.writes)
         wiring.connect(m, ingest.bitmap, maps.bitmap)
-        wiring.connect(m, crossing.commands, table.commands)
+        wiring.connect(m, crossing.asks, table.asks)
+        wiring.connect(m, crossing.releases, table.releases)
         wiring.connect(m, table.answers, crossing.answers)
         for part in self._COUNTING:
             counters = self._parts[part].counters

@@ -71,7 +71,7 @@ class Writer(wiring.Component):
         the planes written for it.
     written : Out(stream.Signature(SLOT_BITS))
         The slot whose completing row (``completes``) is now in memory.
-    mcb : Out(mcb.PortSignature())
+    mcb : Out(mcb.PortSignature(64))
         MCB port 0, clocked by ``sync``; only the write half is used.
     """
 
@@ -84,7 +84,7 @@ class Writer(wiring.Component):
         super().__init__({
             "words": In(stream.Signature(write_word_layout(dmd))),
             "written": Out(stream.Signature(SLOT_BITS)),
-            "mcb": Out(mcb.PortSignature()),
+            "mcb": Out(mcb.PortSignature(64)),
         })
 
     def elaborate(self, platform):

@@ -28,8 +28,9 @@ class BringupTop(Elaboratable):
         rst = platform.request("rst", dir="-")
         m.submodules.clk_buf = clk_buf = io.Buffer("i", clk100)
         m.submodules.rst_buf = rst_buf = io.Buffer("i", rst)
-        m.domains += Spartan6Clocks.domains()
-        m.submodules.clocks = Spartan6Clocks(clk_buf.i, rst_buf.i)
+        # the link at DCLK 200 MHz: one beat a cycle through ODDR2s
+        m.domains += Spartan6Clocks.domains(200e6)
+        m.submodules.clocks = Spartan6Clocks(clk_buf.i, rst_buf.i, 200e6)
 
         dmd = DMDS["dlp7000"]
         serialiser = Serialiser(dmd, lanes=8)
@@ -53,22 +54,23 @@ class BringupTop(Elaboratable):
 
         # Plane words cross into DCLK's domain through an async FIFO.
         m.submodules.words_cdc = fifo = AsyncFIFO(width=64, depth=16, w_domain="sync", r_domain="dmd")
+        into, out = fifo.w_stream, fifo.r_stream
         m.d.comb += [
-            fifo.w_data.eq(serialiser.words.payload.data),
-            fifo.w_en.eq(serialiser.words.valid),
-            serialiser.words.ready.eq(fifo.w_rdy),
-            fifo.r_en.eq(1),
+            into.payload.eq(serialiser.words.payload.data),
+            into.valid.eq(serialiser.words.valid),
+            serialiser.words.ready.eq(into.ready),
+            out.ready.eq(1),
         ]
         word_dmd = Signal(64)
-        with m.If(fifo.r_rdy):
-            m.d.dmd += word_dmd.eq(fifo.r_data)
+        with m.If(out.valid):
+            m.d.dmd += word_dmd.eq(out.payload)
 
         m.submodules.dlpc410 = dlpc = Dlpc410Pins()
         lanes = beat.word_to_lanes(word_dmd)
         m.d.comb += [
-            dlpc.bus.din_a.rise.eq(lanes[("A", "rise")]),
-            dlpc.bus.din_a.fall.eq(lanes[("A", "fall")]),
-            dlpc.bus.dvalid.eq(1),
+            dlpc.bus.din_a[0].eq(lanes[("A", "rise")]),
+            dlpc.bus.din_a[1].eq(lanes[("A", "fall")]),
+            dlpc.bus.dvalid.eq(0b11),
         ]
 
         m.submodules.trigger = trigger = TriggerPins()

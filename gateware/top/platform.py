@@ -7,7 +7,7 @@ Everything vendor-specific lives here and in :mod:`gateware.platform`; the core
 from amaranth import ClockDomain, Elaboratable, Module
 from amaranth.lib import io, wiring
 
-from gateware.platform.clocks import Spartan6Clocks
+from gateware.platform.clocks import DCLK_HZ, Spartan6Clocks
 from gateware.platform.mcb_instance import McbInstance
 from gateware.platform.pins import Dlpc410Pins, GmiiPins, TriggerPins
 from gateware.registers import Registers
@@ -29,13 +29,13 @@ TIMESPEC "TS_cdc_first_stages" = TO "cdc_first_stages" TIG;
 """
 
 
-def core(dmd, frequencies):
+def core(dmd, dclk_hz=DCLK_HZ):
     """The projector's core as the board builds it: disarmed, with power-up sequencer registers
-    of the shortest legal 8-bit global schedule at the facts' timing (the host replaces them with
-    sequencer records, and arms the triggers). ``frequencies``: ``{domain: Hz}``."""
-    plan = schedule.plan(dmd, frequencies["dmd"], depth=8)
-    return Projector(dmd, sync_hz=frequencies["sync"], regs=Registers.const(plan.params.registers(dmd)),
-                     armed=False, **ADDRESSES)
+    of the shortest legal 8-bit global schedule at the facts' timing and DCLK ``dclk_hz``, early
+    triggers held (the host replaces them with sequencer records, and arms the triggers)."""
+    plan = schedule.plan(dmd, dclk_hz, depth=8, trigger_hold=True)
+    return Projector(dmd, sync_hz=Spartan6Clocks.frequencies(dclk_hz)["sync"], beats=plan.params.beats,
+                     regs=Registers.const(plan.params.registers(dmd)), armed=False, **ADDRESSES)
 
 
 class PlatformTop(Elaboratable):
@@ -45,10 +45,13 @@ class PlatformTop(Elaboratable):
     ----------
     dmd : str
         DMD name in :data:`spec.facts.DMDS`.
+    dclk_hz : float
+        DCLK: 400 MHz (the default: two beats a ``dmd`` cycle through OSERDES2s) or 200 MHz.
     """
 
-    def __init__(self, dmd="dlp7000"):
+    def __init__(self, dmd="dlp7000", dclk_hz=DCLK_HZ):
         self._dmd = DMDS[dmd]
+        self._dclk_hz = dclk_hz
 
     def elaborate(self, platform):
         m = Module()
@@ -59,16 +62,17 @@ class PlatformTop(Elaboratable):
         rst = platform.request("rst", dir="-")
         m.submodules.clk_buf = clk_buf = io.Buffer("i", clk100)
         m.submodules.rst_buf = rst_buf = io.Buffer("i", rst)
-        m.domains += [*Spartan6Clocks.domains(), ClockDomain("gmii_rx")]
-        m.submodules.clocks = clocks = Spartan6Clocks(clk_buf.i, rst_buf.i)
+        m.domains += [*Spartan6Clocks.domains(self._dclk_hz), ClockDomain("gmii_rx")]
+        m.submodules.clocks = clocks = Spartan6Clocks(clk_buf.i, rst_buf.i, self._dclk_hz)
 
         # ---- Pins ---------------------------------------------------------------------------
         m.submodules.gmii = gmii = GmiiPins(clocks.locked)
-        m.submodules.dlpc410 = dlpc = Dlpc410Pins(dmd.buses)
+        beats = schedule.beats_at(self._dclk_hz)
+        m.submodules.dlpc410 = dlpc = Dlpc410Pins(dmd.buses, beats, clocks.io)
         m.submodules.trigger = trigger = TriggerPins()
 
         # ---- The core ------------------------------------------------------------------------
-        m.submodules.core = projector = core(dmd, clocks.frequencies())
+        m.submodules.core = projector = core(dmd, self._dclk_hz)
         m.d.comb += [projector.gmii_rx.eq(gmii.rx), gmii.tx.eq(projector.gmii_tx)]
         m.d.comb += [
             gmii.phy_reset_n.eq(projector.phy_reset_n), gmii.mdc.eq(projector.mdc),

@@ -67,6 +67,9 @@ class Projector(wiring.Component):
         ``sync`` frequency (status replies report it; the PHY management derives MDC from it).
     slots : int
         Frame slots in DDR2.
+    beats : int
+        DCLK cycles per ``dmd`` cycle: 2 for DCLK 400 MHz (the platform's 4:1 serialisers), 1
+        for 200 MHz.
     mdio_cycles : tuple(int, int), optional
         PHY reset and settle waits in ``sync`` cycles (simulations shorten them).
 
@@ -78,10 +81,10 @@ class Projector(wiring.Component):
         PHY transmit pins (``gmii_tx``).
     phy_reset_n, mdc, mdio_o, mdio_oe : Out(1); mdio_i : In(1)
         PHY reset and management (``sync``).
-    mcb_write : Out(mcb.PortSignature())
-        MCB port 0 (``sync``).
-    mcb_read : Out(mcb.PortSignature())
-        MCB port 1 (``dmd``).
+    mcb_write : Out(mcb.PortSignature(64))
+        MCB port 0 (``sync``), the store's writer.
+    mcb_read : Out(mcb.PortSignature(128))
+        MCB port 1 (``dmd``), the store's plane reader.
     dlpc : Out(dlpc410.interface.Signature)
         The DLPC410 applications interface (``dmd``).
     trigger_in, sync_in : In(1)
@@ -92,7 +95,8 @@ class Projector(wiring.Component):
         The frame shown last (``dmd``); its id also reaches the status reply (``shown_frame``).
     """
 
-    def __init__(self, dmd, *, mac, ip, port, regs, armed=True, sync_hz=125e6, slots=4, mdio_cycles=None):
+    def __init__(self, dmd, *, mac, ip, port, regs, armed=True, sync_hz=125e6, slots=4, mdio_cycles=None,
+                 beats=1):
         self._dmd = dmd
         self._addresses = dict(mac=mac, ip=ip, port=port)
         self._regs = regs
@@ -100,6 +104,7 @@ class Projector(wiring.Component):
         self._sync_hz = sync_hz
         self._slots = slots
         self._mdio_cycles = mdio_cycles or (None, None)
+        self._beats = beats
         super().__init__({
             "gmii_rx": In(gmii.RxPins),
             "gmii_tx": Out(gmii.TxPins),
@@ -108,9 +113,9 @@ class Projector(wiring.Component):
             "mdio_o": Out(1),
             "mdio_oe": Out(1),
             "mdio_i": In(1),
-            "mcb_write": Out(mcb.PortSignature()),
-            "mcb_read": Out(mcb.PortSignature()),
-            "dlpc": Out(interface.Signature(dmd.buses)),
+            "mcb_write": Out(mcb.PortSignature(64)),
+            "mcb_read": Out(mcb.PortSignature(128)),
+            "dlpc": Out(interface.Signature(dmd.buses, beats)),
             "trigger_in": In(1),
             "sync_in": In(1),
             "sync_out": Out(1),
@@ -124,7 +129,7 @@ class Projector(wiring.Component):
 
         # ---- Ethernet: GMII MAC, stack and application protocol (gmii_rx / gmii_tx -> sync) ------
         m.submodules.ethernet = ethernet = EthernetPort(dmd, frame_bits=FRAME_BITS, armed=self._armed,
-                                                        **self._addresses)
+                                                        beats=self._beats, **self._addresses)
         m.d.comb += [ethernet.gmii_rx.eq(self.gmii_rx), self.gmii_tx.eq(ethernet.gmii_tx)]
 
         m.submodules.phy = phy = StatusPoller(self._sync_hz, reset_cycles=self._mdio_cycles[0],
@@ -137,7 +142,11 @@ class Projector(wiring.Component):
         # ---- Bit-plane serialiser and the store (sync, then dmd) -------------------------------
         m.submodules.serialiser = serialiser = Serialiser(dmd, lanes=1, frame_bits=FRAME_BITS)
         wiring.connect(m, ethernet.pixels, serialiser.pixels)
-        m.submodules.store = store = Store(dmd, slots=self._slots, frame_bits=FRAME_BITS)
+        # The reader reads 128-bit port words (two plane words); a sequencer that takes one word a
+        # cycle (two buses, one DCLK beat a cycle) gets them one at a time.
+        store_words = min(2, dmd.bits_per_dclk * self._beats // 64)
+        m.submodules.store = store = Store(dmd, slots=self._slots, frame_bits=FRAME_BITS, read_width=128,
+                                           plane_words=store_words)
         wiring.connect(m, serialiser.words, store.words)
         wiring.connect(m, serialiser.rows, store.rows)
         # The protocol counts a single streamed frame as a sequence of 1; the store calls streaming
@@ -156,7 +165,8 @@ class Projector(wiring.Component):
         wiring.connect(m, store.frames, broker.offered)
         wiring.connect(m, broker.store_occupancy, store.occupancy)
 
-        m.submodules.sequencer = seq = DomainRenamer("dmd")(Sequencer(dmd))
+        m.submodules.sequencer = seq = DomainRenamer("dmd")(Sequencer(dmd, beats=self._beats,
+                                                                      store_words=store_words))
         wiring.connect(m, broker.frames, seq.frames)
         m.d.comb += [seq.occupancy.eq(broker.occupancy), broker.occ_slot.eq(seq.occ_slot)]
         wiring.connect(m, seq.requests, store.requests)
@@ -197,6 +207,7 @@ class Projector(wiring.Component):
         status = ethernet.status
         for name, source in (("triggers", seq.status.triggers), ("trigger_overruns", seq.status.overruns),
                              ("frames_shown", seq.status.frames), ("triggers_early", seq.status.early),
+                             ("triggers_held", seq.status.held),
                              ("pulses_late", seq.status.late), ("row_underruns", seq.status.underruns),
                              ("frames_bad_depth", seq.status.bad_frames),
                              ("registers_applied", registers.applied)):

@@ -129,14 +129,15 @@ MISALIGN_US = (-5, -1, 0, 1, 5, 20)
 MISALIGN_FIGURE_US = 1
 
 
-def played_frame(plan, dclk=200e6):
+def played_frame(plan):
     """One triggered frame of ``plan`` (schedule model) played through the DLPC410 model: the
     model, the frame's first and last pulse cycles, and the image shown."""
     p = plan.params
     frame = schedule.Frame(0, 8)
     result = schedule.simulate(XGA, p, [frame], [schedule.ready_cycle(XGA, p, frame)])
-    model = Dlpc410(XGA, dclk=dclk, init_cycles=16, strict_rst_active=p.strict_rst)
-    driver = Driver(XGA)
+    model = Dlpc410(XGA, beats=p.beats, clock_hz=schedule.FABRIC_HZ, init_cycles=16,
+                    strict_rst_active=p.strict_rst)
+    driver = Driver(XGA, p.beats)
     driver.start(16)
     image = ramp_image(XGA, 0)
     play_schedule(driver, XGA, p, result, {0: image}, model.ecp2_cycles + 16)
@@ -151,12 +152,12 @@ def gray_error_table(dclk=200e6):
     rows = []
     for factor in LSB_FACTORS:
         plan = fastest if factor == 1 else schedule.plan(
-            XGA, dclk, exposure_s=factor * fastest.params.lsb / dclk)
-        model, first, last, image = played_frame(plan, dclk)
+            XGA, dclk, exposure_s=factor * fastest.params.lsb / schedule.FABRIC_HZ)
+        model, first, last, image = played_frame(plan)
         camera = Camera(model)
         span = last + camera.delay + camera.ramp - first
         for us in MISALIGN_US:
-            t0 = first + round(us * 1e-6 * dclk)
+            t0 = first + round(us * 1e-6 * schedule.FABRIC_HZ)
             seen = to_lsb(camera.image(t0, t0 + span), plan.params.lsb)
             err = seen - image[:, :XGA.visible_columns]
             rows.append((plan.params.lsb, plan.frame_cycles, plan.rate_hz, us,

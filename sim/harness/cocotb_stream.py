@@ -15,7 +15,8 @@ __all__ = ["StreamSource", "StreamSink"]
 
 
 class StreamSource:
-    """Offers payloads on ``dut.<name>__*``; ``idle`` is the chance of an idle cycle before each."""
+    """Offers payloads on ``dut.<name>__*``; ``idle`` is the chance of an idle cycle before each.
+    ``stalls`` counts the cycles a payload was offered and not taken."""
 
     def __init__(self, dut, name, layout, clock, *, idle=0.0, seed=0):
         self.valid = getattr(dut, f"{name}__valid")
@@ -23,6 +24,7 @@ class StreamSource:
         self.payload = getattr(dut, f"{name}__payload")
         self.layout, self.clock = layout, clock
         self.idle, self.rng = idle, random.Random(seed)
+        self.stalls = 0
         self.valid.value = 0
 
     async def send(self, items):
@@ -36,6 +38,7 @@ class StreamSource:
                 await RisingEdge(self.clock)
                 if self.ready.value:
                     break
+                self.stalls += 1
         self.valid.value = 0
 
 
@@ -51,10 +54,11 @@ class StreamSink:
         self.ready.value = 0
 
     async def receive(self, count):
-        out = []
+        out, driven = [], None
         while len(out) < count:
             ready = not (self.stall and self.rng.random() < self.stall)
-            self.ready.value = int(ready)
+            if ready != driven:        # each write is a simulator call
+                self.ready.value = driven = ready
             await RisingEdge(self.clock)
             # values read just after the edge are those the edge sampled (as cocotbext-axi reads them)
             if ready and self.valid.value:

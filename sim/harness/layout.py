@@ -13,7 +13,7 @@ through the layout's own ``const``. Both give the same bits.
 from amaranth import Shape
 from amaranth.lib import data
 
-__all__ = ["pack", "unpack"]
+__all__ = ["pack", "unpack", "fields"]
 
 
 class _NotPlain(Exception):
@@ -74,6 +74,13 @@ def _unpack(shape, bits):
     if signed and width and bits >> (width - 1):
         bits -= 1 << width
     return bits
+
+
+def fields(layout):
+    """``[(name, offset, mask)]`` of a flat struct layout: unpacking with shifts and masks, for
+    values read every cycle."""
+    layout = data.Layout.cast(layout)
+    return [(name, field.offset, (1 << field.width) - 1) for name, field in layout]
 
 
 def _plain(value):

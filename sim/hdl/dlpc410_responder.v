@@ -12,11 +12,12 @@
 // * ECP2_FINISHED from cycle ecp2_cycles on.
 // * INIT_ACTIVE high while ARSTZ is low and until max(rise, ecp2_cycles) + init_cycles after
 //   ARSTZ rose.
-// * Past initialisation (and init_grace_cycles), DVALID high with no row cycle open starts a
-//   row cycle of DCLK_PER_ROW cycles; if BLKMD is 10 or 11 there, RST_ACTIVE is high on the next
+// * Past initialisation (and init_grace_cycles), DVALID high (on the cycle's first DCLK rising
+//   edge) with no row cycle open starts a row cycle of CYCLES_PER_ROW cycles (DCLK per row over
+//   the DCLK cycles per cycle); if BLKMD is 10 or 11 there, RST_ACTIVE is high on the next
 //   rst_active_cycles cycles.
 module dlpc410_responder #(
-    parameter DCLK_PER_ROW = 16
+    parameter CYCLES_PER_ROW = 16
 ) (
     input  wire [31:0] rst_active_cycles,
     input  wire [31:0] init_cycles,
@@ -60,7 +61,7 @@ module dlpc410_responder #(
                     rst_until = cycle + rst_active_cycles;
             end
             beats = beats + 1;
-            if (beats == DCLK_PER_ROW) row_open = 0;
+            if (beats == CYCLES_PER_ROW) row_open = 0;
         end
         cycle = cycle + 1;
         ecp2_finished <= cycle >= ecp2_cycles;

@@ -2,15 +2,19 @@
 //
 // Simulation only. The same port protocol and rules as the Python model sim/models/mcb.py (which
 // stays the reference and the checker of the store's tests), at nanoseconds per cycle instead of
-// a Python call per cycle. PORTS 64-bit ports, each in its own clock, share one memory of WORDS
-// words. Signals of port p are bits [p*W +: W] of the vectors below.
+// a Python call per cycle. PORTS ports, each in its own clock and of its own width (32, 64 or 128
+// bits), share one memory of WORDS 64-bit words (bytes in address order from the low bits up).
+// Signals of port p are bits [p*W +: W] of the vectors below, W their width per port; the data
+// and mask vectors give every port the slot of the widest port (128 data bits, 16 mask bits), a
+// narrower port using the low bits of its slot.
 //
-// Per port: 4 commands, 64 write words and 64 read words (first-word-fall-through); flags
-// registered as the Python model's outputs; calib_done rises after CALIB_CYCLES of the port's
-// clock; a command is taken CMD_LATENCY port cycles after it was pushed at the earliest (both
-// hold one 32-bit value per port, port 0 in the low bits). As in the Python model, the memory is
-// shared in time (ns): a command taken by a port occupies it from when it is free for its words
-// times WORD_NS; its words move at their times (writes leave the write FIFO, reads reach the read
+// Per port: 4 commands, 64 write words and 64 read words of its width (first-word-fall-through);
+// flags registered as the Python model's outputs; calib_done rises after CALIB_CYCLES of the
+// port's clock; a command is taken CMD_LATENCY port cycles after it was pushed at the earliest
+// (WIDTH, CALIB_CYCLES and CMD_LATENCY hold one 32-bit value per port, port 0 in the low bits).
+// Byte addresses are multiples of the port's word. As in the Python model, the memory is shared
+// in time (ns): a command taken by a port occupies it from when it is free for its words times
+// WORD_NS (a 64-bit word) times the port's width over 64; its words move at their times (writes leave the write FIFO, reads reach the read
 // FIFO READ_LATENCY_NS later), seen at the port's next clock edge. Every REFRESH_INTERVAL_NS the
 // memory is busy for REFRESH_NS after the command in progress. Commands are granted in the order
 // the ports' edges see them (the Python model: round robin). Not modelled: random stalls. Times
@@ -22,6 +26,7 @@
 module mcb_model #(
     parameter PORTS = 2,
     parameter WORDS = 1 << 21,
+    parameter [32*PORTS-1:0] WIDTH = {32'd128, 32'd64},
     parameter [32*PORTS-1:0] CALIB_CYCLES = {32'd200, 32'd125},
     parameter [32*PORTS-1:0] CMD_LATENCY = {32'd2, 32'd2},
     parameter real WORD_NS = 5.714,
@@ -37,15 +42,15 @@ module mcb_model #(
     output wire [PORTS-1:0]     cmd_full,
     output wire [PORTS-1:0]     cmd_empty,
     input  wire [PORTS-1:0]     wr_en,
-    input  wire [64*PORTS-1:0]  wr_data,
-    input  wire [8*PORTS-1:0]   wr_mask,
+    input  wire [128*PORTS-1:0] wr_data,
+    input  wire [16*PORTS-1:0]  wr_mask,
     output wire [PORTS-1:0]     wr_full,
     output wire [PORTS-1:0]     wr_empty,
     output wire [7*PORTS-1:0]   wr_count,
     output wire [PORTS-1:0]     wr_underrun,
     output wire [PORTS-1:0]     wr_error,
     input  wire [PORTS-1:0]     rd_en,
-    output wire [64*PORTS-1:0]  rd_data,
+    output wire [128*PORTS-1:0] rd_data,
     output wire [PORTS-1:0]     rd_full,
     output wire [PORTS-1:0]     rd_empty,
     output wire [7*PORTS-1:0]   rd_count,
@@ -75,21 +80,24 @@ module mcb_model #(
     generate for (p = 0; p < PORTS; p = p + 1) begin : port
         localparam [31:0] CALIB = CALIB_CYCLES[32*p +: 32];
         localparam [31:0] CMD_WAIT = CMD_LATENCY[32*p +: 32];
+        localparam integer W = WIDTH[32*p +: 32];
+        localparam integer BYTES = W / 8;
+        localparam real PORT_WORD_NS = WORD_NS * W / 64;
 
-        // command FIFO: instr, words, word address, cycle pushed
+        // command FIFO: instr, words, byte address, cycle pushed
         reg [2:0]  c_instr [0:3];
         reg [6:0]  c_words [0:3];
         reg [31:0] c_addr  [0:3];
         reg [31:0] c_time  [0:3];
         integer c_head, c_n;
-        // write FIFO: data, mask; read FIFO
-        reg [63:0] w_data [0:63];
-        reg [7:0]  w_mask [0:63];
+        // write FIFO: data, mask; read FIFO (port words in the low W bits of a slot's width)
+        reg [127:0] w_data [0:63];
+        reg [15:0]  w_mask [0:63];
         integer w_head, w_n;
-        reg [63:0] r_data [0:63];
+        reg [127:0] r_data [0:63];
         integer r_head, r_n;
         // read words on their way: arrival cycle and data, in order
-        reg [63:0] f_data [0:63];
+        reg [127:0] f_data [0:63];
         real       f_time [0:63];
         integer f_head, f_n;
         // the command being executed
@@ -98,13 +106,14 @@ module mcb_model #(
         real now, next_word_at;
         reg [31:0] cycle;
         reg calib, bad_write;
-        reg [63:0] word, keep;
-        integer b, k;
+        reg [63:0] word;
+        reg [127:0] port_word;
+        integer b, j, k;
         // registered outputs
         reg o_cmd_full, o_cmd_empty, o_wr_full, o_wr_empty, o_underrun;
         reg o_rd_full, o_rd_empty, o_overflow, o_calib_done;
         reg [6:0] o_wr_count, o_rd_count;
-        reg [63:0] o_rd_data;
+        reg [127:0] o_rd_data;
         reg [3:0] o_fault;
         assign cmd_full[p] = o_cmd_full;
         assign cmd_empty[p] = o_cmd_empty;
@@ -113,7 +122,7 @@ module mcb_model #(
         assign wr_count[7*p +: 7] = o_wr_count;
         assign wr_underrun[p] = o_underrun;
         assign wr_error[p] = o_underrun;
-        assign rd_data[64*p +: 64] = o_rd_data;
+        assign rd_data[128*p +: 128] = o_rd_data;
         assign rd_full[p] = o_rd_full;
         assign rd_empty[p] = o_rd_empty;
         assign rd_count[7*p +: 7] = o_rd_count;
@@ -150,10 +159,10 @@ module mcb_model #(
             if (cmd_en[p]) begin
                 if (c_n >= 4) break_rule(2, "cmd_en while cmd_full");
                 else if (cmd_instr[3*p +: 3] > 3'd4) break_rule(10, "bad instruction");
-                else if (cmd_instr[3*p +: 3] != 3'd4 && cmd_byte_addr[30*p +: 3] != 0)
+                else if (cmd_instr[3*p +: 3] != 3'd4 && cmd_byte_addr[30*p +: 30] % BYTES != 0)
                     break_rule(3, "misaligned byte address");
                 else if (cmd_instr[3*p +: 3] != 3'd4
-                         && (cmd_byte_addr[30*p+3 +: 27] + cmd_bl[6*p +: 6] + 1) > WORDS)
+                         && cmd_byte_addr[30*p +: 30] + (cmd_bl[6*p +: 6] + 1) * BYTES > WORDS * 8)
                     break_rule(4, "burst ends past the memory");
                 else begin
                     bad_write = !cmd_instr[3*p] && !cmd_instr[3*p+2]
@@ -162,7 +171,7 @@ module mcb_model #(
                     k = (c_head + c_n) % 4;
                     c_instr[k] = cmd_instr[3*p +: 3];
                     c_words[k] = cmd_bl[6*p +: 6] + 1;
-                    c_addr[k] = cmd_byte_addr[30*p+3 +: 27];
+                    c_addr[k] = cmd_byte_addr[30*p +: 30];
                     c_time[k] = cycle;
                     c_n = c_n + 1;
                     if (!cmd_instr[3*p] && !cmd_instr[3*p+2]) owed = owed + cmd_bl[6*p +: 6] + 1;
@@ -172,8 +181,8 @@ module mcb_model #(
                 if (w_n >= 64) break_rule(6, "wr_en while wr_full");
                 else begin
                     k = (w_head + w_n) % 64;
-                    w_data[k] = wr_data[64*p +: 64];
-                    w_mask[k] = wr_mask[8*p +: 8];
+                    w_data[k] = wr_data[128*p +: 128] & ~(~128'd0 << W);
+                    w_mask[k] = wr_mask[16*p +: 16] & ~(~16'd0 << BYTES);
                     w_n = w_n + 1;
                 end
             end
@@ -189,8 +198,8 @@ module mcb_model #(
                 writing = !c_instr[c_head][0];
                 words_left = c_words[c_head];
                 addr = c_addr[c_head];
-                free_at = next_word_at + (busy ? words_left * WORD_NS : REFRESH_NS);
-                next_word_at = next_word_at + WORD_NS;
+                free_at = next_word_at + (busy ? words_left * PORT_WORD_NS : REFRESH_NS);
+                next_word_at = next_word_at + PORT_WORD_NS;
                 c_head = (c_head + 1) % 4;
                 c_n = c_n - 1;
             end
@@ -200,23 +209,36 @@ module mcb_model #(
                         break_rule(8, "write FIFO empty during a write");
                         o_underrun <= 1'b1;
                     end else begin
-                        keep = 64'd0;
-                        for (b = 0; b < 8; b = b + 1)
-                            if (w_mask[w_head][b]) keep[8*b +: 8] = 8'hFF;
-                        mem[addr] = (mem[addr] & keep) | (w_data[w_head] & ~keep);
+                        if (W >= 64 && w_mask[w_head] == 0)
+                            for (j = 0; j < W / 64; j = j + 1)
+                                mem[addr / 8 + j] = w_data[w_head][64*j +: 64];
+                        else
+                            for (b = 0; b < BYTES; b = b + 1)
+                                if (!w_mask[w_head][b]) begin
+                                    word = mem[(addr + b) / 8];
+                                    word[8*((addr + b) % 8) +: 8] = w_data[w_head][8*b +: 8];
+                                    mem[(addr + b) / 8] = word;
+                                end
                         w_head = (w_head + 1) % 64;
                         w_n = w_n - 1;
                         owed = owed - 1;
                     end
                 end else begin
+                    if (W >= 64)
+                        for (j = 0; j < W / 64; j = j + 1)
+                            port_word[64*j +: 64] = mem[addr / 8 + j];
+                    else begin
+                        word = mem[addr / 8];
+                        port_word = {96'd0, word[32*((addr / 4) % 2) +: 32]};
+                    end
                     k = (f_head + f_n) % 64;
-                    f_data[k] = mem[addr];
+                    f_data[k] = port_word;
                     f_time[k] = next_word_at + READ_LATENCY_NS;
                     f_n = f_n + 1;
                 end
-                addr = addr + 1;
+                addr = addr + BYTES;
                 words_left = words_left - 1;
-                next_word_at = next_word_at + WORD_NS;
+                next_word_at = next_word_at + PORT_WORD_NS;
                 if (words_left == 0) busy = 0;
             end
             while (f_n != 0 && f_time[f_head] <= now) begin
@@ -237,7 +259,7 @@ module mcb_model #(
             o_wr_full <= w_n >= 64;
             o_wr_empty <= w_n == 0;
             o_wr_count <= w_n;
-            o_rd_data <= r_n != 0 ? r_data[r_head] : 64'd0;
+            o_rd_data <= r_n != 0 ? r_data[r_head] : 128'd0;
             o_rd_full <= r_n >= 64;
             o_rd_empty <= r_n == 0;
             o_rd_count <= r_n;

@@ -18,15 +18,20 @@ sensor integrates.
 
 Signals
 -------
-:meth:`Dlpc410.step` takes a dict keyed by the interface's member names with plain ints:
-``din_a``.. ``din_d`` are the packed :class:`~gateware.dlpc410.interface.DinPair` (rising-edge
-bits 0-15, falling-edge bits 16-31), enums are their integer encodings. Missing keys read as
-the interface's reset values. It returns the controller's outputs for the next cycle.
+:meth:`Dlpc410.step` takes a dict keyed by the interface's member names with plain ints, one
+``dmd`` cycle of ``beats`` DCLK cycles: ``din_a``.. ``din_d`` are the packed
+:func:`~gateware.dlpc410.interface.din_layout` (edge ``k`` in bits ``16k .. 16k + 15``: the
+first DCLK cycle's rising edge, its falling edge, the next cycle's ...), ``dvalid`` one bit per
+edge (DVALID is read on each DCLK cycle's rising edge, bit ``2b`` for beat ``b``; its other edges
+carry only the training pattern), enums are their integer encodings. Missing keys read as the
+interface's reset values. It returns the controller's outputs for the next cycle.
 
 Cycle conventions
 -----------------
 Cycle ``c`` is the ``c``-th call of :meth:`Dlpc410.step` (or cycle skipped by
-:meth:`Dlpc410.idle`). A row cycle's commands take effect at its first cycle ``c``: a clock
+:meth:`Dlpc410.idle`), a ``dmd`` cycle; the timing rules are counted in these cycles, the
+row-cycle length and the idle-gap rule in DCLK cycles. A row cycle's commands take effect at
+the cycle of its first beat ``c``: a clock
 pulse latches memory into mirrors there, a clear empties the block there, and the row's data is
 written at the end of the row cycle but counted as written at ``c`` by the settle rule. After a
 pulse at ``p``, RST_ACTIVE is high on cycles ``p + 1 .. p + rst_active_cycles`` and *falls* at
@@ -168,8 +173,11 @@ class Dlpc410:
     Parameters
     ----------
     dmd : spec.facts.DmdType
-    dclk : float
-        DCLK in Hz; the timing defaults are the facts at this rate (:func:`timing_cycles`).
+    beats : int
+        DCLK cycles per step (``dmd`` cycle): 1 at DCLK 200 MHz, 2 at 400 MHz.
+    clock_hz : float
+        The rate of the steps; the timing defaults are the facts at this rate
+        (:func:`timing_cycles`).
     rst_active_cycles, settle_cycles, init_cycles, init_to_dvalid_clocks : int, optional
         Override the facts (tests use short ones).
     init_grace_cycles : int
@@ -202,15 +210,18 @@ class Dlpc410:
         Cycle ARSTZ went high; ``init_end`` the cycle INIT_ACTIVE fell.
     """
 
-    def __init__(self, dmd, *, dclk=200e6, rst_active_cycles=None, settle_cycles=None,
+    def __init__(self, dmd, *, beats=1, clock_hz=200e6, rst_active_cycles=None, settle_cycles=None,
                  init_cycles=None, init_to_dvalid_clocks=None, init_grace_cycles=0, ecp2_cycles=4,
                  strict_rst_active=True, check_training=True, keep_history=True, ddc_version=0):
         if dmd.bits_per_dclk % 64:
             raise ValueError(f"{dmd.name}: {dmd.bits_per_dclk} bits per DCLK is not modelled")
-        facts = timing_cycles(dclk)
+        if dmd.dclk_per_row % beats:
+            raise ValueError(f"{dmd.name}: {dmd.dclk_per_row} DCLK per row is not {beats} beats a cycle")
+        facts = timing_cycles(clock_hz)
         self.dmd = dmd
-        self.dclk = dclk
-        #: the facts at ``dclk`` in cycles (crossover and switching times for the camera)
+        self.beats = beats
+        self.clock_hz = clock_hz
+        #: the facts at ``clock_hz`` in cycles (crossover and switching times for the camera)
         self.timing = facts
         given = {"rst_active_cycles": rst_active_cycles, "settle_cycles": settle_cycles,
                  "init_cycles": init_cycles, "init_to_dvalid_clocks": init_to_dvalid_clocks}
@@ -233,8 +244,7 @@ class Dlpc410:
         self.arstz_rise = None
         self.init_end = None
         self._arstz = 0
-        self._prev_pins = None
-        self._prev2_pins = None
+        self._edges = []                          # the last four training edges per bus
         self._last_pulse = [None] * dmd.blocks   # pulse cycle per block
         self._rst_until = -1                      # last cycle RST_ACTIVE is high
         self._reset_controller()
@@ -284,7 +294,7 @@ class Dlpc410:
             count -= 1
         if count:
             if self._gap is not None:
-                self._gap += count
+                self._gap += count * self.beats
             self.cycle += count
         return self.outputs()
 
@@ -292,6 +302,14 @@ class Dlpc410:
         """True when a DVALID-low cycle with ARSTZ high can only lengthen the idle gap (past
         initialisation, no row cycle open): adapters then need read nothing else."""
         return bool(self._arstz) and not self._initialising(self.cycle) and self._row is None
+
+    def quiet_outputs_until(self):
+        """The first cycle after this one whose outputs differ from this cycle's if only idle
+        cycles (DVALID low, ARSTZ high) come, or None if they never do."""
+        changes = [self._rst_until + 1 if self.cycle <= self._rst_until else None,
+                   self.ecp2_cycles if self.cycle < self.ecp2_cycles else None,
+                   self.init_end if self.init_end is not None and self.cycle < self.init_end else None]
+        return min((c for c in changes if c is not None), default=None)
 
     def run(self, items):
         """Feed a sequence of per-cycle dicts and :class:`Idle` items (see the driver)."""
@@ -322,7 +340,7 @@ class Dlpc410:
             for b in range(self.dmd.blocks):
                 self._record_state(c, b)
             self._reset_controller()
-            self._prev_pins = self._prev2_pins = None
+            self._edges = []
         self._arstz = arstz
 
     def _init_cycle(self, c, s):
@@ -330,23 +348,26 @@ class Dlpc410:
         if rowmd or blkmd:
             raise RuleBreak(RULES["init_command"], c,
                             f"ROWMD={rowmd:02b} BLKMD={blkmd:02b} while INIT_ACTIVE is high")
-        pins = tuple(s.get(f"din_{b}", 0) for b in self.buses)
-        if self.check_training and self._arstz and self._prev2_pins is not None and self.init_active(c):
-            self._check_training(c, pins)
-        self._prev2_pins, self._prev_pins = self._prev_pins, pins
-
-    def _check_training(self, c, pins):
-        """Every pin repeats ``0100`` over four edges: any four consecutive edges hold one 1, and
-        the pattern repeats every two cycles."""
         mask = (1 << PINS_PER_BUS) - 1
-        for bus, now, prev, prev2 in zip(self.buses, pins, self._prev_pins, self._prev2_pins, strict=True):
-            edges = [now & mask, now >> PINS_PER_BUS, prev & mask, prev >> PINS_PER_BUS]
+        for e in range(2 * self.beats):
+            edge = tuple(s.get(f"din_{b}", 0) >> (PINS_PER_BUS * e) & mask for b in self.buses)
+            if self.check_training and self._arstz and len(self._edges) == 4 and self.init_active(c):
+                self._check_training(c, edge)
+            self._edges = (self._edges + [edge])[-4:]
+
+    def _check_training(self, c, edge):
+        """Every pin repeats ``0100`` over four edges: any four consecutive edges hold one 1 on
+        each pin, and every edge repeats the one four edges before."""
+        mask = (1 << PINS_PER_BUS) - 1
+        window = self._edges[1:] + [edge]
+        for i, bus in enumerate(self.buses):
+            edges = [e[i] for e in window]
             two = 0
-            for i in range(4):
-                for j in range(i + 1, 4):
-                    two |= edges[i] & edges[j]
+            for a in range(4):
+                for b in range(a + 1, 4):
+                    two |= edges[a] & edges[b]
             one = edges[0] | edges[1] | edges[2] | edges[3]
-            bad = two | (~one & mask) | ((now ^ prev2) & mask) | ((now ^ prev2) >> PINS_PER_BUS)
+            bad = two | (~one & mask) | (edge[i] ^ self._edges[0][i])
             if bad:
                 pin = (bad & -bad).bit_length() - 1
                 raise RuleBreak(RULES["init_training"], c,
@@ -355,27 +376,30 @@ class Dlpc410:
     # --- row-cycle framing ---------------------------------------------------------------------
 
     def _framing(self, c, s):
+        """One cycle's ``beats`` DCLK cycles, each a beat of a row cycle or an idle DCLK cycle."""
         dvalid = s.get("dvalid", 0)
-        if not dvalid:
-            if self._row is not None:
-                raise RuleBreak(RULES["row_cycle"], c,
-                                f"DVALID fell after {len(self._row.beats)} of {self.dmd.dclk_per_row} "
-                                f"cycles of the row cycle from cycle {self._row.start}")
-            if self._gap is not None:
-                self._gap += 1
-            return
-        if self._row is None:
-            self._start_row(c, s)
-        elif _held(s) != self._row.held:
-            changed = [n for n, a, b in zip(_HELD, _held(s), self._row.held, strict=True) if a != b]
-            raise RuleBreak(RULES["row_hold"], c,
-                            f"{', '.join(changed).upper()} changed in cycle {len(self._row.beats) + 1} "
-                            f"of the row cycle from cycle {self._row.start}")
-        self._row.beats.append([s.get(f"din_{b}", 0) for b in self.buses])
-        if len(self._row.beats) == self.dmd.dclk_per_row:
-            self._end_row(self._row)
-            self._row = None
-            self._gap = 0
+        pair = (1 << (2 * PINS_PER_BUS)) - 1
+        for b in range(self.beats):
+            if not dvalid >> (2 * b) & 1:
+                if self._row is not None:
+                    raise RuleBreak(RULES["row_cycle"], c,
+                                    f"DVALID fell after {len(self._row.beats)} of {self.dmd.dclk_per_row} "
+                                    f"DCLK cycles of the row cycle from cycle {self._row.start}")
+                if self._gap is not None:
+                    self._gap += 1
+                continue
+            if self._row is None:
+                self._start_row(c, s)
+            elif _held(s) != self._row.held:
+                changed = [n for n, x, y in zip(_HELD, _held(s), self._row.held, strict=True) if x != y]
+                raise RuleBreak(RULES["row_hold"], c,
+                                f"{', '.join(changed).upper()} changed in DCLK cycle {len(self._row.beats) + 1} "
+                                f"of the row cycle from cycle {self._row.start}")
+            self._row.beats.append([s.get(f"din_{bus}", 0) >> (2 * PINS_PER_BUS * b) & pair for bus in self.buses])
+            if len(self._row.beats) == self.dmd.dclk_per_row:
+                self._end_row(self._row)
+                self._row = None
+                self._gap = 0
 
     def _start_row(self, c, s):
         earliest = self.init_end + self.init_to_dvalid_clocks
@@ -600,6 +624,10 @@ def amaranth_process(model, iface, *, domain="sync"):
     return process
 
 
+#: What a quiet cycle's pins amount to (:meth:`CocotbAdapter._sample`).
+_QUIET = {"dvalid": 0, "arstz": 1}
+
+
 class CocotbAdapter:
     """Steps ``model`` on each rising edge of ``clock`` from the signals of a cocotb ``dut``.
 
@@ -612,10 +640,17 @@ class CocotbAdapter:
     Each cycle it samples the pins mid-cycle (falling edge of ``clock``, where registered
     outputs are stable) and drives the controller's outputs after the next rising edge, as
     :func:`amaranth_process` does.
+
+    With ``rest``, quiet stretches (:meth:`Dlpc410.quiet`, DVALID low and ARSTZ high) in which
+    the controller's outputs stay as they are (:meth:`Dlpc410.quiet_outputs_until`) are not
+    stepped cycle by cycle: the adapter rests until DVALID or ARSTZ changes (on a rising edge
+    of ``clock``) and then gives the model the cycles it rested as :meth:`Dlpc410.idle`, which
+    is stepping each of them. Meanwhile the model's ``cycle`` lags behind the simulation: for
+    testbenches that read the model's commands (``log``, the mirror history), not its cycle.
     """
 
-    def __init__(self, model, dut, clock, *, prefix="dlpc__", names=None):
-        self.model, self.clock = model, clock
+    def __init__(self, model, dut, clock, *, prefix="dlpc__", names=None, rest=False):
+        self.model, self.clock, self.rest = model, clock, rest
         names = names or {}
 
         def handle(member):
@@ -625,6 +660,7 @@ class CocotbAdapter:
         self.outputs = [(n, h) for n in OUTPUTS if (h := handle(n)) is not None]
         self._dvalid, self._arstz = handle("dvalid"), handle("arstz")
         self._driven = {}
+        self._changed = None         # set when DVALID or ARSTZ changes, once the adapter rests
 
     def _drive(self, levels):
         for n, h in self.outputs:
@@ -636,15 +672,53 @@ class CocotbAdapter:
         if self._dvalid is not None and self._arstz is not None and self.model.quiet():
             dvalid, arstz = int(self._dvalid.value), int(self._arstz.value)
             if not dvalid and arstz:
-                return {"dvalid": 0, "arstz": 1}
+                return dict(_QUIET)
         return {n: int(h.value) for n, h in self.inputs}
 
     async def run(self):
         from cocotb.triggers import FallingEdge, RisingEdge
+        from cocotb.utils import get_sim_time
 
+        falling, rising = FallingEdge(self.clock), RisingEdge(self.clock)
         self._drive(self.model.outputs())
+        last = period = None
         while True:
-            await FallingEdge(self.clock)
+            await falling
             sampled = self._sample()
-            await RisingEdge(self.clock)
+            await rising
             self._drive(self.model.step(sampled))
+            if not self.rest:
+                continue
+            now = get_sim_time("step")
+            if period is None:       # the clock's period, from its first two rising edges
+                period, last = (None if last is None else now - last), now
+            elif sampled == _QUIET and self.model.quiet():
+                await self._rest(now, period)
+
+    async def _rest(self, edge, period):
+        """Rest from the rising edge at ``edge`` (steps) while the model is quiet and its outputs
+        stay as they are; on return, the next falling edge samples the next cycle the model has
+        not had."""
+        import cocotb
+        from cocotb.triggers import Event
+        from cocotb.utils import get_sim_time
+
+        if self._dvalid is None or self._arstz is None or self.model.quiet_outputs_until() is not None:
+            return
+        if self._changed is None:
+            # one waiter per pin for the whole run: the adapter itself waits on a single event,
+            # so that cancelling it stays immediate
+            self._changed = Event()
+            for pin in (self._dvalid, self._arstz):
+                cocotb.start_soon(self._watch(pin))
+        self._changed.clear()
+        await self._changed.wait()
+        rested, phase = divmod(get_sim_time("step") - edge, period)
+        assert phase == 0, "DVALID or ARSTZ changed between rising edges of the clock"
+        if rested:
+            self.model.idle(rested, dict(_QUIET))
+
+    async def _watch(self, pin):
+        while True:
+            await pin.value_change
+            self._changed.set()

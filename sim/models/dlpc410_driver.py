@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gateware.dlpc410.beat import PINS_PER_BUS, word_to_lanes
-from spec.facts import BlockMode, RowMode
+from spec.facts import TIMING, BlockMode, RowMode
 
 __all__ = ["Idle", "Driver", "row_words", "expand"]
 
@@ -33,15 +33,29 @@ def _pair(lanes, bus):
     return lanes[(bus, "rise")] | (lanes[(bus, "fall")] << PINS_PER_BUS)
 
 
-def beat_pins(words, buses):
-    """The words of one beat -> ``{"din_a": packed DinPair, ...}`` (the second word of a
-    four-bus DMD on C/D)."""
+#: The training pattern's bit on each of its four DDR edges (facts: ``0100``, edge 0 first).
+_TRAINING = tuple(int(TIMING["training_pattern"].value) >> (3 - k) & 1 for k in range(4))
+
+
+def beat_pins(words, buses, beat=0):
+    """The words of one beat -> ``{"din_a": packed edge pair, ...}`` (the second word of a
+    four-bus DMD on C/D), placed at the ``beat``-th DCLK cycle's edges of a ``dmd`` cycle."""
     pins = {}
     for i, word in enumerate(words):
         lanes = word_to_lanes(word)
         first, second = buses[2 * i], buses[2 * i + 1]
-        pins[f"din_{first}"] = _pair(lanes, "A")
-        pins[f"din_{second}"] = _pair(lanes, "B")
+        pins[f"din_{first}"] = _pair(lanes, "A") << (2 * PINS_PER_BUS * beat)
+        pins[f"din_{second}"] = _pair(lanes, "B") << (2 * PINS_PER_BUS * beat)
+    return pins
+
+
+def cycle_pins(words, buses, beats):
+    """The words of one ``dmd`` cycle of ``beats`` beats -> the packed data pins."""
+    per_beat = len(words) // beats
+    pins = {f"din_{b}": 0 for b in buses}
+    for beat in range(beats):
+        for name, value in beat_pins(words[beat * per_beat:(beat + 1) * per_beat], buses, beat).items():
+            pins[name] |= value
     return pins
 
 
@@ -55,12 +69,14 @@ def expand(items):
 
 
 class Driver:
-    """Builds a cycle sequence for ``dmd``; :attr:`cycle` is the index of the next cycle."""
+    """Builds a cycle sequence for ``dmd`` at ``beats`` DCLK cycles per cycle; :attr:`cycle`
+    is the index of the next cycle."""
 
-    def __init__(self, dmd):
+    def __init__(self, dmd, beats=1):
         self.dmd = dmd
+        self.beats = beats
         self.buses = "abcd"[:dmd.buses]
-        self.words_per_beat = dmd.bits_per_dclk // 64
+        self.words_per_cycle = dmd.bits_per_dclk * beats // 64
         self.items = []
         self.cycle = 0
 
@@ -73,11 +89,14 @@ class Driver:
         self.training(count, arstz=0)
 
     def training(self, count, *, arstz=1):
-        """The training pattern ``0100`` on every data pin: rising edges 0, falling edges
-        alternating 1 and 0 from cycle to cycle; DVALID low; no commands."""
+        """The training pattern ``0100`` on every data pin and DVALID, edge after edge (its
+        phase counted from cycle 0); no commands."""
+        edges = 2 * self.beats
         for _ in range(count):
-            fall = 0xffff if self.cycle % 2 == 0 else 0
-            self._emit({"arstz": arstz, **{f"din_{b}": fall << PINS_PER_BUS for b in self.buses}})
+            bits = [_TRAINING[(self.cycle * edges + e) % 4] for e in range(edges)]
+            din = sum((0xffff if bit else 0) << (PINS_PER_BUS * e) for e, bit in enumerate(bits))
+            dvalid = sum(bit << e for e, bit in enumerate(bits))
+            self._emit({"arstz": arstz, "dvalid": dvalid, **{f"din_{b}": din for b in self.buses}})
 
     def start(self, init_cycles, *, reset_cycles=4, ecp2_cycles=4, after=64):
         """Reset, training through initialisation, then the wait before the first DVALID.
@@ -105,12 +124,12 @@ class Driver:
         cycle it starts on."""
         start = self.cycle
         words = row_words(bits) if bits is not None else [0] * self.dmd.words_per_row
-        command = {"arstz": 1, "dvalid": 1, "rowmd": int(RowMode(rowmd).value), "rowad": rowad,
-                   "blkmd": int(BlockMode(blkmd).value), "blkad": blkad, "rst2blkz": rst2blkz,
+        command = {"arstz": 1, "dvalid": (1 << (2 * self.beats)) - 1, "rowmd": int(RowMode(rowmd).value),
+                   "rowad": rowad, "blkmd": int(BlockMode(blkmd).value), "blkad": blkad, "rst2blkz": rst2blkz,
                    "comp_data": comp_data, "ns_flip": ns_flip}
-        n = self.words_per_beat
-        for beat in range(self.dmd.dclk_per_row if cut is None else cut):
-            self._emit({**command, **beat_pins(words[beat * n:(beat + 1) * n], self.buses)})
+        n = self.words_per_cycle
+        for c in range(self.dmd.dclk_per_row // self.beats if cut is None else cut):
+            self._emit({**command, **cycle_pins(words[c * n:(c + 1) * n], self.buses, self.beats)})
         return start
 
     def load(self, plane, rows=None, *, ns_flip=0):
@@ -164,7 +183,8 @@ def play_schedule(driver, dmd, p, result, images, offset):
             planes[fi, e] = (np.asarray(images[fi]) >> (8 - depth + e)) & 1
         return planes[fi, e]
 
-    for t, kind, arg in result.commands:
+    # the no-op rows a 1080p clear occupies come with the clear (Driver.clear)
+    for t, kind, arg in result.decoded():
         driver.wait_until(t + offset)
         if kind == "pulse":
             g = group_of[arg[0]]
@@ -182,6 +202,4 @@ def play_schedule(driver, dmd, p, result, images, offset):
                 assert e is not None, f"row {arg} loaded for a dark pulse"
                 bits = plane(fi, e)[arg]
             start = driver.row(RowMode.ADDRESSED, rowad=arg, bits=bits)
-        else:
-            start = driver.row()
         assert start == t + offset, f"{kind} at schedule cycle {t} lands on {start - offset}"

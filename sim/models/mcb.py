@@ -1,17 +1,21 @@
 """A model of the Spartan-6 MCB's native user ports that checks its clients.
 
-One plain-Python :class:`McbModel` holds the memory (numpy, 64-bit words) and the shared DRAM
-timing; each :class:`McbPort` has the fabric-side FIFOs of one 64-bit port (4 commands, 64 write
-words, 64 read words) and is clocked by its own clock: :meth:`McbPort.clock` is called once per
-rising edge of that clock with the inputs sampled at the edge and returns the registered outputs
-for the next cycle. Thin adapters drive it from the Amaranth simulator
-(:func:`amaranth_process`) and from cocotb (:class:`CocotbPort`).
+One plain-Python :class:`McbModel` holds the memory (numpy, 64-bit words, bytes in address
+order from the low bits up) and the shared DRAM timing; each :class:`McbPort` has the
+fabric-side FIFOs of one port of 32, 64 or 128 bits (4 commands, 64 write words and 64 read
+words of the port's width; a port word covers ``width / 8`` consecutive bytes, so a 128-bit
+word holds two 64-bit memory words, the first in its low bits) and is clocked by its own
+clock: :meth:`McbPort.clock` is called once per rising edge of that clock with the inputs
+sampled at the edge and returns the registered outputs for the next cycle. Thin adapters
+drive it from the Amaranth simulator (:func:`amaranth_process`) and from cocotb
+(:class:`CocotbPort`).
 
 Timing
 ------
-The memory moves one 64-bit word every ``8 / (peak_bytes_per_s * efficiency)`` seconds (DDR2-800
-x16: 1.6 GB/s peak, about 85-90 % sustained on sequential bursts); reads and writes of all ports
-share it, commands are granted round robin. A command starts ``command_latency_s`` after it
+The memory moves one byte every ``1 / (peak_bytes_per_s * efficiency)`` seconds (DDR2-800
+x16: 1.6 GB/s peak, about 85-90 % sustained on sequential bursts), so a 128-bit word takes twice
+the time of a 64-bit one: the DRAM, not the port, sets the bandwidth. Reads and writes of all
+ports share it, commands are granted round robin. A command starts ``command_latency_s`` after it
 was pushed at the earliest; read words reach the read FIFO ``read_latency_s`` after their slot on
 the memory; written words leave the write FIFO one per word time. Every ``refresh_interval_s``
 (7.8 us) the memory is busy for ``refresh_s`` (about 160 ns) after the command in progress.
@@ -22,8 +26,9 @@ Errors
 ------
 :class:`McbError` (with a ``kind``) is raised on: traffic before ``calib_done``
 (``before_calib``), a command while ``cmd_full`` (``cmd_full``), a byte address that is not a
-multiple of 8 or a burst outside the memory (``misaligned``, ``out_of_range``), a write command
-whose words are not all in the write FIFO when it is pushed (``data_missing``), a write word
+multiple of the port's word (4, 8 or 16 bytes) or a burst outside the memory (``misaligned``,
+``out_of_range``), a write command whose words are not all in the write FIFO when it is pushed
+(``data_missing``), a write word
 pushed while ``wr_full`` (``wr_full``), a read word taken while ``rd_empty`` (``rd_empty``), the
 controller finding the write FIFO empty during a write (``underrun``, reachable only with
 ``check_write_data=False``, as the real MCB does not check at push time), read data arriving at
@@ -36,14 +41,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["McbError", "McbTiming", "McbModel", "McbPort", "amaranth_process", "CocotbPort",
+__all__ = ["McbError", "McbTiming", "McbModel", "McbPort", "amaranth_process", "CocotbPort", "widths",
            "WRITE", "READ", "WRITE_PRECHARGE", "READ_PRECHARGE", "REFRESH"]
 
 WRITE, READ, WRITE_PRECHARGE, READ_PRECHARGE, REFRESH = 0b000, 0b001, 0b010, 0b011, 0b100
 COMMAND_DEPTH = 4
-FIFO_DEPTH = 64
-WORD_BYTES = 8
-MASK64 = (1 << 64) - 1
+FIFO_DEPTH = 64     # port words, at every width
+WIDTHS = (32, 64, 128)
 
 INPUTS = ("cmd_en", "cmd_instr", "cmd_bl", "cmd_byte_addr", "wr_en", "wr_data", "wr_mask", "rd_en")
 OUTPUTS = ("cmd_full", "cmd_empty", "wr_full", "wr_empty", "wr_count", "wr_underrun", "wr_error",
@@ -71,8 +75,14 @@ class McbTiming:
     stall_max_s: float = 0.0            # (bank conflicts, the other port's turn, ...)
 
     @property
+    def byte_s(self):
+        """Memory time of one byte."""
+        return 1 / (self.peak_bytes_per_s * self.efficiency)
+
+    @property
     def word_s(self):
-        return WORD_BYTES / (self.peak_bytes_per_s * self.efficiency)
+        """Memory time of one 64-bit word (a port word of ``width`` bits: ``width / 64`` of it)."""
+        return 8 * self.byte_s
 
     @property
     def sustained_bytes_per_s(self):
@@ -81,15 +91,20 @@ class McbTiming:
 
 
 class McbModel:
-    """The memory and its shared timing; ``ports`` user ports in ``self.ports``."""
+    """The memory and its shared timing; ``ports`` user ports in ``self.ports``, of ``widths``
+    bits (default 64 each)."""
 
-    def __init__(self, memory_bytes=16 * 2**20, *, ports=2, timing=None, check_write_data=True, seed=0):
+    def __init__(self, memory_bytes=16 * 2**20, *, ports=2, widths=None, timing=None, check_write_data=True,
+                 seed=0):
+        widths = (64,) * ports if widths is None else tuple(widths)
+        assert len(widths) == ports and all(w in WIDTHS for w in widths), widths
         self.timing = timing or McbTiming()
         self.rng = random.Random(seed)
-        self.memory = np.zeros(memory_bytes // WORD_BYTES, dtype=np.uint64)
+        self.memory = np.zeros(memory_bytes // 8, dtype="<u8")
+        self._bytes = self.memory.view(np.uint8)
         self.memory_bytes = memory_bytes
         self.check_write_data = check_write_data
-        self.ports = [McbPort(self, i) for i in range(ports)]
+        self.ports = [McbPort(self, i, w) for i, w in enumerate(widths)]
         self.now = 0.0
         self.busy_until = 0.0
         self.busy_s = 0.0
@@ -140,18 +155,33 @@ class McbModel:
             port._deliver(now)
         self.now = now
 
+    def read_word(self, address, size):
+        """The ``size`` bytes from byte ``address``, as an int (first byte in the low bits)."""
+        return int.from_bytes(self._bytes[address:address + size].tobytes(), "little")
+
+    def write_word(self, address, size, data, mask=0):
+        """Write ``data``'s ``size`` bytes at byte ``address``, but those whose ``mask`` bit is set."""
+        new = data.to_bytes(size, "little")
+        if not mask:
+            self._bytes[address:address + size] = np.frombuffer(new, np.uint8)
+            return
+        for i in range(size):
+            if not mask >> i & 1:
+                self._bytes[address + i] = new[i]
+
     def _execute(self, port, start, instr, words, address):
         t = self.timing
         if instr == REFRESH:
             duration = t.refresh_s
         else:
-            duration = words * t.word_s
-            first = address // WORD_BYTES
+            word_s = port.word_bytes * t.byte_s
+            duration = words * word_s
             for i in range(words):
+                at = address + i * port.word_bytes
                 if instr in (WRITE, WRITE_PRECHARGE):
-                    port.events.append((start + (i + 1) * t.word_s, "w", first + i))
+                    port.events.append((start + (i + 1) * word_s, "w", at))
                 else:
-                    port.events.append((start + t.read_latency_s + (i + 1) * t.word_s, "r", first + i))
+                    port.events.append((start + t.read_latency_s + (i + 1) * word_s, "r", at))
             if instr in (WRITE, WRITE_PRECHARGE):
                 port.claimed -= words
                 port.draining += words
@@ -162,13 +192,16 @@ class McbModel:
 class McbPort:
     """The fabric side of one user port; see the module's documentation."""
 
-    def __init__(self, model, index):
+    def __init__(self, model, index, width=64):
         self.model = model
         self.index = index
+        self.width = width
+        self.word_bytes = width // 8
+        self._data_mask = (1 << width) - 1
         self.commands = deque()      # (push time, instr, words, byte address)
         self.write_fifo = deque()    # (data, mask)
         self.read_fifo = deque()
-        self.events = deque()        # (time, "w"|"r", word address), in time order
+        self.events = deque()        # (time, "w"|"r", byte address), in time order
         self.claimed = 0             # write words owned by queued write commands
         self.draining = 0            # write words owned by started write commands
         self.underrun = self.overflow = False
@@ -182,27 +215,23 @@ class McbPort:
     def _deliver(self, now):
         model = self.model
         while self.events and self.events[0][0] <= now:
-            _time, kind, word = self.events.popleft()
+            _time, kind, address = self.events.popleft()
             if kind == "w":
                 self.draining -= 1
                 if not self.write_fifo:
                     self.underrun = True
                     raise McbError("underrun", f"port {self.index}: write FIFO empty during a write "
-                                               f"command (word address {word:#x})")
+                                               f"command (byte address {address:#x})")
                 data, mask = self.write_fifo.popleft()
-                if mask:
-                    old = int(model.memory[word])
-                    keep = sum(0xFF << (8 * b) for b in range(8) if mask >> b & 1)
-                    data = (old & keep) | (data & ~keep & MASK64)
-                model.memory[word] = data
-                model.write_log.append((word * WORD_BYTES, self.index))
+                model.write_word(address, self.word_bytes, data, mask)
+                model.write_log.append((address, self.index))
                 self.words_written += 1
             else:
                 if len(self.read_fifo) >= FIFO_DEPTH:
                     self.overflow = True
                     raise McbError("overflow", f"port {self.index}: read data arrived at a full read FIFO "
-                                               f"(word address {word:#x})")
-                self.read_fifo.append(int(model.memory[word]))
+                                               f"(byte address {address:#x})")
+                self.read_fifo.append(model.read_word(address, self.word_bytes))
                 self.words_read += 1
 
     # -- the fabric side
@@ -223,7 +252,7 @@ class McbPort:
         if wr_en:
             if seen["wr_full"]:
                 raise McbError("wr_full", f"port {self.index}: wr_en while wr_full")
-            self.write_fifo.append((wr_data & MASK64, wr_mask))
+            self.write_fifo.append((wr_data & self._data_mask, wr_mask & ((1 << self.word_bytes) - 1)))
         self.model.advance(now)
         self.outputs = self._outputs(now)
         self._quiet = bool(self.outputs["calib_done"]) and self.idle()
@@ -237,10 +266,10 @@ class McbPort:
         if instr not in (WRITE, READ, WRITE_PRECHARGE, READ_PRECHARGE, REFRESH):
             raise McbError("bad_instruction", f"port {self.index}: instruction {instr:#05b}")
         if instr != REFRESH:
-            if address % WORD_BYTES:
+            if address % self.word_bytes:
                 raise McbError("misaligned", f"port {self.index}: byte address {address:#x} is not "
-                                             f"a multiple of {WORD_BYTES}")
-            if address + words * WORD_BYTES > model.memory_bytes:
+                                             f"a multiple of {self.word_bytes}")
+            if address + words * self.word_bytes > model.memory_bytes:
                 raise McbError("out_of_range", f"port {self.index}: burst at {address:#x} ends past "
                                                f"the memory")
         if instr in (WRITE, WRITE_PRECHARGE):
@@ -284,6 +313,12 @@ class McbPort:
         return self._quiet
 
 
+def widths(*ports):
+    """The widths of MCB port interfaces (:class:`gateware.store.mcb.PortSignature`), for
+    :class:`McbModel`'s ``widths``."""
+    return tuple(port.signature.width for port in ports)
+
+
 def _plain(value):
     return value.value if hasattr(value, "value") else int(value)
 
@@ -318,14 +353,26 @@ def amaranth_process(port_model, port, *, domain, frequency):
 
 class CocotbPort:
     """Connects ``port_model`` to the Verilog ports ``<prefix>__<member>`` of ``dut``; start
-    :meth:`run` with ``cocotb.start_soon``. ``period_ns`` is that of ``clock``."""
+    :meth:`run` with ``cocotb.start_soon``. ``period_ns`` is that of ``clock``.
+
+    The model is clocked on every rising edge on which something can happen: while the port is
+    quiet (:meth:`McbPort.quiet`) and no strobe was set at the last edge, the adapter waits for
+    a strobe to change instead of looking at every edge.
+    """
 
     def __init__(self, dut, prefix, clock, port_model, period_ns):
         self.inputs = {name: getattr(dut, f"{prefix}__{name}") for name in INPUTS}
         self.outputs = {name: getattr(dut, f"{prefix}__{name}") for name in OUTPUTS}
         self.clock_signal, self.model, self.period = clock, port_model, period_ns * 1e-9
+        self.period_ns = period_ns
         self._last = {}
         self._drive(port_model.outputs)
+
+    @staticmethod
+    def widths(dut, *prefixes):
+        """The widths of the Verilog ports ``<prefix>__*`` of ``dut``, for :class:`McbModel`'s
+        ``widths``."""
+        return tuple(len(getattr(dut, f"{prefix}__rd_data")) for prefix in prefixes)
 
     def _drive(self, values):
         # only what changed: each write is a simulator call
@@ -348,13 +395,24 @@ class CocotbPort:
         return values
 
     async def run(self):
-        from cocotb.triggers import RisingEdge
-        cycle = 0
+        from cocotb.triggers import First, RisingEdge
+        from cocotb.utils import get_sim_steps, get_sim_time
         edge = RisingEdge(self.clock_signal)
+        strobes = [self.inputs[name].value_change for name in ("cmd_en", "wr_en", "rd_en")]
+        period = get_sim_steps(self.period_ns, "ns")
+        await edge
+        first, cycle = get_sim_time("step"), 1
         while True:
-            await edge
-            cycle += 1
             inputs = self._sample()
             if not (inputs["cmd_en"] or inputs["wr_en"] or inputs["rd_en"]) and self.model.quiet():
-                continue        # a Python call per edge of an idle port is most of a long run's time
+                # a Python call per edge of an idle port is most of a long run's time: none until
+                # a strobe changes, then the edges again from the next, numbered from the time
+                await First(*strobes)
+                await edge
+                steps = get_sim_time("step") - first
+                assert steps % period == 0, "the port's clock is not periodic"
+                cycle = steps // period + 1
+                continue
             self._drive(self.model.clock(cycle * self.period, **inputs))
+            await edge
+            cycle += 1

@@ -5,7 +5,7 @@
 function on both models. It follows the port's rules (write data before its command, no push
 while full, read commands only when the read FIFO has room for every word in flight) and keeps
 the words it read. :data:`CASES` are scripts that each break one rule, named by the Python
-model's :class:`~sim.models.mcb.McbError` kind.
+model's :class:`~sim.models.mcb.McbError` kind, for a port of a given width.
 """
 
 import random
@@ -13,19 +13,21 @@ import random
 from sim.models.mcb import FIFO_DEPTH, READ, WRITE, McbError, McbModel
 
 __all__ = ["Client", "traffic", "writes", "reads", "python_reads", "python_fault", "CASES", "FAULTS",
-           "PERIODS_S"]
+           "PERIODS_S", "WIDTHS"]
 
 #: ``mcb_model.v`` fault codes -> the Python model's error kinds.
 FAULTS = {1: "before_calib", 2: "cmd_full", 3: "misaligned", 4: "out_of_range", 5: "data_missing",
           6: "wr_full", 7: "rd_empty", 8: "underrun", 9: "overflow", 10: "bad_instruction"}
-#: The port clock periods the Verilog model's default parameters stand for.
+#: The port clock periods and widths the Verilog model's default parameters stand for (the
+#: store's: a 64-bit writer port, a 128-bit reader port).
 PERIODS_S = (8e-9, 5e-9)
+WIDTHS = (64, 128)
 WORDS = 1 << 21     # mcb_model.v's default
 
 
 class Client:
     """Runs ``ops``: ``("write", byte address, [(data, mask), ...])`` or ``("read", byte address,
-    words)``, one command each (at most 64 words), in order."""
+    words)``, one command each (at most 64 port words), in order."""
 
     def __init__(self, ops):
         self.ops = list(ops)
@@ -64,15 +66,17 @@ class Client:
         return inputs
 
 
-def traffic(seed=0, bursts=24):
-    """Write bursts of 1..64 words (some bytes masked) at scattered addresses, each then read
-    back in two halves."""
+def traffic(seed=0, bursts=24, width=64, base=0):
+    """Write bursts of ``width``-bit words (some bytes masked) at scattered 16-byte aligned
+    addresses from ``base``, each an even number of 64-bit words long (1..64 port words), so
+    that a port of either width reads them back whole."""
     rng = random.Random(seed)
     ops = []
     for i in range(bursts):
-        words = rng.randint(1, 64)
-        address = (i * 4096 + rng.randrange(0, 2048)) * 8
-        payload = [(rng.getrandbits(64), rng.choice([0, 0, 0, 0x0F, 0x81])) for _ in range(words)]
+        words = rng.randint(1, 64) if width == 128 else 2 * rng.randint(1, 32)
+        address = base + (i * 4096 + rng.randrange(0, 1024)) * 16
+        masks = [0, 0, 0, 0x0F, 0x81] + ([0x8001, 0x00F0] if width == 128 else [])
+        payload = [(rng.getrandbits(width), rng.choice(masks)) for _ in range(words)]
         ops.append(("write", address, payload))
     return ops
 
@@ -81,38 +85,45 @@ def writes(ops):
     return [op for op in ops if op[0] == "write"]
 
 
-def reads(ops):
-    """Each write's words read back, in two commands where it has more than one word."""
+def reads(ops, write_width, read_width):
+    """Each write's span read back in ``read_width``-bit words, in two commands where it has more
+    than one word."""
     out = []
     for _kind, address, payload in writes(ops):
-        half = max(1, len(payload) // 2)
+        words = len(payload) * write_width // read_width
+        half = max(1, words // 2)
         out.append(("read", address, half))
-        if len(payload) > half:
-            out.append(("read", address + 8 * half, len(payload) - half))
+        if words > half:
+            out.append(("read", address + half * read_width // 8, words - half))
     return out
 
 
-def _run(model, port, client, period, cycles=100000):
+def _model():
+    return McbModel(WORDS * 8, widths=WIDTHS)
+
+
+def _run(model, port, client, cycles=100000):
     outputs = model.ports[port].outputs
     for cycle in range(1, cycles + 1):
-        outputs = model.ports[port].clock(cycle * period, **client.step(outputs))
+        outputs = model.ports[port].clock(cycle * PERIODS_S[port], **client.step(outputs))
         if client.done():
             return cycle
     raise AssertionError("the client did not finish on the Python model")
 
 
-def python_reads(ops):
-    """What :func:`reads` of ``ops`` returns on the Python model after the writes on port 0."""
-    model = McbModel(WORDS * 8)
-    _run(model, 0, Client(writes(ops)), PERIODS_S[0])
-    reader = Client(reads(ops))
-    _run(model, 1, reader, PERIODS_S[1])
+def python_reads(ops, write_port=0, read_port=1):
+    """What :func:`reads` of ``ops`` returns on the Python model after the writes on
+    ``write_port``, read on ``read_port``."""
+    model = _model()
+    _run(model, write_port, Client(writes(ops)))
+    reader = Client(reads(ops, WIDTHS[write_port], WIDTHS[read_port]))
+    _run(model, read_port, reader)
     return reader.read
 
 
 def python_fault(script, port):
     """The error kind the Python model raises on ``script`` (per-cycle inputs) on ``port``."""
-    model = McbModel(WORDS * 8)
+    model = _model()
     try:
         for cycle, inputs in enumerate(script, start=1):
             model.ports[port].clock(cycle * PERIODS_S[port], **inputs)
@@ -131,15 +142,15 @@ def _read(address, words=1):
     return {"cmd_en": 1, "cmd_instr": READ, "cmd_bl": words - 1, "cmd_byte_addr": address}
 
 
-#: Scripts (per-cycle inputs of one port) that break one rule each.
+#: Scripts (per-cycle inputs of one port of ``width`` bits) that break one rule each.
 CASES = {
-    "before_calib": lambda: [_read(0)],
-    "rd_empty": lambda: _after_calib({"rd_en": 1}),
-    "misaligned": lambda: _after_calib(_read(4)),
-    "out_of_range": lambda: _after_calib(_read(WORDS * 8 - 8, 2)),
-    "data_missing": lambda: _after_calib({"wr_en": 1, "wr_data": 1}, {"wr_en": 1, "wr_data": 2},
-                                         {"cmd_en": 1, "cmd_instr": WRITE, "cmd_bl": 2, "cmd_byte_addr": 0}),
-    "wr_full": lambda: _after_calib(*[{"wr_en": 1, "wr_data": i} for i in range(FIFO_DEPTH + 1)]),
-    "cmd_full": lambda: _after_calib(*[_read(64 * 8 * i, 64) for i in range(8)]),
-    "overflow": lambda: _after_calib(_read(0, 64), _read(512, 64)),
+    "before_calib": lambda width: [_read(0)],
+    "rd_empty": lambda width: _after_calib({"rd_en": 1}),
+    "misaligned": lambda width: _after_calib(_read(width // 16)),          # half a port word
+    "out_of_range": lambda width: _after_calib(_read(WORDS * 8 - width // 8, 2)),
+    "data_missing": lambda width: _after_calib({"wr_en": 1, "wr_data": 1}, {"wr_en": 1, "wr_data": 2},
+                                               {"cmd_en": 1, "cmd_instr": WRITE, "cmd_bl": 2, "cmd_byte_addr": 0}),
+    "wr_full": lambda width: _after_calib(*[{"wr_en": 1, "wr_data": i} for i in range(FIFO_DEPTH + 1)]),
+    "cmd_full": lambda width: _after_calib(*[_read(64 * width // 8 * i, 64) for i in range(8)]),
+    "overflow": lambda width: _after_calib(_read(0, 64), _read(64 * width // 8, 64)),
 }

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 from spec import records, wire
 from spec.records import RecordType
+from spec.schedule import row_cycles
 
 __all__ = ["Model", "Rows", "ones_sum", "BROADCAST"]
 
@@ -35,6 +36,7 @@ class Model:
     ip: int
     port: int
     frame_bits: int = 4
+    beats: int = 1                  # DCLK beats per dmd cycle of the sequencer
     counters: dict = field(default_factory=dict)
     rows: list = field(default_factory=list)        # (frame tag, row, bytes) handed on
     replies: list = field(default_factory=list)     # ("arp"|"icmp"|"status", details)
@@ -174,7 +176,7 @@ class Model:
                 return "drop_app_value"
         if kind == RecordType.SEQUENCER:
             registers = wire.unpack(records.SEQUENCER, data[header_size:])
-            if any(records.register_faults(registers, self.dmd.dclk_per_row).values()):
+            if any(records.register_faults(registers, row_cycles(self.dmd, self.beats)).values()):
                 return "drop_app_value"
         mask = (1 << dict(records.HEADER)["sequence"]) - 1
         if self._sequence is not None and head["sequence"] != (self._sequence + 1) & mask:

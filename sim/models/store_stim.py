@@ -34,6 +34,11 @@ def random_image(dmd, seed):
     return np.random.default_rng(seed).integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8)
 
 
+def plane_words(transfers, width):
+    """The 64-bit plane words in ``transfers`` of ``width`` bits each, the low word first."""
+    return [int(t) >> (64 * i) & (2**64 - 1) for t in transfers for i in range(width // 64)]
+
+
 def check_plane(dmd, image, plane, words, first_row=0, row_count=None, what=""):
     """``words`` (read back in order) against numpy's slicing of ``image``."""
     row_count = dmd.rows if row_count is None else row_count
@@ -78,18 +83,18 @@ class PortDriver:
         while not self.port.outputs["calib_done"]:
             self.tick()
 
-    def write(self, address, words):
+    def write(self, address, words, masks=None):
         """One burst as the writer gives it: the words first, then the command."""
         while not self.port.outputs["calib_done"] or self.port.outputs["wr_count"] > 64 - len(words):
             self.tick()
-        for w in words:
-            self.tick(wr_en=1, wr_data=int(w))
+        for w, mask in zip(words, masks or [0] * len(words), strict=True):
+            self.tick(wr_en=1, wr_data=int(w), wr_mask=mask)
         while self.port.outputs["cmd_full"]:
             self.tick()
         self.tick(cmd_en=1, cmd_instr=0, cmd_bl=len(words) - 1, cmd_byte_addr=address)
 
     def read(self, address, count, lookahead=4):
-        """``count`` words from ``address`` in bursts of up to 64, ``lookahead`` in flight."""
+        """``count`` port words from ``address`` in bursts of up to 64, ``lookahead`` in flight."""
         out, issued, reserved = [], 0, 0
         while len(out) < count:
             o = self.port.outputs
@@ -102,7 +107,7 @@ class PortDriver:
             if (burst and o["calib_done"] and not o["cmd_full"]
                     and reserved + burst <= 64 * lookahead):
                 inputs.update(cmd_en=1, cmd_instr=1, cmd_bl=burst - 1,
-                              cmd_byte_addr=address + issued * 8)
+                              cmd_byte_addr=address + issued * self.port.word_bytes)
                 issued += burst
                 reserved += burst
             self.tick(**inputs)

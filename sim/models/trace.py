@@ -11,12 +11,11 @@ responder drove equal the model's; :func:`gmii_frames` cuts a GMII transmit trac
 :func:`write_vcd` turns a window of a trace into waves.
 """
 
-from amaranth.lib import data
-
 from gateware.mac import gmii as gmii_pins
+from sim.harness.layout import fields
 from sim.models.dlpc410 import INPUTS, OUTPUTS
 
-__all__ = ["read", "fields", "Mismatch", "replay_dlpc410", "rising_edges", "gmii_frames", "write_vcd"]
+__all__ = ["read", "Mismatch", "replay_dlpc410", "rising_edges", "gmii_frames", "write_vcd"]
 
 #: Controller outputs the responder drives and the replay compares.
 COMPARED = ("init_active", "rst_active", "ecp2_finished")
@@ -34,12 +33,6 @@ def read(path):
             cycle, value = line.split()
             out.append((int(cycle), int(value, 16)))
     return out
-
-
-def fields(layout):
-    """``[(name, offset, mask)]`` of a flat struct layout, for fast unpacking."""
-    layout = data.Layout.cast(layout)
-    return [(name, field.offset, (1 << field.width) - 1) for name, field in layout]
 
 
 def rising_edges(trace, layout, name):

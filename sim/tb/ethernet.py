@@ -78,10 +78,15 @@ class Bench:
 
     async def _take_pixels(self):
         dut = self.dut
+        edge, driven = RisingEdge(dut.clk), None
         while True:
             ready = not (self._stall and self._rng.random() < self._stall)
-            dut.pixels__ready.value = int(ready)
-            await RisingEdge(dut.clk)
+            if ready != driven:
+                dut.pixels__ready.value = driven = ready
+            if not self._stall and not dut.pixels__valid.value:
+                # always ready and nothing offered: no cycle to look at until valid rises
+                await RisingEdge(dut.pixels__valid)
+            await edge
             if ready and dut.pixels__valid.value:
                 bits = dut.pixels__payload.value.to_unsigned()
                 pixel = tuple(bits >> offset & mask for offset, mask in self._fields)
@@ -93,11 +98,8 @@ class Bench:
     async def send(self, gmii_frames, timeout_ms=20):
         for frame in gmii_frames:
             await self.source.send(frame)
-        await with_timeout(self._drained(), timeout_ms, "ms")
+        await with_timeout(self.source.wait(), timeout_ms, "ms")
 
-    async def _drained(self):
-        while not self.source.idle() or not self.source.empty():
-            await RisingEdge(self.dut.gmii_rx_clk)
 
     async def settle(self, quiet_ps=10_000_000):
         """Wait until no pixel and no transmitted byte for ``quiet_ps``."""

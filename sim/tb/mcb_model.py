@@ -1,8 +1,9 @@
 """cocotb: the Verilog MCB model (``sim/hdl/mcb_model.v``) against the Python one.
 
-The same client (:class:`sim.models.mcb_client.Client`) runs on both: the words it reads back
-must agree. Scripted rule breaks, one per port and run (the Verilog fault
-code is sticky), must give the rule the Python model names.
+The same client (:class:`sim.models.mcb_client.Client`) runs on both, with the model's default
+ports (64 bits on port 0, 128 on port 1): the words it reads back must agree. Scripted rule
+breaks, one per port and run (the Verilog fault code is sticky), must give the rule the Python
+model names.
 """
 
 import cocotb
@@ -16,11 +17,12 @@ from sim.models import mcb_client
 
 
 def _widths(flow):
-    return {name: Shape.cast(member.shape).width for name, member in mcb.PortSignature().members.items()
+    return {name: Shape.cast(member.shape).width for name, member in mcb.PortSignature(128).members.items()
             if member.flow == flow}
 
 
-#: The port's members by width: driven by the user (the model's inputs) and by the model.
+#: The members' slots in the model's vectors (those of the widest port), driven by the user (the
+#: model's inputs) and by the model; a narrower port uses the low bits of its data and mask slots.
 WIDTHS, OUT_WIDTHS = _widths(wiring.Out), _widths(wiring.In)
 
 
@@ -72,17 +74,25 @@ async def run_ports(dut, ports, steps, cycles, until=None):
 
 @cocotb.test()
 async def client_traffic_agrees(dut):
-    """Writes (some masked) on port 0, then reads on port 1: same words as the Python model."""
+    """Writes (some masked) on one port, then reads on the other: same words as the Python
+    model, 64-bit words written and read as 128-bit ones, then 128-bit ones as 64-bit ones."""
     ports = await start(dut)
-    ops = mcb_client.traffic(seed=1)
-    writer, reader = mcb_client.Client(mcb_client.writes(ops)), mcb_client.Client(mcb_client.reads(ops))
-    await run_ports(dut, ports, [writer.step, None], 20000, until=writer.done)
-    assert writer.done(), "the writes did not finish"
-    await run_ports(dut, ports, [None, reader.step], 20000, until=reader.done)
-    assert reader.done(), "the reads did not finish"
-    want = mcb_client.python_reads(ops)
-    assert len(reader.read) == len(want), f"{len(reader.read)} words read, the Python model {len(want)}"
-    assert reader.read == want, f"{sum(a != b for a, b in zip(reader.read, want, strict=True))} words differ"
+    for write_port, base in ((0, 0), (1, 2**23)):
+        read_port = 1 - write_port
+        ops = mcb_client.traffic(seed=1 + write_port, width=mcb_client.WIDTHS[write_port], base=base)
+        writer = mcb_client.Client(mcb_client.writes(ops))
+        reader = mcb_client.Client(mcb_client.reads(ops, mcb_client.WIDTHS[write_port], mcb_client.WIDTHS[read_port]))
+        steps = [None, None]
+        steps[write_port] = writer.step
+        await run_ports(dut, ports, steps, 20000, until=writer.done)
+        assert writer.done(), f"the writes on port {write_port} did not finish"
+        steps = [None, None]
+        steps[read_port] = reader.step
+        await run_ports(dut, ports, steps, 20000, until=reader.done)
+        assert reader.done(), f"the reads on port {read_port} did not finish"
+        want = mcb_client.python_reads(ops, write_port, read_port)
+        assert len(reader.read) == len(want), f"{len(reader.read)} words read, the Python model {len(want)}"
+        assert reader.read == want, f"{sum(a != b for a, b in zip(reader.read, want, strict=True))} words differ"
     assert ports.fault(0) is None and ports.fault(1) is None
 
 
@@ -91,9 +101,10 @@ async def scripted_rule_breaks(dut):
     """One scripted sequence per port; each port's fault names the Python model's rule."""
     p = params()
     ports = await start(dut)
-    scripts = [iter(mcb_client.CASES[name]()) for name in p["case"]]
+    widths = mcb_client.WIDTHS
+    scripts = [iter(mcb_client.CASES[name](widths[port])) for port, name in enumerate(p["case"])]
     await run_ports(dut, ports, [lambda _out, s=s: next(s, None) for s in scripts], 1000)
     for port, name in enumerate(p["case"]):
-        want = mcb_client.python_fault(mcb_client.CASES[name](), port)
+        want = mcb_client.python_fault(mcb_client.CASES[name](widths[port]), port)
         assert want == name, f"the Python model says {want} for case {name}"
         assert ports.fault(port) == want, f"port {port}: Verilog says {ports.fault(port)}, Python {want}"

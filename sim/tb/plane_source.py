@@ -53,11 +53,13 @@ class TableSignature(wiring.Signature):
 
 class OfferedFrame(data.Struct):
     """An entry of the frame table: offer a frame of ``bit_depth`` planes in ``slot`` once the
-    sequencer's time base reaches ``ready``; entries after the last have ``valid`` low."""
+    sequencer's time base reaches ``ready`` (``sequence``: as the next frame of a stored
+    sequence); entries after the last have ``valid`` low."""
     valid: 1
     slot: SLOT_BITS
     bit_depth: 4
     ready: TIME_BITS
+    sequence: 1
 
 
 @dataclass
@@ -70,10 +72,11 @@ class Contents:
     offered: list
 
 
-def contents(dmd, frames, images=None):
-    """The tables for ``frames`` (list of (slot, bit depth) or (slot, bit depth, ready)) and
+def contents(dmd, frames, images=None, store_words=1):
+    """The tables for ``frames`` (list of (slot, bit depth), (slot, bit depth, ready) or (slot,
+    bit depth, ready, sequence)) and
     ``images`` ({slot: 8-bit image}; None: :func:`ramp_image` in every slot with every block
-    marked occupied, whatever the image holds)."""
+    marked occupied, whatever the image holds); the planes ``store_words`` words an entry."""
     assert len(frames) <= MAX_FRAMES, f"at most {MAX_FRAMES} frames"
     planes = np.zeros((SLOTS, 8, dmd.rows, dmd.words_per_row), dtype=np.uint64)
     occupancy = [[0] * dmd.blocks for _ in range(1 << SLOT_BITS)]
@@ -83,21 +86,25 @@ def contents(dmd, frames, images=None):
         planes[slot] = bitplane.plane_words(image)
         occupancy[slot] = [255] * dmd.blocks if images is None else \
             [int(x) for x in bitplane.occupancy(image, dmd.rows_per_block)]
-    offered = [OfferedFrame.const({"valid": 1, "slot": f[0], "bit_depth": f[1],
-                                   "ready": f[2] if len(f) > 2 else 0}).as_value().value for f in frames]
-    return Contents(planes.ravel(), [sum(v << (8 * b) for b, v in enumerate(row)) for row in occupancy], offered)
+    offered = [OfferedFrame.const({"valid": 1, "slot": f[0], "bit_depth": f[1], "ready": f[2] if len(f) > 2 else 0,
+                                   "sequence": f[3] if len(f) > 3 else 0}).as_value().value for f in frames]
+    words = planes.ravel()
+    if store_words > 1:
+        words = [sum(int(w) << (64 * i) for i, w in enumerate(words[k:k + store_words]))
+                 for k in range(0, len(words), store_words)]
+    return Contents(words, [sum(v << (8 * b) for b, v in enumerate(row)) for row in occupancy], offered)
 
 
 class PlaneSource(wiring.Component):
-    """Answers :class:`PlaneRequest` with words, one per cycle; offers the frame table's frames
-    in turn.
+    """Answers :class:`PlaneRequest` with words, ``store_words`` per transfer and a transfer a
+    cycle; offers the frame table's frames in turn.
 
     A frame is offered once ``now`` (the sequencer's time base) has reached its ``ready``,
     after the frames before it were taken or dropped.
 
     Members
     -------
-    requests : In(stream.Signature(PlaneRequest)); words : Out(stream.Signature(64))
+    requests : In(stream.Signature(PlaneRequest)); words : Out(stream.Signature(64 * store_words))
     frames : Out(stream.Signature(FrameInfo)); ``frame_id`` is the table index
     occ_slot : In(4); occupancy : Out(ArrayLayout(8, blocks))
         The slot's occupancy, one cycle later.
@@ -106,22 +113,22 @@ class PlaneSource(wiring.Component):
         The tables (:class:`Contents`), read asynchronously.
     """
 
-    def __init__(self, dmd):
-        self._dmd = dmd
+    def __init__(self, dmd, store_words=1):
+        self._dmd, self._store_words = dmd, store_words
         super().__init__({
             "requests": In(stream.Signature(PlaneRequest)),
-            "words": Out(stream.Signature(64)),
+            "words": Out(stream.Signature(64 * store_words)),
             "frames": Out(stream.Signature(FrameInfo)),
             "occ_slot": In(SLOT_BITS),
             "occupancy": Out(data.ArrayLayout(8, dmd.blocks)),
             "now": In(TIME_BITS),
-            **table_members(dmd),
+            **table_members(dmd, store_words),
         })
 
     def elaborate(self, platform):
         m = Module()
         dmd = self._dmd
-        wpr = dmd.words_per_row
+        wpr = dmd.words_per_row // self._store_words       # transfers per row
         req = Signal(PlaneRequest)
         busy = Signal()
         word = Signal(range(wpr))
@@ -150,25 +157,26 @@ class PlaneSource(wiring.Component):
         m.d.comb += [self.offered.addr.eq(index),
                      self.frames.valid.eq((index < MAX_FRAMES) & entry.valid & (self.now >= entry.ready)),
                      self.frames.payload.slot.eq(entry.slot), self.frames.payload.bit_depth.eq(entry.bit_depth),
+                     self.frames.payload.sequence.eq(entry.sequence),
                      self.frames.payload.frame_id.eq(index)]
         with m.If(self.frames.valid & self.frames.ready):
             m.d.sync += index.eq(index + 1)
         return m
 
 
-def table_depths(dmd):
-    """Words of each table: the planes of :data:`SLOTS` slots, the occupancy of every slot, and
-    :data:`MAX_FRAMES` frames."""
-    return {"planes": SLOTS * 8 * dmd.rows * dmd.words_per_row, "occupancy_map": 1 << SLOT_BITS,
+def table_depths(dmd, store_words=1):
+    """Entries of each table: the planes of :data:`SLOTS` slots (``store_words`` words an
+    entry), the occupancy of every slot, and :data:`MAX_FRAMES` frames."""
+    return {"planes": SLOTS * 8 * dmd.rows * dmd.words_per_row // store_words, "occupancy_map": 1 << SLOT_BITS,
             "offered": MAX_FRAMES}
 
 
-def table_members(dmd):
+def table_members(dmd, store_words=1):
     """The three table ports of :class:`PlaneSource` (the frame index counts one past the last
     entry)."""
-    depths = table_depths(dmd)
+    depths = table_depths(dmd, store_words)
     return {
-        "planes": Out(TableSignature(ceil_log2(depths["planes"]), 64)),
+        "planes": Out(TableSignature(ceil_log2(depths["planes"]), 64 * store_words)),
         "occupancy_map": Out(TableSignature(SLOT_BITS, 8 * dmd.blocks)),
         "offered": Out(TableSignature(ceil_log2(depths["offered"] + 1), OfferedFrame)),
     }
@@ -177,15 +185,21 @@ def table_members(dmd):
 class SourcedSequencer(wiring.Component):
     """The sequencer with a :class:`PlaneSource` in front of it; the tables are outside.
 
+    Parameters
+    ----------
+    dmd : DmdType
+    beats, store_words : int
+        As :class:`gateware.dlpc410.sequencer.Sequencer`'s.
+
     Members
     -------
     The sequencer's (:class:`gateware.dlpc410.sequencer.Sequencer`) but those facing the store,
     and the :class:`PlaneSource`'s tables.
     """
 
-    def __init__(self, dmd):
-        self._seq = Sequencer(dmd)
-        self._src = PlaneSource(dmd)
+    def __init__(self, dmd, *, beats=1, store_words=1):
+        self._seq = Sequencer(dmd, beats=beats, store_words=store_words)
+        self._src = PlaneSource(dmd, store_words)
         super().__init__({**members(self._seq, exclude=_STORE_SIDE), **members(self._src, TABLES)})
 
     def elaborate(self, platform):
@@ -211,10 +225,10 @@ class SequencerBench(wiring.Component):
     As :class:`SourcedSequencer`'s, without the tables.
     """
 
-    def __init__(self, dmd, frames, images=None):
-        self._dmd = dmd
-        self._core = SourcedSequencer(dmd)
-        self._contents = contents(dmd, frames, images)
+    def __init__(self, dmd, frames, images=None, *, beats=1, store_words=1):
+        self._dmd, self._store_words = dmd, store_words
+        self._core = SourcedSequencer(dmd, beats=beats, store_words=store_words)
+        self._contents = contents(dmd, frames, images, store_words)
         super().__init__(members(self._core, exclude=TABLES))
 
     def elaborate(self, platform):
@@ -223,7 +237,7 @@ class SequencerBench(wiring.Component):
         forward(m, self, core)
         c = self._contents
         init = {"planes": [int(x) for x in c.planes], "occupancy_map": c.occupancy, "offered": c.offered}
-        for name, depth in table_depths(self._dmd).items():
+        for name, depth in table_depths(self._dmd, self._store_words).items():
             port = getattr(core, name)
             m.submodules[name] = mem = memory.Memory(shape=len(Value.cast(port.data)), depth=depth,
                                                      init=init[name])

@@ -14,12 +14,15 @@ model; the model's mirror history feeds the camera model (:func:`frame_lights`).
 
 from dataclasses import dataclass, field
 
+from amaranth.lib import data
+
+from gateware.dlpc410.layouts import Status
 from gateware.registers import Registers
 from sim.harness.amaranth_sim import simulate
 from sim.models.camera import Camera
 from sim.models.dlpc410 import Dlpc410, amaranth_process
 from sim.tb.plane_source import SequencerBench
-from spec.schedule import RST_MARGIN
+from spec.schedule import FABRIC_HZ, RST_MARGIN
 
 __all__ = ["Run", "run_bench", "dlpc410_for", "frame_lights", "INIT_CYCLES", "INIT_GRACE",
            "CAMERA_RAMP", "CAMERA_DELAY"]
@@ -54,12 +57,12 @@ class Run:
         return list(zip(rises, falls, strict=False))
 
 
-def dlpc410_for(dmd, p, *, dclk=200e6, init_cycles=INIT_CYCLES, ecp2_cycles=4):
+def dlpc410_for(dmd, p, *, init_cycles=INIT_CYCLES, ecp2_cycles=4):
     """The rule model with the RST_ACTIVE and settle times ``p`` (schedule Params) was planned
-    for: ``t_rst`` covers RST_ACTIVE plus :data:`~spec.schedule.RST_MARGIN`."""
-    return Dlpc410(dmd, dclk=dclk, rst_active_cycles=p.t_rst - RST_MARGIN, settle_cycles=p.t_settle,
-                   init_cycles=init_cycles, init_grace_cycles=INIT_GRACE, ecp2_cycles=ecp2_cycles,
-                   strict_rst_active=p.strict_rst)
+    for (``t_rst`` covers RST_ACTIVE plus :data:`~spec.schedule.RST_MARGIN`), at its beats."""
+    return Dlpc410(dmd, beats=p.beats, clock_hz=FABRIC_HZ, rst_active_cycles=p.t_rst - RST_MARGIN,
+                   settle_cycles=p.t_settle, init_cycles=init_cycles, init_grace_cycles=INIT_GRACE,
+                   ecp2_cycles=ecp2_cycles, strict_rst_active=p.strict_rst)
 
 
 def frame_lights(model, frames, *, ramp=CAMERA_RAMP, delay=CAMERA_DELAY):
@@ -77,7 +80,7 @@ def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, nam
     ``pins``: ``now`` values at which the trigger pin rises (high for 4 cycles); ``early_pins``:
     testbench cycles (before initialisation ends) of extra rising edges. ``model``: the
     controller (default :func:`dlpc410_for`)."""
-    dut = SequencerBench(dmd, frames, images)
+    dut = SequencerBench(dmd, frames, images, beats=params.beats)
     regs = Registers.const(params.registers(dmd))
     model = dlpc410_for(dmd, params) if model is None else model
     run = Run(model)
@@ -123,8 +126,7 @@ def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, nam
             high_left = max(0, high_left - 1)
             sync_left = max(0, sync_left - 1)
         st = ctx.get(dut.status)
-        run.status = {k: int(getattr(st, k)) for k in
-                      ("now", "frames", "triggers", "overruns", "early", "late", "underruns", "bad_frames")}
+        run.status = {name: int(getattr(st, name)) for name, _ in data.Layout.cast(Status)}
 
     process = amaranth_process(model, dut.pins)
     simulate(dut, [bench], name=name, clocks={"sync": 200e6}, processes=[process])

@@ -18,7 +18,6 @@ from spec.facts import DMDS
 
 SYNC_NS, DMD_NS = 8, 5
 #: plain-number stream payloads, named for the layout helpers
-WORD = data.StructLayout({"word": 64})
 SLOT = data.StructLayout({"slot": SLOT_BITS})
 
 
@@ -26,11 +25,12 @@ class Bench:
     def __init__(self, dut):
         p = params()
         self.dut, self.dmd, self.slots = dut, DMDS[p["dmd"]], p["slots"]
-        self.model = McbModel(p["memory_bytes"])
+        self.model = McbModel(p["memory_bytes"], widths=CocotbPort.widths(dut, "mcb_write", "mcb_read"))
         self.pixels = StreamSource(dut, "pixels", pixel_layout(self.dmd, 8, 16), dut.clk)
         self.frames = StreamSink(dut, "frames", FrameInfo, dut.dmd_clk)
         self.requests = StreamSource(dut, "requests", PlaneRequest, dut.dmd_clk)
-        self.planes = StreamSink(dut, "planes", WORD, dut.dmd_clk)
+        self.width = len(dut.planes__payload)          # plane words a transfer, times 64
+        self.planes = StreamSink(dut, "planes", data.StructLayout({"words": self.width}), dut.dmd_clk)
         self.release_port = StreamSource(dut, "release", SLOT, dut.dmd_clk)
         dut.ask__valid.value = 0
 
@@ -65,8 +65,8 @@ class Bench:
         row_count = self.dmd.rows if row_count is None else row_count
         await self.requests.send([{"slot": slot, "plane": plane, "first_row": first_row,
                                    "row_count": row_count}])
-        words = await self.planes.receive(row_count * self.dmd.words_per_row)
-        return [w["word"] for w in words]
+        transfers = await self.planes.receive(row_count * self.dmd.words_per_row * 64 // self.width)
+        return store_stim.plane_words([t["words"] for t in transfers], self.width)
 
     async def occupancy(self, slot):
         dut, got = self.dut, []

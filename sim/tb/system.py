@@ -27,7 +27,8 @@ from pathlib import Path
 import cocotb
 import numpy as np
 from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles, RisingEdge, Timer
+from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
+from cocotb.utils import get_sim_time
 from scapy.layers.inet import IP, UDP
 from scapy.layers.l2 import Ether
 from scapy.packet import Raw
@@ -37,7 +38,7 @@ from gateware.mac.gmii import TxPins
 from gateware.store.slots import SlotCounters
 from host import codec
 from sim.harness.cocotb_run import params
-from sim.harness.layout import unpack
+from sim.harness.layout import fields, unpack
 from sim.models import gmii
 from sim.models.camera import Camera, to_lsb
 from sim.models.dlpc410 import CocotbAdapter, Dlpc410
@@ -57,17 +58,47 @@ def _address(text):
     return int(text.replace(":", ""), 16) if ":" in text else int.from_bytes(bytes(map(int, text.split("."))), "big")
 
 
+def _now_ps():
+    return round(get_sim_time("ps"))
+
+
+class Edges:
+    """The rising edges of a clock that cocotb's :class:`Clock` starts now (high first): counted
+    from the simulation time, and waited for without waking the testbench on every one."""
+
+    def __init__(self, clock, period_ns):
+        self.clock, self.period = clock, round(period_ns * 1000)
+        self.first = _now_ps()
+
+    def count(self):
+        """Rising edges so far, the one at this instant included."""
+        now = _now_ps()
+        return 0 if now < self.first else (now - self.first) // self.period + 1
+
+    async def cycles(self, n):
+        """As ``ClockCycles(clock, n)``: returns on the n-th rising edge from now. A timer runs
+        to a quarter period after the edge before it (so the testbench waits for that last edge
+        after the tasks that wait on every edge, as it would counting them), then the edge."""
+        target = self.first + (self.count() + n - 1) * self.period
+        wake = target - self.period + self.period // 4
+        now = _now_ps()
+        if wake > now:
+            await Timer(wake - now, "ps")
+        await RisingEdge(self.clock)
+        assert _now_ps() == target, "the clock's edges are not where they were counted"
+
+
 class System:
     def __init__(self, dut, p):
         self.dut, self.p = dut, p
         self.dmd = DMDS[p["dmd"]]
-        self.memory = McbModel(p["memory_bytes"])
+        self.memory = McbModel(p["memory_bytes"], widths=CocotbPort.widths(dut, "mcb_write", "mcb_read"))
         self.plan = run_plan(p)
-        self.dlpc = Dlpc410(self.dmd, dclk=1e9 / DMD_NS, rst_active_cycles=p["t_rst"],
+        self.dlpc = Dlpc410(self.dmd, clock_hz=1e9 / DMD_NS, rst_active_cycles=p["t_rst"],
                             settle_cycles=p["t_settle"], init_cycles=p["init_cycles"],
                             init_grace_cycles=p["init_grace"], check_training=p.get("check_training", True))
         self.net = Model(self.dmd, _address(p["mac"]), _address(p["ip"]), p["port"])
-        self.dmd_cycle = 0
+        self.dmd_clock = None            # the dmd clock's edges, once started
         self.frames_sent = 0
         self.mac = {"good": 0, "bad_fcs": 0}
         self.sequence = 0                # the host's record counter, as host.Client keeps it
@@ -88,31 +119,38 @@ class System:
         cocotb.start_soon(Clock(dut.gmii_tx_clk, GMII_NS, unit="ns").start())
         await Timer(250, "ps")
         cocotb.start_soon(Clock(dut.dmd_clk, DMD_NS, unit="ns").start())
+        self.dmd_clock = Edges(dut.dmd_clk, DMD_NS)
         await ClockCycles(dut.clk, 4)
         for rst in (dut.rst, dut.gmii_rx_rst, dut.gmii_tx_rst, dut.dmd_rst):
             rst.value = 0
         cocotb.start_soon(CocotbPort(dut, "mcb_write", dut.clk, self.memory.ports[0], SYNC_NS).run())
         cocotb.start_soon(CocotbPort(dut, "mcb_read", dut.dmd_clk, self.memory.ports[1], DMD_NS).run())
-        self.adapter = cocotb.start_soon(CocotbAdapter(self.dlpc, dut, dut.dmd_clk).run())
-        cocotb.start_soon(self._count_dmd())
+        # resting through quiet stretches: the testbench reads the model's commands, not its cycle
+        self.adapter = cocotb.start_soon(CocotbAdapter(self.dlpc, dut, dut.dmd_clk, rest=True).run())
         cocotb.start_soon(self._receive_tx())
+        self.counted_from = self.dmd_clock.count()
 
-    async def _count_dmd(self):
-        edge = RisingEdge(self.dut.dmd_clk)
-        while True:
-            await edge
-            self.dmd_cycle += 1
+    @property
+    def dmd_cycle(self):
+        """dmd cycles since the end of :meth:`start`: its rising edges, the one at this instant
+        included (the count the DLPC410 model's cycles follow)."""
+        return self.dmd_clock.count() - self.counted_from
 
     async def _receive_tx(self):
-        """Frames on the GMII transmit pins: preamble and SFD stripped, FCS checked."""
-        edge, frame = RisingEdge(self.dut.gmii_tx_clk), bytearray()
+        """Frames on the GMII transmit pins: preamble and SFD stripped, FCS checked. The pins
+        are registered on the transmit clock: sampled mid-cycle (falling edge) every cycle of a
+        frame, and between frames only once they change."""
+        pins, edge, frame = self.dut.gmii_tx, FallingEdge(self.dut.gmii_tx_clk), bytearray()
+        tx = {name: (offset, mask) for name, offset, mask in fields(TxPins)}
+        (d, d_mask), (en, _), (er, _) = tx["d"], tx["en"], tx["er"]
         while True:
             await edge
-            pins = unpack(TxPins, self.dut.gmii_tx.value.to_unsigned())
-            assert not pins["er"], "tx_er on the transmit pins"
-            if pins["en"]:
-                frame.append(pins["d"])
-            elif frame:
+            value = pins.value.to_unsigned()
+            assert not value >> er & 1, "tx_er on the transmit pins"
+            if value >> en & 1:
+                frame.append(value >> d & d_mask)
+                continue
+            if frame:
                 assert frame[:8] == gmii.PREAMBLE, "preamble or SFD wrong"
                 body = bytes(frame[8:])
                 assert zlib.crc32(body) == 0x2144DF1C, "bad FCS on a transmitted frame"
@@ -120,6 +158,7 @@ class System:
                 if UDP in packet:
                     self.replies.append(bytes(packet[UDP].payload))
                 frame = bytearray()
+            await pins.value_change
 
     # -- what the host sends ----------------------------------------------------------------
 
@@ -163,7 +202,7 @@ class System:
         handled; then ``settle_after_send`` cycles for the store to finish writing a frame and
         the sequencer to load it."""
         await self.status()
-        await ClockCycles(self.dut.dmd_clk, self.p["settle_after_send"])
+        await self.dmd_clock.cycles(self.p["settle_after_send"])
 
     async def deliver(self, frames, bad_fcs=()):
         await self.send(frames, bad_fcs)
@@ -194,7 +233,7 @@ class System:
         await RisingEdge(self.dut.dmd_clk)
         at = self.dmd_cycle
         self.dut.trigger_in.value = 1
-        await ClockCycles(self.dut.dmd_clk, 8)
+        await self.dmd_clock.cycles(8)
         self.dut.trigger_in.value = 0
         return at
 
@@ -261,10 +300,10 @@ async def frames_over_gmii_are_shown_exactly(dut):
         expect["triggers"] += 1
         task = cocotb.start_soon(system.send(*sending)) if sending else None
         for _ in range(burst):
-            await ClockCycles(dut.dmd_clk, period // (burst + 1))
+            await system.dmd_clock.cycles(period // (burst + 1))
             await system.trigger()
             expect["trigger_overruns"] += 1
-        await ClockCycles(dut.dmd_clk, period - burst * (period // (burst + 1)) + p["t_rst"] * 4)
+        await system.dmd_clock.cycles(period - burst * (period // (burst + 1)) + p["t_rst"] * 4)
         pulses = system.pulses_after(pin)
         if not pulses:     # the sequencer's counters, to say why
             counters = unpack(SequencerStatus, int(dut.sequencer.status.value))
@@ -292,7 +331,7 @@ async def frames_over_gmii_are_shown_exactly(dut):
     expect["registers_applied"] += 1
     await system.deliver(*encoded(0))
     pin = await system.trigger()
-    await ClockCycles(dut.dmd_clk, 200)
+    await system.dmd_clock.cycles(200)
     assert not system.pulses_after(pin), "a trigger reached the sequencer while disarmed"
     await system.records([codec.control_record(system.next_sequence(), armed=1)])
 

@@ -6,9 +6,12 @@ testbench only starts each replay, raises the trigger at chosen instants and wai
 ``replay_busy`` or on timers; the checks are made after the run on the traces
 (:mod:`sim.xga`).
 
-Sequence: frame 0 is sent; each frame is then triggered while the next one is sent (as a
-renderer streams), the next trigger coming once the frame has been shown and the next one has
-arrived; at the end a status query is sent and the reply is recorded on the transmit pins.
+Sequence: a control record makes the store keep the frames as a sequence; the frames are sent;
+``one_by_one`` frames are triggered, each once the one before has been shown and the next one
+loaded, at a different phase of the trigger against the clock; then ``back_to_back`` triggers
+come faster than frames can be shown (every ``fast_period_cycles``): each is held until the
+sequencer is ready. At the end a status query is sent and the reply is recorded on the transmit
+pins.
 """
 
 import json
@@ -97,25 +100,30 @@ async def stream_frames(dut):
     cocotb.start_soon(run.progress(p["progress_us"]))
     period_ns = p["period_cycles"] * DMD_NS
     frames = p["frames"]
-    await run.send(p["replays"][0], f"frame 1/{frames}")
-    await Timer(p["settle_us"], "us")
+    await run.send(p["replays"][0], "sequence of stored frames (control record)")
     for index in range(frames):
+        await run.send(p["replays"][index + 1], f"frame {index + 1}/{frames}")
+    await Timer(p["settle_us"], "us")
+    shown = 0
+    for index in range(p["one_by_one"]):
         # a different phase of the trigger against DCLK each time: latency has a spread
-        phase = (index * 1300) % int(DMD_NS * 1000)
-        await run.trigger(phase)
-        shown_at = run.events["triggers_ns"][-1] + period_ns + p["margin_us"] * 1e3
-        run.log(f"frame {index + 1}/{frames} triggered")
+        await run.trigger((index * 1300) % int(DMD_NS * 1000))
         if index == 0:
             last_pulse = run.events["triggers_ns"][0] + p["last_pulse_cycles"] * DMD_NS
             cocotb.start_soon(run.mark(last_pulse, "first_frame_last_pulse"))
-        if index + 1 < frames:
-            await run.send(p["replays"][index + 1], f"frame {index + 2}/{frames}")
-            await Timer(p["settle_us"], "us")
-        wait = shown_at - run.now_ns()
-        if wait > 0:
-            await Timer(round(wait), "ns")
-        run.log(f"frame {index + 1}/{frames} shown")
+        await Timer(round(period_ns + p["margin_us"] * 1e3), "ns")
+        shown += 1
+        run.log(f"frame {shown} triggered and shown")
         run.check_memory()
+    fast_ns = p["fast_period_cycles"] * DMD_NS
+    for index in range(p["back_to_back"]):
+        start = run.now_ns()
+        await run.trigger((index * 700) % int(DMD_NS * 1000))
+        shown += 1
+        run.log(f"frame {shown} triggered, back to back")
+        await Timer(round(start + fast_ns - run.now_ns()), "ns")
+    await Timer(round(2 * period_ns + p["margin_us"] * 1e3), "ns")
+    run.check_memory()
     await run.send(p["status_query"], "status query")
     await Timer(p["reply_us"], "us")
     dut.flush.value = 1
