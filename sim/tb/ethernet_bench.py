@@ -14,6 +14,10 @@ the receive MAC samples the record's last FCS byte (the ``gmii_rx`` edge after t
 it) up to and including the edge on which the record's first pixel is taken from ``pixels``. That
 first transfer is the earliest effect of the record outside the block and the moment its data
 starts flowing on: the stack holds the frame until its FCS verdict, so nothing of it leaves before.
+The first record's (``latency_first``) is the pipeline's own: nothing is ahead of it. A later
+record that starts a row may wait behind the rows before it (``latency_max``): a row split across
+the two records before it goes on only once its last piece has come, and the next image's record
+comes right after a shorter one that is still flowing out.
 """
 
 import json
@@ -66,8 +70,9 @@ async def line_rate(dut):
     # the records that start a row (their first pixel is the row's), and when that pixel left
     starting = {i: rows_of(i)[0] for i in range(len(gmii_frames))
                 if i == len(encoded) or i * pixels % dmd.columns == 0}
-    latencies = [math.ceil((row_start[row] - fcs_sampled[i]) / sync_ps) for i, row in starting.items()
-                 if row in row_start]
+    latency = {i: math.ceil((row_start[row] - fcs_sampled[i]) / sync_ps) for i, row in starting.items()
+               if row in row_start}
+    latencies = list(latency.values())
     span = row_start.get((2, 0), 0) - row_start.get((1, 0), 0)
     with open(p["out"], "w") as f:
         json.dump({
@@ -76,6 +81,6 @@ async def line_rate(dut):
             "records_image": got["app"]["records_image"], "mac_good": got["mac"]["good"],
             "rows_incomplete": got["app"]["rows_incomplete"],
             "payload_bytes": picture.size, "line_bytes": span / GMII_PS,
-            "latency_min": min(latencies), "latency_max": max(latencies),
+            "latency_first": latency.get(0), "latency_min": min(latencies), "latency_max": max(latencies),
             "header_bytes": records.IMAGE_HEADER, "pixels_per_record": pixels,
         }, f)
