@@ -1,7 +1,8 @@
 """Host side of the projector's network protocol: record encoder/decoder, UDP client and CLI.
 
 The records are built from :mod:`spec.records`, the same tables the gateware parser
-is generated from; the testbenches feed the gateware with this very encoder.
+is generated from; the testbenches feed the gateware with this very encoder. Plain Python and
+numpy: no HDL toolchain.
 """
 
 from .client import Client, ClientError
@@ -9,12 +10,15 @@ from .codec import (
                       ProtocolError,
                       control_record,
                       decode,
+                      image_record,
                       image_records,
-                      rows_per_record,
+                      pixels_per_record,
                       sequence_records,
                       sequencer_record,
                       status_query,
 )
+from .levels import Quantised, quantise
 
-__all__ = ["Client", "ClientError", "ProtocolError", "control_record", "decode", "image_records",
-           "rows_per_record", "sequence_records", "sequencer_record", "status_query"]
+__all__ = ["Client", "ClientError", "ProtocolError", "Quantised", "control_record", "decode", "image_record",
+           "image_records", "pixels_per_record", "quantise", "sequence_records", "sequencer_record",
+           "status_query"]

@@ -1,13 +1,20 @@
-"""Command line: ``python -m host send IMAGE...``, ``configure``, ``arm``/``disarm`` and ``status``."""
+"""Command line: ``python -m host send IMAGE...``, ``configure``, ``arm``/``disarm``, ``trigger`` and
+``status``.
+
+``send`` sizes records to the path MTU (``--mtu`` to say it), continues after the newest frame id
+the projector has (``--frame`` to choose), sends each frame at the smallest bit depth that shows it
+within ``--tolerance`` LSB (``--depth`` to fix it) and checks in a status reply that the projector
+took every record (``--no-check`` not to)."""
 
 import argparse
+import dataclasses
 import sys
 
 import numpy as np
 
 from spec import schedule
 from spec.facts import DMDS
-from spec.registers import PlaneOrder, ResetMode
+from spec.registers import PlaneOrder, ResetMode, TriggerMode
 
 from .client import DEFAULT_PORT, Client, ClientError
 
@@ -15,25 +22,33 @@ __all__ = ["main", "describe"]
 
 
 def _load(path):
-    """An 8-bit grey image from ``.npy`` or any format Pillow reads."""
+    """A grey image from ``.npy`` (8-bit, or real targets in 0..255) or any format Pillow reads."""
     try:
         if path.endswith(".npy"):
             image = np.load(path)
         else:
-            from PIL import Image
+            try:
+                from PIL import Image
+            except ImportError:
+                raise ClientError(f"{path}: reading image files needs Pillow "
+                                  "(pip install 'dmd-projector[images]'); .npy needs nothing") from None
             image = np.asarray(Image.open(path).convert("L"))
     except (OSError, ValueError) as error:
         raise ClientError(f"cannot read {path}: {error}") from error
-    if image.dtype != np.uint8 or image.ndim != 2:
-        raise ClientError(f"{path}: need a 2-D 8-bit image, got {image.dtype} {image.shape}")
+    if image.ndim != 2 or not (image.dtype == np.uint8 or np.issubdtype(image.dtype, np.floating)):
+        raise ClientError(f"{path}: need a 2-D 8-bit or real image, got {image.dtype} {image.shape}")
     return image
 
 
 def _plan(args):
     dmd = DMDS[args.dmd]
     plan = schedule.plan(dmd, args.dclk, depth=args.depth, reset_mode=ResetMode[args.reset_mode],
-                         order=PlaneOrder[args.order], exposure_s=args.exposure)
-    return dmd, plan
+                         order=PlaneOrder[args.order], exposure_s=args.exposure, words_per_cycle=args.read_rate)
+    trigger = TriggerMode[args.trigger.upper()]
+    period = round(args.period * schedule.FABRIC_HZ) if args.period else plan.frame_cycles
+    params = dataclasses.replace(plan.params, trigger=trigger,
+                                 period=period if trigger == TriggerMode.PERIODIC else plan.params.period)
+    return dmd, dataclasses.replace(plan, params=params)
 
 
 def describe(plan):
@@ -51,19 +66,35 @@ def main(argv=None):
     parser.add_argument("--timeout", type=float, default=1.0, help="seconds to wait for a reply")
     sub = parser.add_subparsers(dest="command", required=True)
     send = sub.add_parser("send", help="send images as consecutive frames")
-    send.add_argument("images", nargs="+", help=".npy or image files, 8-bit grey")
-    send.add_argument("--frame", type=int, default=0, help="frame id of the first image")
+    send.add_argument("--mtu", type=int, default=None,
+                      help="IP MTU of the path to the projector (default: what the system knows)")
+    send.add_argument("images", nargs="+", help=".npy or image files, grey")
+    send.add_argument("--frame", type=int, default=None,
+                      help="frame id of the first image (default: after the projector's newest)")
+    send.add_argument("--depth", type=int, default=None, help="bit depth, 1..8 (default: the smallest "
+                      "that shows each frame within --tolerance)")
+    send.add_argument("--tolerance", type=float, default=0.5, help="largest rounding error, 8-bit LSB")
     send.add_argument("--rate", type=float, default=100e6, help="pacing in bytes per second")
+    send.add_argument("--no-check", action="store_true", help="do not check the status after each frame")
     configure = sub.add_parser("configure", help="plan a schedule, say the rate it reaches, send it")
     configure.add_argument("--dmd", default="dlp7000", choices=sorted(DMDS))
-    configure.add_argument("--dclk", type=float, default=200e6, help="DCLK in Hz")
+    configure.add_argument("--dclk", type=float, default=400e6,
+                           help="DCLK in Hz the projector was built for (default 400e6; 200e6 for the older PROM)")
     configure.add_argument("--depth", type=int, default=8, help="bit-planes per frame, 1..8")
     configure.add_argument("--reset-mode", default="GLOBAL", choices=[m.name for m in ResetMode])
     configure.add_argument("--order", default="MSB_FIRST", choices=["MSB_FIRST", "LSB_FIRST"])
     configure.add_argument("--exposure", type=float, default=0.0,
                            help="least significant plane at least this long, seconds (0: shortest)")
+    configure.add_argument("--trigger", default="external", choices=[m.name.lower() for m in TriggerMode],
+                           help="what starts a frame: the trigger pin, a period, a software trigger "
+                                "(python -m host trigger) or the sync input")
+    configure.add_argument("--period", type=float, default=0.0,
+                           help="periodic trigger: seconds between frames (default: the fastest the plan allows)")
+    configure.add_argument("--read-rate", type=float, default=1.0,
+                           help="the store's read bandwidth in 64-bit words per DCLK cycle (row pacing)")
     configure.add_argument("--dry-run", action="store_true", help="say the rate, send nothing")
-    for name, text in (("arm", "let triggers reach the sequencer"), ("disarm", "ignore every trigger")):
+    for name, text in (("arm", "let triggers reach the sequencer"), ("disarm", "ignore every trigger"),
+                       ("trigger", "a software trigger (the sequencer's trigger mode must be software)")):
         sub.add_parser(name, help=text)
     sub.add_parser("status", help="print the projector's counters")
     args = parser.parse_args(argv)
@@ -74,18 +105,24 @@ def main(argv=None):
             print(f"{dmd.name}, {args.depth}-bit: {describe(plan)}")
             if args.dry_run:
                 return 0
-        with Client(args.address, args.port, timeout=args.timeout,
-                    rate=getattr(args, "rate", None)) as client:
+        with Client(args.address, args.port, timeout=args.timeout, rate=getattr(args, "rate", None),
+                    mtu=getattr(args, "mtu", None), check=not getattr(args, "no_check", False)) as client:
             if args.command == "send":
                 images = [_load(path) for path in args.images]
-                sent = client.send_sequence(images, args.frame)
-                print(f"sent {len(images)} frame(s) in {sent} records")
+                sent = client.send_sequence(images, args.frame, depth=args.depth, tolerance=args.tolerance)
+                for path, frame in zip(args.images, sent, strict=True):
+                    print(f"frame {frame.frame}: {path}, {frame.depth}-bit, {frame.records} records, "
+                          f"rounding error {frame.error_lsb:.3g} LSB")
+                print(f"sent {len(images)} frame(s) in {sum(f.records for f in sent)} records "
+                      f"of at most {client.limit} bytes (MTU {client.mtu})")
             elif args.command == "configure":
                 client.configure(plan, dmd)
                 client.control(bit_depth=args.depth)
                 print("sent; the sequencer takes it when no frame is playing")
             elif args.command in ("arm", "disarm"):
                 client.control(armed=int(args.command == "arm"))
+            elif args.command == "trigger":
+                client.control(software_trigger=True)
             else:
                 for name, value in client.status().items():
                     print(f"{name:24} {value}")

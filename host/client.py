@@ -1,19 +1,85 @@
-"""A UDP client for the projector: sends images and control records, asks for status."""
+"""A UDP client for the projector: sends frames and control records, asks for status.
 
+What it does for the user:
+
+* **Record size.** Records must travel unfragmented (the projector drops fragments). The client
+  sends with the don't-fragment flag, takes the path MTU the operating system knows for the
+  projector (or the ``mtu`` it is given) and sizes image records to fill it: 1,462 pixels a
+  record on an ordinary 1,500-byte MTU, 8,962 on a jumbo path. A record that does not fit (the
+  path turned out narrower, or ``mtu`` was too large) raises :class:`ClientError` saying so.
+* **Frame ids.** Before its first frame the client reads a status reply and continues after the
+  newest frame id the projector has handed on, so a restarted sender is never refused as old
+  (see ``docs/protocol.md``, Frame ids).
+* **Bit depth.** Each frame goes at the smallest bit depth that shows it within a tolerance,
+  rounded to the nearest level (:mod:`host.levels`); a control record sets the depth when it
+  changes. The rounding error is reported.
+* **Checks.** With ``check`` (the default), after each frame a status reply must show every
+  record taken and every row handed on; otherwise :class:`ClientError` says what the projector
+  counted instead (fragments, overflow, refused rows, ...).
+"""
+
+import errno
 import socket
+import sys
 import time
+from dataclasses import dataclass
 
+import numpy as np
+
+from spec import records
 from spec.records import RecordType
 
-from . import codec
+from . import codec, levels
 
-__all__ = ["Client", "ClientError", "DEFAULT_PORT"]
+__all__ = ["Client", "ClientError", "Sent", "DEFAULT_PORT", "path_mtu"]
 
 DEFAULT_PORT = 5000
 
+# Linux socket options (Python's socket module does not name them): the don't-fragment policy
+# and the path MTU of a connected socket.
+_IP_MTU_DISCOVER, _IP_PMTUDISC_DO, _IP_MTU = 10, 2, 14
+
+#: Counters that say why records or rows went missing, with what each means for a sender.
+_WHY = {
+    "drop_ip_fragment": "the records were fragmented on the way (the path's MTU is smaller than the "
+                        "records: give a smaller mtu)",
+    "drop_overflow": "the projector's receive buffer overflowed (send slower: rate)",
+    "mac_rx_dropped": "the projector's receive FIFO overflowed (send slower: rate)",
+    "drop_ip_length": "frames arrived shorter than their IP length",
+    "drop_ip_checksum": "frames arrived with a bad IP checksum",
+    "drop_udp_checksum": "datagrams arrived with a bad UDP checksum",
+    "drop_udp_length": "datagrams arrived with a bad UDP length",
+    "mac_bad_fcs": "frames arrived with a bad FCS (the link is damaging them)",
+    "drop_app_version": "the projector speaks another protocol version",
+    "drop_app_rows": "the image does not fit the projector's DMD",
+    "drop_app_length": "records were malformed",
+    "rows_incomplete": "records were lost or reordered on the way, so rows they split were dropped",
+    "store_rows_refused": "the projector's store refused rows (a frame id not newer than its newest, "
+                          "or no free slot)",
+}
+
 
 class ClientError(RuntimeError):
-    """The projector did not answer, or answered with something we cannot use."""
+    """The projector did not answer, refused or lost what was sent, or cannot be reached as asked."""
+
+
+@dataclass
+class Sent:
+    """One frame sent: its id, bit depth, records, and the rounding error left (8-bit LSB)."""
+    frame: int
+    depth: int
+    records: int
+    error_lsb: float
+
+
+def path_mtu(sock):
+    """The path MTU the operating system knows for a connected socket (None where it cannot tell)."""
+    if not sys.platform.startswith("linux"):
+        return None
+    try:
+        return sock.getsockopt(socket.IPPROTO_IP, _IP_MTU)
+    except OSError:
+        return None
 
 
 class Client:
@@ -31,18 +97,40 @@ class Client:
         Pacing: at most this many bytes of records per second (None: as fast as the socket
         takes them). The gateware keeps up with a full gigabit line; pacing protects switches
         and the host's own buffers.
+    mtu : int or None
+        IP MTU of the path to the projector; default: what the operating system knows (the
+        route's MTU, lowered by any ICMP "fragmentation needed" it has seen), else 1,500.
+    check : bool
+        After each frame, read a status reply and raise :class:`ClientError` if the projector
+        did not take every record and hand on every row.
     """
 
-    def __init__(self, address, port=DEFAULT_PORT, *, timeout=1.0, rate=None, bind=("0.0.0.0", 0)):
+    def __init__(self, address, port=DEFAULT_PORT, *, timeout=1.0, rate=None, mtu=None, check=True,
+                 bind=("0.0.0.0", 0)):
         self.peer = (address, port)
         self.timeout = timeout
         self.rate = rate
+        self.check = check
         self.sequence = 0
         self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        self._sock.bind(bind)
+        try:
+            self._sock.bind(bind)
+            if sys.platform.startswith("linux"):
+                self._sock.setsockopt(socket.IPPROTO_IP, _IP_MTU_DISCOVER, _IP_PMTUDISC_DO)
+            self._sock.connect(self.peer)
+        except OSError as error:
+            self._sock.close()
+            raise ClientError(f"cannot reach {address}:{port}: {error}") from error
         self._sock.settimeout(timeout)
+        self.mtu = mtu or path_mtu(self._sock) or 1500
+        self.limit = records.record_limit(self.mtu)
+        if self.limit <= records.IMAGE_HEADER:
+            raise ClientError(f"an MTU of {self.mtu} bytes leaves no room for pixels")
         self._paced_since = None
         self._paced_bytes = 0
+        self._depth = None         # the bit depth this client last set
+        self._next_frame = None    # the frame id to send next (known after the first status)
+        self._last = None          # the last status reply read
 
     def close(self):
         self._sock.close()
@@ -55,24 +143,34 @@ class Client:
 
     def _next(self):
         sequence = self.sequence
-        self.sequence = (self.sequence + 1) & 0xFFFFFFFF
+        self.sequence = (self.sequence + 1) & codec.SEQUENCE_MASK
         return sequence
 
+    def _pace(self, size):
+        if not self.rate:
+            return
+        now = time.monotonic()
+        if self._paced_since is None:
+            self._paced_since = now
+        ahead = self._paced_since + self._paced_bytes / self.rate - now
+        if ahead > 0:
+            time.sleep(ahead)
+        elif ahead < -0.1:
+            # idle for a while: do not burst to catch up
+            self._paced_since, self._paced_bytes = now, 0
+        self._paced_bytes += size
+
     def _send(self, record):
-        if self.rate:
-            now = time.monotonic()
-            if self._paced_since is None:
-                self._paced_since = now
-            ahead = self._paced_since + self._paced_bytes / self.rate - now
-            if ahead > 0:
-                time.sleep(ahead)
-            elif ahead < -0.1:
-                # idle for a while: do not burst to catch up
-                self._paced_since, self._paced_bytes = now, 0
-            self._paced_bytes += len(record)
+        self._pace(len(record))
         try:
-            self._sock.sendto(record, self.peer)
+            self._sock.send(record)
         except OSError as error:
+            if error.errno == errno.EMSGSIZE:
+                known = path_mtu(self._sock)
+                raise ClientError(
+                    f"a {len(record)}-byte record does not fit the path to {self.peer[0]} without "
+                    f"fragmenting (the records are sized for an MTU of {self.mtu} bytes; the path's is "
+                    f"{known or 'smaller'}): give mtu={known or 'the path MTU'}") from error
             raise ClientError(f"cannot send to {self.peer[0]}:{self.peer[1]}: {error}") from error
 
     def send_records(self, encoded):
@@ -81,20 +179,94 @@ class Client:
             self._send(record)
         return len(encoded)
 
-    def send_image(self, image, frame=0):
-        """Send one ``uint8`` image as frame ``frame``; returns the records sent."""
-        encoded = codec.image_records(image, frame, sequence=self.sequence)
-        self.sequence = (self.sequence + len(encoded)) & 0xFFFFFFFF
-        return self.send_records(encoded)
+    # -- frames ------------------------------------------------------------------------------
 
-    def send_sequence(self, images, first_frame=0):
-        encoded = codec.sequence_records(images, first_frame, sequence=self.sequence)
-        self.sequence = (self.sequence + len(encoded)) & 0xFFFFFFFF
-        return self.send_records(encoded)
+    def next_frame(self):
+        """The frame id the next frame gets: after the newest the projector has handed on (read
+        from a status reply the first time), then counting up."""
+        if self._next_frame is None:
+            self._next_frame = (self.status()["newest_frame"] + 1) & 0xFFFF
+        return self._next_frame
+
+    def send_image(self, image, frame=None, *, depth=None, tolerance=0.5):
+        """Send one image as a frame.
+
+        Parameters
+        ----------
+        image : array_like
+            Rows x columns, the DMD's geometry: 8-bit (``uint8``) or real targets in 0..255.
+        frame : int, optional
+            Frame id; default :meth:`next_frame`. An id the projector does not take as newer
+            than its newest is refused by it (and, with ``check``, raises).
+        depth : int, optional
+            Bit depth; default the smallest within ``tolerance`` (8-bit LSB) of every target.
+
+        Returns
+        -------
+        Sent
+        """
+        frame = self.next_frame() if frame is None else frame & 0xFFFF
+        image = np.asarray(image)
+        before = self._last if self.check else None
+        if self.check and before is None:
+            before = self.status()
+        if before is not None:
+            self._fits(image, before)
+        shown = levels.quantise(image, depth, tolerance=tolerance)
+        if shown.depth != self._depth:
+            self.control(bit_depth=shown.depth)
+            self._depth = shown.depth
+        encoded = codec.image_records(shown.data, frame, sequence=self.sequence, limit=self.limit)
+        self.sequence = (self.sequence + len(encoded)) & codec.SEQUENCE_MASK
+        self.send_records(encoded)
+        self._next_frame = (frame + 1) & 0xFFFF
+        if self.check:
+            self._verify(before, len(encoded), image.shape[0], frame)
+        return Sent(frame=frame, depth=shown.depth, records=len(encoded), error_lsb=shown.error_lsb)
+
+    def send_sequence(self, images, first_frame=None, **kwargs):
+        """Several images as consecutive frames; returns a :class:`Sent` for each."""
+        out = []
+        for i, image in enumerate(images):
+            out.append(self.send_image(image, None if first_frame is None else first_frame + i, **kwargs))
+        return out
+
+    @staticmethod
+    def _fits(image, status):
+        geometry = (status["dmd_rows"], status["dmd_columns"])
+        if image.shape != geometry:
+            raise ClientError(f"the image is {image.shape[1]}x{image.shape[0]}, the projector's DMD "
+                              f"{geometry[1]}x{geometry[0]}")
+
+    def _verify(self, before, sent, rows, frame):
+        """Wait (at most ``timeout``) until a status reply shows ``sent`` more image records and
+        ``rows`` more rows handed on than ``before``, none refused by the store; else raise with
+        the counters that say why. (A frame's first row is the one a stale id gets refused, long
+        before its last row is handed on.)"""
+        deadline = time.monotonic() + self.timeout
+        while True:
+            after = self.status()
+            took, handed = (after[name] - before[name] for name in ("records_image", "rows"))
+            if took >= sent and handed >= rows or time.monotonic() > deadline:
+                break
+            time.sleep(0.001)
+        refused = after["store_rows_refused"] - before["store_rows_refused"]
+        if took >= sent and handed >= rows and not refused:
+            return
+        grew = {name: after[name] - before[name] for name in _WHY if after[name] != before[name]}
+        why = "; ".join(f"{name} +{count}: {_WHY[name]}" for name, count in grew.items()) or \
+            "no counter says why (the records did not reach the projector)"
+        raise ClientError(f"frame {frame}: the projector took {took} of {sent} records and handed on {handed} "
+                          f"of {rows} rows; {why}. Its newest frame id is {after['newest_frame']}, "
+                          f"it shows frame {after['shown_frame']}")
+
+    # -- settings and status -----------------------------------------------------------------
 
     def control(self, *, software_trigger=False, **config):
         """Set configuration fields (see ``docs/protocol.md``); others keep their values."""
         self._send(codec.control_record(self._next(), software_trigger=software_trigger, **config))
+        if "bit_depth" in config:
+            self._depth = config["bit_depth"]
 
     def configure(self, plan, dmd):
         """Send the register set of a :func:`spec.schedule.plan` (checked as the
@@ -111,20 +283,19 @@ class Client:
             while (left := deadline - time.monotonic()) > 0:
                 self._sock.settimeout(left)
                 try:
-                    raw, sender = self._sock.recvfrom(65536)
+                    raw = self._sock.recv(65536)
                 except socket.timeout:
                     break
                 except OSError as error:
                     raise ClientError(f"no status from {self.peer[0]}:{self.peer[1]}: {error}") \
                         from error
-                if sender != self.peer:
-                    continue
                 try:
                     head, body, _rest = codec.decode(raw)
                 except codec.ProtocolError as error:
-                    raise ClientError(f"bad status reply from {sender[0]}:{sender[1]}: {error}") \
+                    raise ClientError(f"bad status reply from {self.peer[0]}:{self.peer[1]}: {error}") \
                         from error
                 if head["type"] == RecordType.STATUS_REPLY and head["sequence"] == sequence:
+                    self._last = body
                     return body
         raise ClientError(f"no status reply from {self.peer[0]}:{self.peer[1]} "
                           f"after {retries + 1} tries of {self.timeout} s")

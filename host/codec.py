@@ -6,55 +6,58 @@ from spec import records, wire
 from spec.records import Action, RecordType
 from spec.schedule import row_cycles
 
-__all__ = ["ProtocolError", "header", "image_records", "sequence_records", "rows_per_record",
-           "control_record", "sequencer_record", "status_query", "status_reply", "decode"]
+__all__ = ["ProtocolError", "header", "image_record", "image_records", "sequence_records", "pixels_per_record",
+           "control_record", "sequencer_record", "status_query", "status_reply", "decode", "SEQUENCE_MASK",
+           "DEFAULT_LIMIT"]
+
+#: Record sequence numbers wrap at this mask.
+SEQUENCE_MASK = (1 << dict(records.HEADER)["sequence"]) - 1
+#: Records fit an ordinary 1500-byte MTU unless the caller says otherwise.
+DEFAULT_LIMIT = records.record_limit(1500)
 
 
 class ProtocolError(ValueError):
     """Bytes that are not a well-formed record of this protocol version."""
 
 
-def header(record_type, length, sequence):
+def header(record_type, sequence):
     return wire.pack(records.HEADER, {"magic": records.MAGIC, "version": records.VERSION,
-                                       "type": record_type, "length": length,
-                                       "sequence": sequence & 0xFFFFFFFF})
+                                       "type": record_type, "sequence": sequence & SEQUENCE_MASK})
 
 
-def rows_per_record(row_bytes, limit=records.MAX_RECORD):
-    """Whole rows that fit one record: 8 rows of 1,024 bytes or 4 of 2,048 in a 9,000-byte MTU."""
-    rows = (limit - records.image_record_length(0, row_bytes)) // row_bytes
-    if rows < 1:
-        raise ValueError(f"a {row_bytes}-byte row does not fit a {limit}-byte record")
-    # Keep to a power of two so that records of a frame are all the same size.
-    return 1 << (rows.bit_length() - 1)
+def pixels_per_record(limit=DEFAULT_LIMIT):
+    """Pixels an image record of at most ``limit`` bytes carries: 1,462 in a 1500-byte MTU,
+    8,962 in a 9,000-byte one."""
+    pixels = limit - records.IMAGE_HEADER
+    if pixels < 1:
+        raise ValueError(f"a {limit}-byte record has no room for pixels")
+    return pixels
 
 
-def image_records(image, frame, *, sequence=0, rows=None):
-    """An 8-bit image (``uint8`` array, rows x columns) -> its image records, top to bottom.
+def image_record(frame, offset, pixels, sequence=0):
+    """One image record: ``pixels`` (bytes) of frame ``frame`` from position ``offset``."""
+    body = wire.pack(records.IMAGE, {"frame": frame & 0xFFFF, "offset": offset})
+    return header(RecordType.IMAGE, sequence) + body + bytes(pixels)
 
-    ``rows`` is the rows per record (default :func:`rows_per_record`). Sequence numbers count
-    up from ``sequence``.
-    """
+
+def image_records(image, frame, *, sequence=0, limit=DEFAULT_LIMIT, pixels=None):
+    """An 8-bit image (``uint8`` array, rows x columns) -> its image records: its pixels row by
+    row, each record as many as fit ``limit`` bytes (or ``pixels``), so that rows split across
+    records anywhere. Sequence numbers count up from ``sequence``."""
     image = np.asarray(image)
     if image.dtype != np.uint8 or image.ndim != 2:
         raise ValueError(f"need a 2-D uint8 image, got {image.dtype} with shape {image.shape}")
-    height, width = image.shape
-    rows = rows or rows_per_record(width)
-    out = []
-    for first in range(0, height, rows):
-        block = image[first:first + rows]
-        body = wire.pack(records.IMAGE, {"frame": frame & 0xFFFF, "first_row": first,
-                                          "row_count": len(block), "row_bytes": width})
-        length = records.image_record_length(len(block), width)
-        out.append(header(RecordType.IMAGE, length, sequence + len(out)) + body + block.tobytes())
-    return out
+    flat = np.ascontiguousarray(image).reshape(-1).tobytes()
+    step = pixels or pixels_per_record(limit)
+    return [image_record(frame, offset, flat[offset:offset + step], sequence + i)
+            for i, offset in enumerate(range(0, len(flat), step))]
 
 
-def sequence_records(images, first_frame=0, *, sequence=0, rows=None):
+def sequence_records(images, first_frame=0, *, sequence=0, limit=DEFAULT_LIMIT):
     """Several images, frame ids counting up from ``first_frame``."""
     out = []
     for i, image in enumerate(images):
-        out += image_records(image, first_frame + i, sequence=sequence + len(out), rows=rows)
+        out += image_records(image, first_frame + i, sequence=sequence + len(out), limit=limit)
     return out
 
 
@@ -68,7 +71,7 @@ def control_record(sequence=0, *, software_trigger=False, **config):
     apply = sum(1 << names.index(name) for name in config)
     action = Action.SOFTWARE_TRIGGER if software_trigger else 0
     body = wire.pack(records.CONTROL, {"apply": apply, "action": int(action), **config})
-    return header(RecordType.CONTROL, wire.size(records.HEADER) + len(body), sequence) + body
+    return header(RecordType.CONTROL, sequence) + body
 
 
 def sequencer_record(registers, sequence=0, *, dmd=None, beats=1):
@@ -87,17 +90,16 @@ def sequencer_record(registers, sequence=0, *, dmd=None, beats=1):
         if failed:
             raise ValueError(f"the sequencer cannot obey this register set: {', '.join(failed)}")
     body = wire.pack(records.SEQUENCER, fields)
-    return header(RecordType.SEQUENCER, wire.size(records.HEADER) + len(body), sequence) + body
+    return header(RecordType.SEQUENCER, sequence) + body
 
 
 def status_query(sequence=0):
-    return header(RecordType.STATUS_QUERY, wire.size(records.HEADER), sequence)
+    return header(RecordType.STATUS_QUERY, sequence)
 
 
 def status_reply(sequence, values):
     """A status reply record (what the gateware sends; used by test servers)."""
-    body = wire.pack(records.STATUS_REPLY, values)
-    return header(RecordType.STATUS_REPLY, wire.size(records.HEADER) + len(body), sequence) + body
+    return header(RecordType.STATUS_REPLY, sequence) + wire.pack(records.STATUS_REPLY, values)
 
 
 _BODIES = {
@@ -110,8 +112,9 @@ _BODIES = {
 
 
 def decode(raw):
-    """A record's bytes -> ``(header, body, rest)``: two dicts and the bytes after the body
-    (an image record's pixels). Raises :class:`ProtocolError` on anything malformed."""
+    """A record's bytes (a whole UDP payload) -> ``(header, body, rest)``: two dicts and the
+    bytes after the body (an image record's pixels). Raises :class:`ProtocolError` on anything
+    malformed."""
     raw = bytes(raw)
     n = wire.size(records.HEADER)
     if len(raw) < n:
@@ -121,13 +124,16 @@ def decode(raw):
         raise ProtocolError(f"magic 0x{head['magic']:04x} is not 0x{records.MAGIC:04x}")
     if head["version"] != records.VERSION:
         raise ProtocolError(f"protocol version {head['version']}, this client speaks {records.VERSION}")
-    if head["length"] != len(raw):
-        raise ProtocolError(f"record says {head['length']} bytes, datagram has {len(raw)}")
     try:
-        table = _BODIES[RecordType(head["type"])]
+        kind = RecordType(head["type"])
     except ValueError:
         raise ProtocolError(f"unknown record type {head['type']}") from None
-    if len(raw) < n + wire.size(table):
-        raise ProtocolError(f"record type {head['type']} needs {n + wire.size(table)} bytes")
+    table = _BODIES[kind]
+    size = n + wire.size(table)
+    if len(raw) < size + (kind == RecordType.IMAGE):
+        raise ProtocolError(f"record type {head['type']} needs {size + (kind == RecordType.IMAGE)} bytes, "
+                            f"got {len(raw)}")
+    if kind != RecordType.IMAGE and len(raw) != size:
+        raise ProtocolError(f"record type {head['type']} is {size} bytes, got {len(raw)}")
     body = wire.unpack(table, raw[n:]) if table else {}
-    return head, body, raw[n + wire.size(table):]
+    return head, body, raw[size:]

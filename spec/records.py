@@ -15,8 +15,9 @@ store's bit depth and sequence, arming, the network addresses.
 
 __all__ = [
     "MAGIC", "VERSION", "RecordType", "Action",
-    "HEADER", "IMAGE", "CONTROL", "CONFIG", "SEQUENCER", "NET_COUNTERS", "APP_COUNTERS",
-    "SYSTEM_STATUS", "STATUS_REPLY", "image_record_length", "MAX_RECORD",
+    "HEADER", "IMAGE", "CONTROL", "CONFIG", "SEQUENCER", "NET_COUNTERS", "RECORD_COUNTERS",
+    "ROW_COUNTERS", "GEOMETRY", "APP_COUNTERS", "SYSTEM_STATUS", "STATUS_REPLY", "IMAGE_HEADER",
+    "MAX_RECORD", "UDP_IP_OVERHEAD", "record_limit", "frame_newer",
     "register_wire", "registers_bits", "register_faults",
 ]
 
@@ -30,9 +31,12 @@ from .wire import size
 #: ``"DM"``: first two bytes of every record.
 MAGIC = 0x444D
 #: Protocol version this tree speaks; records with any other version are dropped and counted.
-VERSION = 2
+#: ``magic`` and ``version`` keep their places in every version, so that a projector can tell.
+VERSION = 3
+#: IPv4 and UDP headers around a record: a record fills an MTU less these.
+UDP_IP_OVERHEAD = 28
 #: Largest record: a UDP payload inside a 9000-byte IP MTU (9000 - 20 IPv4 - 8 UDP).
-MAX_RECORD = 8972
+MAX_RECORD = 9000 - UDP_IP_OVERHEAD
 
 
 class RecordType(_enum.IntEnum):
@@ -47,21 +51,19 @@ class Action(_enum.IntFlag):
     SOFTWARE_TRIGGER = 1
 
 
-#: Common header of every record.
+#: Common header of every record. A record is a whole UDP payload: its length is the datagram's.
 HEADER = [
     ("magic", 16),
     ("version", 8),
     ("type", 8),
-    ("length", 16),      # whole record in bytes, this header included
-    ("sequence", 32),    # sender's record counter; gaps are counted as loss
+    ("sequence", 8),     # sender's record counter (mod 256); gaps are counted as loss
 ]
 
-#: Image record body (after :data:`HEADER`), followed by ``row_count * row_bytes`` pixel bytes.
+#: Image record body (after :data:`HEADER`), followed by its pixel bytes: the rest of the
+#: datagram, consecutive pixels of the frame (row by row, left to right) from ``offset``.
 IMAGE = [
-    ("frame", 16),       # frame id; its low bits select the store's frame slot
-    ("first_row", 16),
-    ("row_count", 16),
-    ("row_bytes", 16),   # must equal the DMD's columns (8-bit pixels)
+    ("frame", 16),       # frame id (serial-number order: see frame_newer)
+    ("offset", 24),      # position of the first pixel carried: row * columns + column
 ]
 
 #: Run-time configuration: the registers a control record sets (the gateware's ``Config``).
@@ -109,7 +111,7 @@ NET_COUNTERS = [
 ]
 
 #: Counters kept by the protocol parser (records, by outcome).
-APP_COUNTERS = [
+RECORD_COUNTERS = [
     ("records_image", 32),
     ("records_control", 32),   # control records applied
     ("records_sequencer", 32), # sequencer records passed on (applied when the sequencer rests)
@@ -117,16 +119,31 @@ APP_COUNTERS = [
     ("drop_app_magic", 32),    # not a record of this protocol
     ("drop_app_version", 32),
     ("drop_app_type", 32),
-    ("drop_app_empty", 32),    # zero length or zero rows
-    ("drop_app_length", 32),   # length field against datagram, or against the rows it carries
-    ("drop_app_rows", 32),     # rows beyond the frame geometry, or row_bytes not the DMD's
+    ("drop_app_empty", 32),    # an image record without pixels
+    ("drop_app_length", 32),   # the datagram shorter than its type's header, or not its type's size
+    ("drop_app_rows", 32),     # pixels beyond the frame
     ("drop_app_value", 32),    # a control or sequencer record with a value it cannot obey
     ("sequence_gaps", 32),     # records whose sequence number was not the previous + 1
-    ("rows", 32),              # image rows handed to the serialiser
-    ("payload_bytes", 48),     # image bytes handed on
-    ("last_frame", 16),
-    ("last_row", 16),
 ]
+
+#: Counters kept by the row assembler (whole rows handed to the bit-plane serialiser).
+ROW_COUNTERS = [
+    ("rows", 32),              # image rows handed on
+    ("rows_incomplete", 32),   # rows begun and abandoned: a piece of them was lost or came out of order
+    ("payload_bytes", 48),     # pixel bytes handed on
+    ("last_frame", 16),        # frame id and row of the last row handed on
+    ("last_row", 16),
+    ("newest_frame", 16),      # newest frame id handed on (serial-number order): continue after it
+]
+
+#: The DMD's geometry, as the projector was built for it (image records' positions count in it).
+GEOMETRY = [
+    ("dmd_columns", 16),
+    ("dmd_rows", 16),
+]
+
+#: The application's part of the status reply.
+APP_COUNTERS = RECORD_COUNTERS + ROW_COUNTERS + GEOMETRY
 
 #: Figures the rest of the system supplies (the gateware's ``Status`` input).
 SYSTEM_STATUS = [
@@ -135,6 +152,7 @@ SYSTEM_STATUS = [
     ("triggers", 32),          # triggers obeyed
     ("trigger_overruns", 32),  # triggers that came while a frame was still showing
     ("frames_shown", 32),
+    ("shown_frame", 16),       # frame id of the frame shown last (its first clocking pulse)
     ("dlpc410_state", 16),     # bits: 0 INIT_ACTIVE, 1 RST_ACTIVE, 2 ECP2_FINISHED, 3 DDR2 calibrated, 4-6 link
     ("triggers_early", 32),    # triggers before the DLPC410 finished initialising
     ("pulses_late", 32),       # clocking pulses made after their time
@@ -201,5 +219,16 @@ def register_faults(wire, row_cycles):
     return faults
 
 
-def image_record_length(row_count, row_bytes):
-    return size(HEADER) + size(IMAGE) + row_count * row_bytes
+#: Bytes of an image record before its pixels.
+IMAGE_HEADER = size(HEADER) + size(IMAGE)
+
+
+def record_limit(mtu):
+    """Largest record that travels unfragmented in an IP MTU of ``mtu`` bytes."""
+    return min(mtu, 9000) - UDP_IP_OVERHEAD
+
+
+def frame_newer(frame, than):
+    """Frame ids are ordered as serial numbers (RFC 1982, 16 bits): ``frame`` is newer than
+    ``than`` when it is 1 to 32,767 ahead of it, modulo 65,536."""
+    return 0 < (frame - than) % (1 << 16) < (1 << 15)

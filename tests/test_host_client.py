@@ -1,5 +1,7 @@
 """The host client and CLI against an in-process UDP server on 127.0.0.1 that plays projector
-with the reference model."""
+with the reference models: the endpoint's (records, rows, counters) and the store's frame-slot
+policy (which frames it takes, which rows it refuses); a software trigger shows the newest
+complete frame."""
 
 import socket
 import threading
@@ -7,22 +9,29 @@ import threading
 import numpy as np
 import pytest
 
-from host import Client, ClientError, cli, codec
+from host import Client, ClientError, cli, codec, levels
 from sim.models.net import Model
+from sim.models.slots import SlotPolicy
 from spec import records
 from spec.facts import TEST_DMD
 
+#: The store's refusals, summed into the status reply's ``store_rows_refused``.
+REFUSALS = ("rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot")
+
 
 class FakeProjector:
-    """Decodes every datagram with the reference model; answers status queries (or, with
-    ``mode``, answers badly or not at all)."""
+    """Decodes every datagram with the reference model, stores its rows with the store's policy;
+    answers status queries (or, with ``mode``, answers badly or not at all)."""
 
     def __init__(self, mode="good"):
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.bind(("127.0.0.1", 0))
         self.sock.settimeout(0.05)
         self.port = self.sock.getsockname()[1]
-        self.model = Model(TEST_DMD, 0x020000000001, 0x7F000001, self.port)
+        self.model = Model(TEST_DMD, 0x020000000001, 0x7F000001, self.port, frame_bits=16)
+        self.store = SlotPolicy(TEST_DMD.rows, slots=4)
+        self.shown = None
+        self.depths = []            # bit depth of each frame the store completed
         self.mode = mode
         self.received = []
         self._stop = threading.Event()
@@ -36,11 +45,23 @@ class FakeProjector:
             except socket.timeout:
                 continue
             self.received.append(raw)
-            replies_before = len(self.model.replies)
+            replies_before, rows_before = len(self.model.replies), len(self.model.rows)
             self.model.record(raw)
+            for frame, row, _data in self.model.rows[rows_before:]:
+                complete = self.store.counters["frames_complete"]
+                self.store.row(frame, row, self.model.config["bit_depth"])
+                if self.store.counters["frames_complete"] > complete:
+                    self.depths.append(self.store.frames[frame]["depth"])
+            if self.model.triggers and self.store.can_answer():
+                self.model.triggers = 0
+                if self.shown is not None:
+                    self.store.release(self.shown)
+                self.shown = self.store.ask()
             if len(self.model.replies) > replies_before and self.mode != "silent":
                 sequence = self.model.replies[-1][1]["sequence"]
                 values = {name: self.model.counters.get(name, 0) for name, _ in records.STATUS_REPLY}
+                values["store_rows_refused"] = sum(self.store.counters[name] for name in REFUSALS)
+                values["shown_frame"] = self.shown or 0
                 reply = codec.status_reply(sequence, values)
                 if self.mode == "garbled":
                     reply = reply[:20]
@@ -61,16 +82,82 @@ def projector(request):
 
 def test_send_image_and_status(projector):
     image = np.random.default_rng(1).integers(0, 256, (TEST_DMD.rows, TEST_DMD.columns), dtype=np.uint8)
-    with Client("127.0.0.1", projector.port, timeout=1.0, rate=50e6) as client:
+    with Client("127.0.0.1", projector.port, timeout=1.0, rate=50e6, mtu=1500) as client:
         sent = client.send_image(image, frame=3)
         client.control(armed=1, software_trigger=True)
         status = client.status()
-    assert sent == 2   # 64 rows + 32 rows of 128 bytes
-    assert status["records_image"] == 2 and status["records_control"] == 1
-    assert status["rows"] == TEST_DMD.rows and status["sequence_gaps"] == 0
+    # 12,288 pixels in records of 1,462 (a 1500-byte MTU): 9 records, rows split between them
+    assert (sent.frame, sent.depth, sent.records, sent.error_lsb) == (3, 8, 9, 0.0)
+    assert status["records_image"] == 9 and status["records_control"] == 2   # the depth, then arming
+    assert status["rows"] == TEST_DMD.rows and status["sequence_gaps"] == 0 and status["rows_incomplete"] == 0
     rows = {row: data for _tag, row, data in projector.model.rows}
     assert all(rows[r] == image[r].tobytes() for r in range(TEST_DMD.rows))
-    assert projector.model.triggers == 1 and projector.model.config["armed"] == 1
+    assert projector.model.config["armed"] == 1 and status["shown_frame"] == 3
+    assert all(len(raw) <= 1472 for raw in projector.received)
+
+
+def test_records_fill_the_path_mtu(projector):
+    """Without an MTU given, the client takes the path's (loopback: more than the projector's
+    9,000-byte limit, so jumbo records); given one, it fills that."""
+    image = np.zeros((TEST_DMD.rows, TEST_DMD.columns), np.uint8)
+    with Client("127.0.0.1", projector.port) as client:
+        assert client.mtu >= 9000 and client.limit == records.MAX_RECORD
+        client.send_image(image)
+    with Client("127.0.0.1", projector.port, mtu=2000) as client:
+        client.send_image(image)
+    sizes = [len(raw) for raw in projector.received if raw[3] == records.RecordType.IMAGE]
+    # 12,288 pixels: 8,962 + 3,326 in jumbo records, 6 x 1,962 + 516 in records for a 2,000-byte MTU,
+    # each with its 10-byte header
+    assert sizes == [8972, 3336] + [1972] * 6 + [526]
+
+
+def test_a_record_too_large_for_the_path_is_a_clear_error(projector):
+    """The don't-fragment flag is set: a record larger than the path allows is refused by the
+    system, and the client says what to do."""
+    with Client("127.0.0.1", projector.port, check=False) as client:
+        with pytest.raises(ClientError, match="a 65600-byte record does not fit the path .* give mtu="):
+            client.send_records([codec.image_record(1, 0, bytes(65590))])
+
+
+def test_frame_ids_continue_after_the_projectors_newest(projector):
+    """A sender that restarts continues after the newest frame id the projector has: its frames
+    are taken. One that starts again from an id the projector holds is refused, and the client
+    says so."""
+    image = np.full((TEST_DMD.rows, TEST_DMD.columns), 200, np.uint8)
+    with Client("127.0.0.1", projector.port) as client:
+        first = [client.send_image(image).frame for _ in range(3)]
+    with Client("127.0.0.1", projector.port) as client:
+        again = client.send_image(image).frame
+        with pytest.raises(ClientError, match=r"store_rows_refused \+96: .* newest frame id is 4"):
+            client.send_image(image, frame=first[0])
+    assert first == [1, 2, 3] and again == 4
+    assert projector.store.counters["rows_stale"] == TEST_DMD.rows and projector.store.counters["frames_complete"] == 4
+
+
+def test_depth_per_frame_and_rounding(projector):
+    """Each frame at the smallest depth that shows it within the tolerance: a control record
+    sets the depth when it changes, and the store keeps the frame at that depth."""
+    shape = (TEST_DMD.rows, TEST_DMD.columns)
+    binary = np.where(np.indices(shape).sum(axis=0) % 2, 255, 0).astype(np.uint8)
+    grey = np.random.default_rng(3).integers(0, 256, shape, dtype=np.uint8)
+    dim = np.zeros(shape)
+    dim[10:20, 10:20] = 15.0                                # a dim target on black
+    with Client("127.0.0.1", projector.port) as client:
+        sent = [client.send_image(binary), client.send_image(grey), client.send_image(binary),
+                client.send_image(dim, depth=4), client.send_image(dim, tolerance=1.0)]
+    assert [s.depth for s in sent] == [1, 8, 1, 4, 7] == projector.depths
+    assert [s.error_lsb for s in sent[:3]] == [0.0, 0.0, 0.0]
+    assert sent[3].error_lsb == pytest.approx(2.0) and sent[4].error_lsb == pytest.approx(15 - 255 * 7 / 127)
+    assert projector.model.counters["records_control"] == 5
+    # the dim target at depth 4 is level 1 (17 LSB), not black
+    rows = {row: data for _tag, row, data in projector.model.rows[-2 * TEST_DMD.rows:-TEST_DMD.rows]}
+    assert rows[15][15] >> 4 == 1 == levels.levels(15, 4)
+
+
+def test_an_image_of_another_size_is_refused(projector):
+    with Client("127.0.0.1", projector.port) as client:
+        with pytest.raises(ClientError, match="the image is 64x96, the projector's DMD 128x96"):
+            client.send_image(np.zeros((96, 64), np.uint8))
 
 
 @pytest.mark.parametrize("projector", ["silent"], indirect=True)
@@ -90,11 +177,12 @@ def test_garbled_reply_is_a_clear_error(projector):
 def test_pacing_limits_the_rate(projector):
     import time
     image = np.zeros((TEST_DMD.rows, TEST_DMD.columns), np.uint8)
-    with Client("127.0.0.1", projector.port, rate=200e3) as client:
+    with Client("127.0.0.1", projector.port, rate=200e3, check=False) as client:
+        client.next_frame()
         start = time.monotonic()
         client.send_sequence([image] * 3)
         elapsed = time.monotonic() - start
-    # 6 records of ~8 kB and ~4 kB: the last one may leave at 5/6 of 37 kB / 200 kB/s
+    # 3 jumbo records a frame, 37 kB in all: the last one may leave at 31 kB / 200 kB/s
     assert elapsed >= 0.1
 
 
@@ -102,8 +190,12 @@ def test_cli_send_and_status(projector, tmp_path, capsys):
     path = tmp_path / "scene.npy"
     np.save(path, np.full((TEST_DMD.rows, TEST_DMD.columns), 9, np.uint8))
     base = ["--address", "127.0.0.1", "--port", str(projector.port)]
-    assert cli.main(base + ["send", str(path), "--frame", "2"]) == 0
-    assert "sent 1 frame(s) in 2 records" in capsys.readouterr().out
+    assert cli.main(base + ["send", str(path), "--frame", "2", "--mtu", "1500"]) == 0
+    out = capsys.readouterr().out
+    assert f"frame 2: {path}, 8-bit, 9 records, rounding error 0 LSB" in out
+    assert "sent 1 frame(s) in 9 records of at most 1472 bytes (MTU 1500)" in out
+    assert cli.main(base + ["send", str(path), str(path)]) == 0
+    assert "frame 3:" in (out := capsys.readouterr().out) and "frame 4:" in out
     assert cli.main(base + ["status"]) == 0
     assert "records_image" in capsys.readouterr().out
     assert cli.main(base + ["send", str(tmp_path / "missing.npy")]) == 1

@@ -15,7 +15,7 @@ from host import codec
 from sim.harness.amaranth_sim import simulate, stream_collect, stream_put
 from sim.models.frames import Addresses
 from sim.models.net import Model
-from sim.tb.endpoint_sim import assemble_rows, plain
+from sim.tb.endpoint_sim import plain
 from spec import records
 from spec.facts import TEST_DMD
 
@@ -123,24 +123,30 @@ def test_transmitter_builds_and_arbitrates(test_name):
 
 
 def test_parser_against_model(test_name):
-    """Records of every kind, good and bad, as datagrams: pixels, queries, settings and counters
-    as the model says."""
+    """Records of every kind, good and bad, as datagrams: the pixels of each image record the
+    model accepts (with their position, their record's end and first), queries, settings and
+    counters as the model says."""
     dmd = TEST_DMD
     dut = Parser(dmd, config_init(mac=A.mac, ip=A.ip, port=A.port))
     model = Model(dmd, A.mac, A.ip, A.port)
     rng = random.Random(4)
     image = np.random.default_rng(4).integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8)
-    # the records of the first, a middle and the last rows of the frame: the parser handles each
+    # pieces of the first, a middle and the last rows of the frame: the parser handles each
     # record alone, the others would only lengthen the run
-    records_of_image = codec.image_records(image, 9, rows=8)
-    datagrams = [records_of_image[i] for i in (0, len(records_of_image) // 2, -1)]
+    records_of_image = codec.image_records(image, 9, pixels=1000)
+    chosen = [records_of_image[i] for i in (0, len(records_of_image) // 2, -1)]
+    datagrams = list(chosen)
     datagrams += [codec.status_query(len(datagrams)), codec.control_record(99, armed=1, bit_depth=4),
-                  codec.control_record(100, bit_depth=0), b"\x44\x4d\x01\x01", codec.status_query(5)]
+                  codec.control_record(100, bit_depth=0), b"\x44\x4d\x03\x01", codec.status_query(5)]
     rng.shuffle(datagrams)
     peer = {"mac": 0x020000000099, "ip": 0x0A000001, "port": 40000}
+    pieces = []
     for d in datagrams:
-        model.record(d, peer)
-    out = {"pixels": [], "queries": []}
+        if model.record(d, peer) == "image":
+            _head, body, pixels = codec.decode(d)
+            until = body["offset"] + len(pixels)
+            pieces += [(body["frame"], body["offset"] + i, byte, until, int(i == 0)) for i, byte in enumerate(pixels)]
+    out = {"pieces": [], "queries": []}
 
     async def feed(ctx):
         for d in datagrams:
@@ -149,13 +155,13 @@ def test_parser_against_model(test_name):
                                                       "length": len(d), "peer": peer})
         for _ in range(30):
             await ctx.tick()
-        out["app"] = plain(ctx.get(dut.counters), records.APP_COUNTERS)
+        out["app"] = plain(ctx.get(dut.counters), records.RECORD_COUNTERS)
         out["settings"] = plain(ctx.get(dut.settings), records.CONFIG)
 
     async def pixels(ctx):
         while True:
-            p, = await stream_collect(ctx, dut.pixels, 1, stall=0.2, rng=rng)
-            out["pixels"].append((p.frame, p.row, p.column, p.pixels[0]))
+            p, = await stream_collect(ctx, dut.pieces, 1, stall=0.2, rng=rng)
+            out["pieces"].append((p.frame, p.position, p.data, p.until, p.first))
 
     async def queries(ctx):
         while True:
@@ -163,7 +169,7 @@ def test_parser_against_model(test_name):
             out["queries"].append((int(q.sequence), int(q.peer.port)))
 
     simulate(dut, [feed], processes=[pixels, queries], name=test_name, deadline=1e-3)
-    assert assemble_rows(out["pixels"], dmd.columns) == model.rows
-    assert out["app"] == {k: model.counters[k] for k, _ in records.APP_COUNTERS}
+    assert out["pieces"] == pieces and len(pieces) == sum(len(r) - records.IMAGE_HEADER for r in chosen)
+    assert out["app"] == {k: model.counters[k] for k, _ in records.RECORD_COUNTERS}
     assert out["queries"] == [(r[1]["sequence"], 40000) for r in model.replies]
     assert out["settings"]["armed"] == 1 and out["settings"]["bit_depth"] == 4

@@ -69,6 +69,19 @@ def test_bad_frame_dropped_and_counted(case, one_by_one):
     assert outcome == counter
 
 
+def test_padding_beyond_the_ip_length_is_trimmed(test_name):
+    """Frames longer than their IP total length (RFC 894 / RFC 1122 padding, or a NIC's extra
+    bytes): the datagram is the total length's bytes, the rest is not part of it."""
+    echo = frames.icmp_echo(A, bytes(range(30)), ident=7, seq=2)
+    sequence = [(image_frame(0) + b"\xa5" * 17, False), (echo + bytes(40), False),
+                (image_frame(1) + b"\x01", False)]
+    out = endpoint_sim.run(sequence, name=test_name, gap=(12, 12), waves=False)
+    assert out["net"]["accepted"] == 3 and out["net"]["drop_ip_length"] == 0
+    assert [(r, d) for _f, r, d in out["rows"]] == [(0, IMAGE[0].tobytes()), (1, IMAGE[1].tobytes())]
+    reply = Ether(out["tx"][0])
+    assert bytes(reply[ICMP].payload) == bytes(range(30)) and reply[IP].len == 20 + 8 + 30
+
+
 def test_good_frames_around_bad_ones_arrive(one_by_one):
     sequence, out = one_by_one
     assert [(r, data) for _f, r, data in out["rows"]] == [(0, IMAGE[0].tobytes()), (1, IMAGE[1].tobytes())]

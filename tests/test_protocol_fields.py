@@ -38,25 +38,33 @@ def test_gateware_view_reads_host_bytes(table):
     assert isinstance(layout(table), data.StructLayout)
 
 
-def test_record_sizes_fit_the_mtu():
-    assert codec.rows_per_record(1024) == 8
-    assert codec.rows_per_record(2048) == 4
-    assert records.image_record_length(8, 1024) <= records.MAX_RECORD
-    assert records.image_record_length(4, 2048) <= records.MAX_RECORD
+@pytest.mark.parametrize("mtu, pixels", [(1500, 1462), (9000, 8962)])
+def test_record_sizes_fill_the_mtu(mtu, pixels):
+    """A record fills the MTU less the IPv4 and UDP headers; its own header is 10 bytes."""
+    assert records.IMAGE_HEADER == 10
+    assert records.record_limit(mtu) == mtu - 28
+    assert codec.pixels_per_record(records.record_limit(mtu)) == pixels
+    assert len(codec.image_records(np.zeros((16, 1024), np.uint8), 0, limit=records.record_limit(mtu))[0]) == \
+        records.record_limit(mtu)
 
 
-def test_image_records_round_trip():
+@pytest.mark.parametrize("mtu", [1500, 9000])
+def test_image_records_round_trip(mtu):
     image = np.random.default_rng(0).integers(0, 256, (768, 1024), dtype=np.uint8)
-    encoded = codec.image_records(image, frame=5, sequence=10)
-    assert len(encoded) == 96
-    rebuilt = np.zeros_like(image)
+    encoded = codec.image_records(image, frame=5, sequence=250, limit=records.record_limit(mtu))
+    assert len(encoded) == -(-image.size // codec.pixels_per_record(records.record_limit(mtu)))
+    rebuilt = bytearray(image.size)
     for i, record in enumerate(encoded):
         head, body, pixels = codec.decode(record)
-        assert head["sequence"] == 10 + i and head["type"] == records.RecordType.IMAGE
-        assert body["frame"] == 5 and body["row_bytes"] == 1024 and body["row_count"] == 8
-        rebuilt[body["first_row"]:body["first_row"] + body["row_count"]] = \
-            np.frombuffer(pixels, np.uint8).reshape(-1, 1024)
-    assert (rebuilt == image).all()
+        assert head["sequence"] == (250 + i) % 256 and head["type"] == records.RecordType.IMAGE
+        assert body["frame"] == 5 and len(record) <= records.record_limit(mtu)
+        rebuilt[body["offset"]:body["offset"] + len(pixels)] = pixels
+    assert bytes(rebuilt) == image.tobytes()
+
+
+def test_frame_ids_in_serial_number_order():
+    assert records.frame_newer(1, 0) and records.frame_newer(0, 0xFFFF) and records.frame_newer(0x7FFF, 0)
+    assert not records.frame_newer(0, 0) and not records.frame_newer(0x8000, 0) and not records.frame_newer(0, 5)
 
 
 def test_control_record_selects_fields():
@@ -70,10 +78,10 @@ def test_control_record_selects_fields():
 
 
 @pytest.mark.parametrize("mutate, message", [
-    (lambda r: r[:5], "shorter than a record header"),
+    (lambda r: r[:4], "shorter than a record header"),
     (lambda r: b"XX" + r[2:], "magic"),
     (lambda r: r[:2] + bytes([9]) + r[3:], "version"),
-    (lambda r: r + b"\0", "datagram has"),
+    (lambda r: r + b"\0", "is 5 bytes, got 6"),
     (lambda r: r[:3] + bytes([77]) + r[4:], "unknown record type"),
 ])
 def test_decode_rejects_malformed(mutate, message):

@@ -19,6 +19,10 @@ def test_system_small_geometry():
     assert all(f["latency_cycles"] <= 8 for f in frames)
     status = report["status"]      # the testbench checked every counter; the headline ones here
     assert status["triggers"] == status["frames_shown"] == len(frames)
+    # the frame shown last, by its id, and the newest id handed on (the frame after the lost record)
+    assert status["shown_frame"] == frames[-1]["index"] == status["newest_frame"]
+    # the lost record's neighbours: the row the record before it began, the row the one after it ends
+    assert status["rows_incomplete"] == 2
     assert status["trigger_overruns"] == 3 and status["registers_applied"] == 2
     assert status["store_frames_abandoned"] == 1
     # bad frames interleaved with each of the scene's frames and the first fault frame

@@ -33,3 +33,6 @@ def test_xga_frames_end_to_end():
     drops = {k: v for k, v in status.items() if k.startswith("drop") and k != "drop_udp_port" and v}
     assert not drops, drops
     assert status["triggers"] == 3 and status["trigger_overruns"] == 0 and status["triggers_held"] == 1
+    # the sequence of two frames plays on: the last frame shown is the first again
+    assert status["shown_frame"] == (len(shown) - 1) % 2 and status["newest_frame"] == 1
+    assert status["rows_incomplete"] == 0

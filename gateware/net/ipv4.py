@@ -31,7 +31,8 @@ class Checker(wiring.Component):
     ip : In(32)
         Our address.
     length_ok : Out(1)
-        Total length at least a header and the frame exactly that long (or padded to 60 bytes).
+        Total length at least a header, and the frame at least that long: bytes beyond the total
+        length (Ethernet padding, RFC 894 and RFC 1122) are not part of the datagram.
     version_ok, options, checksum_ok, fragment, dst_ok : Out(1)
         Version 4; a header longer than 20 bytes; the header checksum holds; MF set or a
         non-zero fragment offset; addressed to ``ip``.
@@ -77,9 +78,7 @@ class Checker(wiring.Component):
                 m.d.sync += self.payload_sum.eq(word_add(self.payload_sum, tap.data, ~tap.offset[0]))
 
         m.d.comb += [
-            self.length_ok.eq((header.total_length >= size(headers.IPV4))
-                              & ((tap.length == end)
-                                 | ((end < headers.MIN_FRAME) & (tap.length == headers.MIN_FRAME)))),
+            self.length_ok.eq((header.total_length >= size(headers.IPV4)) & (tap.length >= end)),
             self.version_ok.eq(header.version == 4),
             self.options.eq(header.ihl != 5),
             self.checksum_ok.eq(fold(header_sum) == 0xFFFF),

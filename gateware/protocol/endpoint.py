@@ -17,6 +17,7 @@ from ..registers import Registers
 from ..wire import layout
 from .layouts import pixel_layout
 from .parser import CONFIG_LAYOUT, Parser, config_init
+from .rows import RowAssembler
 from .status import StatusReply
 
 __all__ = ["Endpoint", "Config", "Status"]
@@ -28,7 +29,7 @@ Status = layout(records.SYSTEM_STATUS)
 
 
 class Endpoint(wiring.Component):
-    """Stack + protocol parser + status reply.
+    """Stack + protocol parser + row assembler + status reply.
 
     Parameters
     ----------
@@ -85,13 +86,15 @@ class Endpoint(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         m.submodules.stack = stack = Stack(buffer_depth=self._depth)
-        m.submodules.parser = parser = Parser(self._dmd, self._config, frame_bits=self._frame_bits, beats=self._beats)
+        m.submodules.parser = parser = Parser(self._dmd, self._config, beats=self._beats)
+        m.submodules.rows = rows = RowAssembler(self._dmd, frame_bits=self._frame_bits)
         m.submodules.status_reply = reply = StatusReply()
 
         connect(m, wiring.flipped(self.rx), stack.rx)
         connect(m, stack.tx, wiring.flipped(self.tx))
         connect(m, stack.datagrams, parser.datagrams)
-        connect(m, parser.pixels, wiring.flipped(self.pixels))
+        connect(m, parser.pieces, rows.pieces)
+        connect(m, rows.pixels, wiring.flipped(self.pixels))
         connect(m, parser.queries, reply.queries)
         connect(m, parser.registers, wiring.flipped(self.registers))
         connect(m, reply.request, stack.reply_request)
@@ -103,9 +106,12 @@ class Endpoint(wiring.Component):
             self.settings.eq(parser.settings),
             self.trigger.eq(parser.trigger),
             reply.net.eq(stack.counters),
-            reply.app.eq(parser.counters),
+            reply.app.eq(self.app_counters),
             reply.system.eq(self.status),
             self.net_counters.eq(stack.counters),
-            self.app_counters.eq(parser.counters),
+            self.app_counters.dmd_columns.eq(self._dmd.columns),
+            self.app_counters.dmd_rows.eq(self._dmd.rows),
         ]
+        for source, table in ((parser.counters, records.RECORD_COUNTERS), (rows.counters, records.ROW_COUNTERS)):
+            m.d.comb += [self.app_counters[name].eq(source[name]) for name, _ in table]
         return m

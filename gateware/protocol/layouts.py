@@ -3,7 +3,7 @@
 from amaranth.lib import data
 from amaranth.utils import ceil_log2
 
-__all__ = ["pixel_layout", "position_fields"]
+__all__ = ["pixel_layout", "position_fields", "piece_layout", "position_bits"]
 
 
 def position_fields(dmd, frame_bits):
@@ -21,4 +21,23 @@ def pixel_layout(dmd, lanes=1, frame_bits=4):
         "pixels": data.ArrayLayout(8, lanes),
         "column": ceil_log2(dmd.columns),
         **position_fields(dmd, frame_bits),
+    })
+
+
+def position_bits(dmd):
+    """Width of a pixel's position in its frame (``row * columns + column``) and of one past the
+    frame's last pixel."""
+    return ceil_log2(dmd.rows * dmd.columns + 1)
+
+
+def piece_layout(dmd):
+    """One pixel of an image record, from the parser to the row assembler: its byte, frame id,
+    position in the frame, where its record ends (one past the record's last pixel), and whether
+    it is the record's first."""
+    return data.StructLayout({
+        "data": 8,
+        "frame": 16,
+        "position": position_bits(dmd),
+        "until": position_bits(dmd),
+        "first": 1,
     })

@@ -3,8 +3,9 @@
 One UDP datagram carries one record (see ``docs/protocol.md``). The parser collects the common
 header and the type's own header, checks them all against each other, against the datagram's
 length and against the DMD geometry, and only then acts: an image record's rows go to the
-bit-plane serialiser, a control record updates :attr:`Parser.settings`, a sequencer record's
-register set leaves whole on :attr:`Parser.registers`, a status query asks
+row assembler (:class:`~gateware.protocol.rows.RowAssembler`) as pixels with their position in
+the frame, a control record updates :attr:`Parser.settings`, a sequencer record's register set
+leaves whole on :attr:`Parser.registers`, a status query asks
 :class:`~gateware.protocol.status.StatusReply` for an answer. A record that fails a check is
 consumed and counted under its cause and has no other effect.
 """
@@ -12,7 +13,6 @@ consumed and counted under its cause and has no other effect.
 from amaranth import Cat, Module, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
-from amaranth.utils import ceil_log2, exact_log2
 
 from spec import records, wire
 from spec.records import RecordType
@@ -21,7 +21,7 @@ from spec.schedule import row_cycles
 from ..net.layouts import OFFSET_BITS, Datagram, Peer
 from ..registers import Registers, wire_registers
 from ..wire import byte_slice, layout
-from .layouts import pixel_layout
+from .layouts import piece_layout
 
 __all__ = ["Parser", "Query", "config_init", "CONFIG_LAYOUT"]
 
@@ -31,12 +31,13 @@ _IMAGE_END = _HEADER + wire.size(records.IMAGE)
 _CONTROL_END = _HEADER + wire.size(records.CONTROL)
 _SEQUENCER_END = _HEADER + wire.size(records.SEQUENCER)
 _CAPTURED = max(_IMAGE_END, _CONTROL_END, _SEQUENCER_END)
+_SEQUENCE_BITS = dict(records.HEADER)["sequence"]
 
 
 class Query(data.Struct):
     """A status query: who asked, and the sequence number the answer echoes."""
     peer: Peer
-    sequence: 32
+    sequence: _SEQUENCE_BITS
 
 
 def config_init(*, mac, ip, port, bit_depth=8, armed=False):
@@ -56,15 +57,14 @@ class Parser(wiring.Component):
         DCLK beats per ``dmd`` cycle the sequencer is built for (its shortest ``row_period``).
     config : dict
         Initial configuration (:func:`config_init`).
-    frame_bits : int
-        Bits of the frame id passed to the serialiser as its frame tag (the store's slot).
 
     Members
     -------
     datagrams : In(stream.Signature(Datagram))
         Committed UDP payloads from :class:`gateware.net.stack.Stack`.
-    pixels : Out(stream.Signature(pixel_layout(dmd, 1, frame_bits)))
-        The rows of valid image records, one 8-bit pixel per transfer, left to right.
+    pieces : Out(stream.Signature(piece_layout(dmd)))
+        The pixels of valid image records, one per transfer, in order, each with its frame id
+        and position in the frame, where its record ends and whether it is the record's first.
     settings : Out(layout(records.CONFIG))
         The configuration registers; control records update the fields they select.
     registers : Out(stream.Signature(Registers))
@@ -74,21 +74,20 @@ class Parser(wiring.Component):
         One-cycle pulse for a control record with the software-trigger action.
     queries : Out(stream.Signature(Query))
         Valid status queries, for the status reply.
-    counters : Out(layout(records.APP_COUNTERS))
-        Records accepted per type, dropped per cause, sequence gaps, rows and bytes handed on.
+    counters : Out(layout(records.RECORD_COUNTERS))
+        Records accepted per type, dropped per cause, sequence gaps.
     """
 
-    def __init__(self, dmd, config, *, frame_bits=4, beats=1):
+    def __init__(self, dmd, config, *, beats=1):
         self._dmd, self._beats = dmd, beats
-        self._frame_bits = frame_bits
         super().__init__({
             "datagrams": In(stream.Signature(Datagram)),
-            "pixels": Out(stream.Signature(pixel_layout(dmd, 1, frame_bits))),
+            "pieces": Out(stream.Signature(piece_layout(dmd))),
             "settings": Out(CONFIG_LAYOUT, init=config),
             "trigger": Out(1),
             "registers": Out(stream.Signature(Registers)),
             "queries": Out(stream.Signature(Query)),
-            "counters": Out(layout(records.APP_COUNTERS)),
+            "counters": Out(layout(records.RECORD_COUNTERS)),
         })
 
     def elaborate(self, platform):
@@ -124,19 +123,22 @@ class Parser(wiring.Component):
             with m.If(index == 0):
                 m.d.sync += [peer.eq(beat.peer), length.eq(beat.length)]
 
-        # The header each record type needs before it can be checked, and its whole length.
+        # The header each record type needs before it can be checked (the whole record, but for
+        # an image record's pixels).
         needed = Signal(range(_CAPTURED + 1))
-        expected = Signal(OFFSET_BITS + 17)
         with m.Switch(header.type):
             with m.Case(RecordType.IMAGE):
-                m.d.comb += [needed.eq(_IMAGE_END),
-                             expected.eq(_IMAGE_END + (image.row_count << exact_log2(dmd.columns)))]
+                m.d.comb += needed.eq(_IMAGE_END)
             with m.Case(RecordType.CONTROL):
-                m.d.comb += [needed.eq(_CONTROL_END), expected.eq(_CONTROL_END)]
+                m.d.comb += needed.eq(_CONTROL_END)
             with m.Case(RecordType.SEQUENCER):
-                m.d.comb += [needed.eq(_SEQUENCER_END), expected.eq(_SEQUENCER_END)]
+                m.d.comb += needed.eq(_SEQUENCER_END)
             with m.Default():
-                m.d.comb += [needed.eq(_HEADER), expected.eq(_HEADER)]
+                m.d.comb += needed.eq(_HEADER)
+        is_image = header.type == RecordType.IMAGE
+        # one past the image record's last pixel
+        until = Signal.like(self.pieces.payload.until)
+        m.d.comb += until.eq(image.offset + (length - _IMAGE_END))
 
         cause = Signal(range(8))
         causes = ["magic", "version", "type", "empty", "length", "rows", "value"]
@@ -151,16 +153,13 @@ class Parser(wiring.Component):
         with m.Elif((header.type != RecordType.IMAGE) & (header.type != RecordType.CONTROL)
                     & (header.type != RecordType.STATUS_QUERY) & (header.type != RecordType.SEQUENCER)):
             m.d.comb += cause.eq(1 + causes.index("type"))
-        with m.Elif(header.length == 0):
-            m.d.comb += cause.eq(1 + causes.index("empty"))
-        with m.Elif((header.length != length) | (length < needed)):
+        with m.Elif(length < needed):
             m.d.comb += cause.eq(1 + causes.index("length"))
-        with m.Elif((header.type == RecordType.IMAGE) & (image.row_count == 0)):
+        with m.Elif(is_image & (length == needed)):
             m.d.comb += cause.eq(1 + causes.index("empty"))
-        with m.Elif(header.length != expected):
+        with m.Elif(~is_image & (length != needed)):
             m.d.comb += cause.eq(1 + causes.index("length"))
-        with m.Elif((header.type == RecordType.IMAGE)
-                    & ((image.first_row + image.row_count > dmd.rows) | (image.row_bytes != dmd.columns))):
+        with m.Elif(is_image & (image.offset + (length - _IMAGE_END) > dmd.rows * dmd.columns)):
             m.d.comb += cause.eq(1 + causes.index("rows"))
         with m.Elif((header.type == RecordType.CONTROL)
                     & ((applies("bit_depth") & ((control.bit_depth == 0) | (control.bit_depth > 8)))
@@ -172,9 +171,9 @@ class Parser(wiring.Component):
             m.d.comb += cause.eq(1 + causes.index("value"))
 
         sequence_seen = Signal()
-        sequence_last = Signal(32)
-        column = Signal(ceil_log2(dmd.columns))
-        row = Signal(16)
+        sequence_last = Signal.like(header.sequence)
+        position = Signal.like(self.pieces.payload.position)
+        first = Signal()
 
         def bump(name, by=1):
             m.d.sync += counters[name].eq(counters[name] + by)
@@ -194,12 +193,12 @@ class Parser(wiring.Component):
                             bump(f"drop_app_{name}")
                     m.next = "DISCARD"
                 with m.Else():
-                    with m.If(sequence_seen & (header.sequence != (sequence_last + 1)[:32])):
+                    with m.If(sequence_seen & (header.sequence != (sequence_last + 1)[:len(sequence_last)])):
                         bump("sequence_gaps")
                     m.d.sync += [sequence_seen.eq(1), sequence_last.eq(header.sequence)]
                     with m.Switch(header.type):
                         with m.Case(RecordType.IMAGE):
-                            m.d.sync += [column.eq(0), row.eq(image.first_row)]
+                            m.d.sync += [position.eq(image.offset), first.eq(1)]
                             m.next = "PIXELS"
                         with m.Case(RecordType.CONTROL):
                             bump("records_control")
@@ -217,20 +216,16 @@ class Parser(wiring.Component):
                             m.next = "QUERY"
             with m.State("PIXELS"):
                 m.d.comb += [
-                    self.pixels.valid.eq(self.datagrams.valid),
-                    self.pixels.payload.pixels[0].eq(beat.data),
-                    self.pixels.payload.column.eq(column),
-                    self.pixels.payload.row.eq(row),
-                    self.pixels.payload.frame.eq(image.frame),
-                    self.datagrams.ready.eq(self.pixels.ready),
+                    self.pieces.valid.eq(self.datagrams.valid),
+                    self.pieces.payload.data.eq(beat.data),
+                    self.pieces.payload.frame.eq(image.frame),
+                    self.pieces.payload.position.eq(position),
+                    self.pieces.payload.until.eq(until),
+                    self.pieces.payload.first.eq(first),
+                    self.datagrams.ready.eq(self.pieces.ready),
                 ]
                 with m.If(taken):
-                    bump("payload_bytes")
-                    m.d.sync += column.eq(column + 1)
-                    with m.If(column == dmd.columns - 1):
-                        bump("rows")
-                        m.d.sync += [row.eq(row + 1), counters.last_row.eq(row),
-                                     counters.last_frame.eq(image.frame)]
+                    m.d.sync += [position.eq(position + 1), first.eq(0)]
                     with m.If(beat.last):
                         bump("records_image")
                         m.d.sync += [index.eq(0), ended.eq(0)]

@@ -44,7 +44,7 @@ class StatusReply(wiring.Component):
         m = Module()
         query = self.queries.payload
         values = {"magic": records.MAGIC, "version": records.VERSION, "type": RecordType.STATUS_REPLY,
-                  "length": REPLY_LENGTH, "sequence": query.sequence}
+                  "sequence": query.sequence}
         for source, table in ((self.net, records.NET_COUNTERS), (self.app, records.APP_COUNTERS),
                               (self.system, records.SYSTEM_STATUS)):
             values.update({name: source[name] for name, _ in table})

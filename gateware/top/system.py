@@ -15,7 +15,7 @@ memory controller (platform) or the MCB model (simulation).
 """
 
 from amaranth import Cat, DomainRenamer, Module, Mux, Signal
-from amaranth.lib import wiring
+from amaranth.lib import data, wiring
 from amaranth.lib.cdc import FFSynchronizer, PulseSynchronizer
 from amaranth.lib.wiring import In, Out
 
@@ -27,14 +27,27 @@ from gateware.dlpc410.sequencer import Sequencer
 from gateware.mac import gmii
 from gateware.mac.mdio import StatusPoller
 from gateware.protocol.port import EthernetPort
-from gateware.registers import TriggerMode
+from gateware.queue import AsyncQueue
+from gateware.registers import LSB_BITS, TriggerMode
 from gateware.store import mcb
 from gateware.store.broker import FrameBroker
+from gateware.store.layouts import FrameInfo
 from gateware.store.store import Store
 
-__all__ = ["Projector"]
+__all__ = ["Projector", "ShownFrame"]
 
 FRAME_BITS = 16
+
+
+class ShownFrame(data.Struct):
+    """The frame the DMD shows, from its first clocking pulse: how many frames have started
+    (wrapping: it steps at each, a repeat included), the frame's id, its bit depth and the
+    duration of its least significant plane (``dmd`` cycles), so that whoever watches the mirrors
+    knows the frame and its full-scale light (``lsb * (2**depth - 1)``)."""
+    number: 8
+    frame: FRAME_BITS
+    depth: 4
+    lsb: LSB_BITS
 
 
 class Projector(wiring.Component):
@@ -78,6 +91,8 @@ class Projector(wiring.Component):
         TTL trigger and sync inputs (asynchronous).
     sync_out, camera_out : Out(1)
         Frame shown; camera trigger (``dmd``).
+    shown : Out(ShownFrame)
+        The frame shown last (``dmd``); its id also reaches the status reply (``shown_frame``).
     """
 
     def __init__(self, dmd, *, mac, ip, port, regs, armed=True, sync_hz=125e6, slots=4, mdio_cycles=None,
@@ -105,6 +120,7 @@ class Projector(wiring.Component):
             "sync_in": In(1),
             "sync_out": Out(1),
             "camera_out": Out(1),
+            "shown": Out(ShownFrame),
         })
 
     def elaborate(self, platform):
@@ -217,4 +233,27 @@ class Projector(wiring.Component):
             Cat(self.dlpc.init_active, self.dlpc.rst_active, self.dlpc.ecp2_finished, self.mcb_read.calib_done),
             state)
         m.d.comb += status.dlpc410_state.eq(Cat(state, phy.status.up, phy.status.speed))
+        m.d.comb += status.shown_frame.eq(self._shown_frame(m, broker.frames, seq))
         return m
+
+    def _shown_frame(self, m, frames, seq):
+        """The frame shown last (:attr:`shown`, ``dmd``) and its id in ``sync``: the frame the
+        sequencer took last, when its count of frames started steps (a frame's first clocking
+        pulse), with the registers' ``lsb`` then. The sequencer takes a frame before its first
+        pulse and only a newer one replaces it there, so the frame that starts is the one taken
+        last (a repeat keeps its id)."""
+        taken = Signal(FrameInfo)
+        counted, shown_id = Signal.like(seq.status.frames), Signal(FRAME_BITS)
+        with m.If(frames.valid & frames.ready):
+            m.d.dmd += taken.eq(frames.payload)
+        m.d.dmd += counted.eq(seq.status.frames)
+        started = seq.status.frames != counted
+        with m.If(started):
+            m.d.dmd += [self.shown.number.eq(self.shown.number + 1), self.shown.frame.eq(taken.frame_id),
+                        self.shown.depth.eq(taken.bit_depth), self.shown.lsb.eq(seq.regs.lsb)]
+        m.submodules.shown_cdc = crossing = AsyncQueue(FRAME_BITS, 4, w_domain="dmd", r_domain="sync")
+        m.d.comb += [crossing.w_stream.valid.eq(started), crossing.w_stream.payload.eq(taken.frame_id),
+                     crossing.r_stream.ready.eq(1)]
+        with m.If(crossing.r_stream.valid):
+            m.d.sync += shown_id.eq(crossing.r_stream.payload)
+        return shown_id

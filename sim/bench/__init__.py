@@ -9,6 +9,7 @@ MODULES = [
     "sim.bench.bitplane",
     "sim.bench.dlpc410_model",
     "sim.bench.formal",
+    "sim.bench.host",
     "sim.bench.mac",
     "sim.bench.net",
     "sim.bench.store",

@@ -24,31 +24,28 @@ __all__ = ["DMD", "A", "IMAGE", "image_frame", "app_frame", "sequencer_record", 
 DMD = TEST_DMD
 A = Addresses()
 COLUMNS = DMD.columns
+PIXELS = DMD.rows * COLUMNS
+HEADER = wire.size(records.HEADER)
 IMAGE = np.random.default_rng(5).integers(0, 256, (DMD.rows, COLUMNS), dtype=np.uint8)
 
 
 def image_frame(first_row, rows=1, frame=1, sequence=0):
     """``rows`` rows of :data:`IMAGE` from ``first_row`` in one image record, in a frame."""
-    record = codec.image_records(IMAGE[first_row:first_row + rows], frame, sequence=sequence, rows=rows)[0]
-    # image_records numbers rows from 0: rewrite first_row through the same field table
-    head, body, pixels = codec.decode(record)
-    body["first_row"] = first_row
-    return frames.udp(A, record[:10] + wire.pack(records.IMAGE, body) + pixels)
+    pixels = IMAGE[first_row:first_row + rows].tobytes()
+    return frames.udp(A, codec.image_record(frame, first_row * COLUMNS, pixels, sequence))
 
 
 def app_frame(record):
     return frames.udp(A, record)
 
 
-def _record(record_type=records.RecordType.IMAGE, length=None, body=b"", **head):
-    values = {"magic": records.MAGIC, "version": records.VERSION, "type": record_type,
-              "length": 10 + len(body) if length is None else length, "sequence": 0, **head}
+def _record(record_type=records.RecordType.IMAGE, body=b"", **head):
+    values = {"magic": records.MAGIC, "version": records.VERSION, "type": record_type, "sequence": 0, **head}
     return wire.pack(records.HEADER, values) + body
 
 
-def _image_body(first_row=0, row_count=1, row_bytes=COLUMNS):
-    return wire.pack(records.IMAGE, {"frame": 2, "first_row": first_row, "row_count": row_count,
-                                      "row_bytes": row_bytes}) + bytes(row_count * COLUMNS)
+def _image_body(offset=0, count=COLUMNS):
+    return wire.pack(records.IMAGE, {"frame": 2, "offset": offset}) + bytes(count)
 
 
 #: A register set the sequencer can obey (a plan for the test DMD), as the record's wire values.
@@ -78,26 +75,24 @@ BAD_RECORDS = {
     "bad_magic": (_record(body=_image_body(), magic=0x1234), "drop_app_magic"),
     "unknown_version": (_record(body=_image_body(), version=records.VERSION + 1), "drop_app_version"),
     "unknown_type": (_record(record_type=9), "drop_app_type"),
-    "zero_length": (_record(body=_image_body(), length=0), "drop_app_empty"),
-    "zero_rows": (_record(body=_image_body(row_count=0)), "drop_app_empty"),
-    "length_not_datagram": (_record(body=_image_body(), length=10 + 8 + COLUMNS - 1), "drop_app_length"),
-    "length_not_rows": (_record(body=_image_body()) + b"\0\0", "drop_app_length"),
-    "truncated_header": (_record()[:6], "drop_app_length"),
-    "rows_beyond_frame": (_record(body=_image_body(first_row=DMD.rows - 1, row_count=2)),
-                          "drop_app_rows"),
-    "row_bytes_not_dmd": (_record(body=_image_body(row_bytes=COLUMNS * 2)), "drop_app_rows"),
+    "image_without_pixels": (_record(body=_image_body(count=0)), "drop_app_empty"),
+    "truncated_header": (_record()[:4], "drop_app_length"),
+    "truncated_image_header": (_record(body=_image_body())[:HEADER + 4], "drop_app_length"),
+    "status_query_too_long": (codec.status_query() + b"\0", "drop_app_length"),
+    "pixels_beyond_frame": (_record(body=_image_body(offset=PIXELS - COLUMNS + 1)), "drop_app_rows"),
+    "offset_beyond_frame": (_record(body=_image_body(offset=PIXELS, count=1)), "drop_app_rows"),
     "bit_depth_out_of_range": (codec.control_record(bit_depth=9, armed=1), "drop_app_value"),
     "armed_not_a_bit": (codec.control_record(armed=2), "drop_app_value"),
     "sequence_length_zero": (codec.control_record(sequence_length=0), "drop_app_value"),
     "control_too_long": (codec.control_record(armed=1) + b"\0", "drop_app_length"),
     "sequencer_too_long": (sequencer_record() + b"\0", "drop_app_length"),
-    "sequencer_truncated": (_record(records.RecordType.SEQUENCER, body=sequencer_record()[10:-1]),
+    "sequencer_truncated": (_record(records.RecordType.SEQUENCER, body=sequencer_record()[HEADER:-1]),
                             "drop_app_length"),
     **{f"sequencer_{name}": (sequencer_record(**changes), "drop_app_value")
        for name, changes in BAD_REGISTERS.items()},
 }
 
-_PAYLOAD = codec.image_records(IMAGE[:1], 1)[0]
+_PAYLOAD = codec.image_record(1, 0, IMAGE[0].tobytes())
 #: Every bad input: ``name -> (frame, bad MAC verdict, counter)``.
 BAD_CASES = {name: (builder(A, _PAYLOAD), False, counter)
              for name, (builder, counter) in frames.BAD_FRAMES.items()}
@@ -107,24 +102,26 @@ BAD_CASES.update({name: (app_frame(record), False, counter)
 
 
 def randomized_mix(count=260, seed=11):
-    """``count`` frames ``(bytes, bad MAC verdict)`` at random: image records of 1, 2 or 4 rows
-    (now and then one skipping a sequence number), ARP requests, ICMP echoes of random length,
+    """``count`` frames ``(bytes, bad MAC verdict)`` at random: image records that split rows
+    anywhere, mostly continuing the frame, now and then jumping or starting another frame (and
+    now and then one skipping a sequence number), ARP requests, ICMP echoes of random length,
     status queries, control records with random values, sequencer records good and bad, and bad
     inputs from :data:`BAD_CASES`."""
     rng = random.Random(seed)
     sequence = []
     seq = 0
     bad_cases = list(BAD_CASES.values())
+    flat = IMAGE.tobytes()
+    offset, frame = 0, 1
     for _ in range(count):
         roll = rng.random()
         if roll < 0.5:
-            rows = rng.choice([1, 2, 4])
-            first = rng.randrange(0, DMD.rows - rows + 1)
-            record = codec.image_records(IMAGE[first:first + rows], rng.randrange(16), sequence=seq,
-                                         rows=rows)[0]
-            head, body, pixels = codec.decode(record)
-            body["first_row"] = first
-            raw, bad = frames.udp(A, record[:10] + wire.pack(records.IMAGE, body) + pixels), False
+            if rng.random() < 0.1:
+                offset, frame = rng.randrange(PIXELS), frame + rng.choice([0, 1, 7])
+            size = min(rng.choice([1, 5, COLUMNS - 1, COLUMNS, 2 * COLUMNS + 9, 500]), PIXELS - offset)
+            record = codec.image_record(frame, offset, flat[offset:offset + size], seq)
+            offset = (offset + size) % PIXELS
+            raw, bad = frames.udp(A, record), False
             seq += 1 if rng.random() < 0.95 else 2
         elif roll < 0.56:
             raw, bad = frames.arp_request(A), False

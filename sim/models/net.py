@@ -2,7 +2,9 @@
 
 It reads frames byte by byte with its own parsing (only the application field tables are shared
 with the gateware, as the protocol's single definition) and predicts, frame by frame, every
-counter, every image row handed on, every configuration change and every reply.
+counter, every image row handed on, every configuration change and every reply. Rows are
+assembled from the image records' pixels as ``docs/protocol.md`` says (:class:`Rows`): a row goes
+on once all of it has come in consecutive records of one frame.
 """
 
 from dataclasses import dataclass, field
@@ -11,11 +13,10 @@ from spec import records, wire
 from spec.records import RecordType
 from spec.schedule import row_cycles
 
-__all__ = ["Model", "ones_sum", "BROADCAST"]
+__all__ = ["Model", "Rows", "ones_sum", "BROADCAST"]
 
 BROADCAST = b"\xff" * 6
 VLAN_TPIDS = (0x8100, 0x88A8, 0x9100)
-MIN_FRAME = 60
 
 
 def ones_sum(raw):
@@ -47,6 +48,8 @@ class Model:
     def __post_init__(self):
         for name, _ in records.NET_COUNTERS + records.APP_COUNTERS:
             self.counters.setdefault(name, 0)
+        self.counters.update(dmd_columns=self.dmd.columns, dmd_rows=self.dmd.rows)
+        self.assembler = Rows(self.dmd)
         from gateware.protocol.parser import config_init
         self.config = {k: int(v) for k, v in config_init(mac=self.mac, ip=self.ip, port=self.port).items()}
 
@@ -93,7 +96,7 @@ class Model:
         head = raw[14:34]
         total = int.from_bytes(head[2:4], "big") if n >= 18 else 0
         end = 14 + total
-        if n < 34 or total < 20 or not (n == end or (end < MIN_FRAME and n == MIN_FRAME)):
+        if n < 34 or total < 20 or n < end:
             return "drop_ip_length"
         if head[0] >> 4 != 4:
             return "drop_ip_version"
@@ -137,34 +140,30 @@ class Model:
 
     def _record(self, data, peer):
         header_size = wire.size(records.HEADER)
-        image_end = header_size + wire.size(records.IMAGE)
-        control_end = header_size + wire.size(records.CONTROL)
-        sequencer_end = header_size + wire.size(records.SEQUENCER)
-        padded = data + bytes(max(0, max(image_end, control_end, sequencer_end) - len(data)))
+        sizes = {RecordType.IMAGE: records.IMAGE_HEADER,
+                 RecordType.CONTROL: header_size + wire.size(records.CONTROL),
+                 RecordType.SEQUENCER: header_size + wire.size(records.SEQUENCER),
+                 RecordType.STATUS_QUERY: header_size}
+        padded = data + bytes(max(0, max(sizes.values()) - len(data)))
         head = wire.unpack(records.HEADER, padded)
-        image = wire.unpack(records.IMAGE, padded[header_size:])
         kind = head["type"]
-        needed = {RecordType.IMAGE: image_end, RecordType.CONTROL: control_end,
-                  RecordType.SEQUENCER: sequencer_end}.get(kind, header_size)
-        expected = records.image_record_length(image["row_count"], self.dmd.columns) \
-            if kind == RecordType.IMAGE else needed
         if head["magic"] != records.MAGIC:
             return "drop_app_magic"
         if head["version"] != records.VERSION:
             return "drop_app_version"
-        if kind not in (RecordType.IMAGE, RecordType.CONTROL, RecordType.STATUS_QUERY, RecordType.SEQUENCER):
+        if kind not in sizes:
             return "drop_app_type"
-        if head["length"] == 0:
-            return "drop_app_empty"
-        if head["length"] != len(data) or len(data) < needed:
+        if len(data) < sizes[kind]:
             return "drop_app_length"
-        if kind == RecordType.IMAGE and image["row_count"] == 0:
+        if kind == RecordType.IMAGE and len(data) == sizes[kind]:
             return "drop_app_empty"
-        if head["length"] != expected:
+        if kind != RecordType.IMAGE and len(data) != sizes[kind]:
             return "drop_app_length"
-        if kind == RecordType.IMAGE and (image["first_row"] + image["row_count"] > self.dmd.rows
-                                         or image["row_bytes"] != self.dmd.columns):
-            return "drop_app_rows"
+        if kind == RecordType.IMAGE:
+            image = wire.unpack(records.IMAGE, data[header_size:])
+            pixels = data[sizes[kind]:]
+            if image["offset"] + len(pixels) > self.dmd.rows * self.dmd.columns:
+                return "drop_app_rows"
         if kind == RecordType.CONTROL:
             control = wire.unpack(records.CONTROL, data[header_size:])
             names = [name for name, _ in records.CONFIG]
@@ -179,20 +178,16 @@ class Model:
             registers = wire.unpack(records.SEQUENCER, data[header_size:])
             if any(records.register_faults(registers, row_cycles(self.dmd, self.beats)).values()):
                 return "drop_app_value"
-        if self._sequence is not None and head["sequence"] != (self._sequence + 1) & 0xFFFFFFFF:
+        mask = (1 << dict(records.HEADER)["sequence"]) - 1
+        if self._sequence is not None and head["sequence"] != (self._sequence + 1) & mask:
             self.count("sequence_gaps")
         self._sequence = head["sequence"]
         if kind == RecordType.IMAGE:
-            pixels = data[image_end:]
-            tag = image["frame"] & ((1 << self.frame_bits) - 1)
-            for i in range(image["row_count"]):
-                row = image["first_row"] + i
-                self.rows.append((tag, row, pixels[i * self.dmd.columns:(i + 1) * self.dmd.columns]))
             self.count("records_image")
-            self.count("rows", image["row_count"])
-            self.count("payload_bytes", len(pixels))
-            self.counters["last_row"] = image["first_row"] + image["row_count"] - 1
-            self.counters["last_frame"] = image["frame"]
+            tag = (1 << self.frame_bits) - 1
+            for frame, row, row_bytes in self.assembler.record(image["frame"], image["offset"], pixels):
+                self.rows.append((frame & tag, row, row_bytes))
+            self.counters.update(self.assembler.counters)
             return "image"
         if kind == RecordType.CONTROL:
             for i, (name, _) in enumerate(records.CONFIG):
@@ -208,3 +203,43 @@ class Model:
         self.count("records_status")
         self.replies.append(("status", {**(peer or {}), "sequence": head["sequence"]}))
         return "status"
+
+
+class Rows:
+    """Whole rows from image records' pixels, as ``docs/protocol.md`` says.
+
+    A record continues the row waiting for it when it is of the same frame and starts where the
+    previous record ended; otherwise that row is abandoned, and so are the record's own pixels
+    before its first row start (each an incomplete row). Rows are handed on whole, in order."""
+
+    def __init__(self, dmd):
+        self.columns = dmd.columns
+        self.waiting = None          # (frame, next position, bytes of the row so far)
+        self.counters = {name: 0 for name, _ in records.ROW_COUNTERS}
+        self._seen = False
+
+    def record(self, frame, offset, pixels):
+        """One image record's pixels; returns the rows it completes: ``[(frame id, row, bytes)]``."""
+        columns = self.columns
+        if self.waiting is not None and self.waiting[:2] == (frame, offset):
+            data = self.waiting[2] + pixels
+            start = offset - len(self.waiting[2])
+        else:
+            self.counters["rows_incomplete"] += (self.waiting is not None) + (offset % columns != 0)
+            skip = -offset % columns
+            data, start = pixels[skip:], offset + skip
+        whole = len(data) // columns * columns
+        out = [(frame, (start + at) // columns, data[at:at + columns]) for at in range(0, whole, columns)]
+        self.waiting = (frame, start + len(data), data[whole:]) if len(data) > whole else None
+        for frame_id, row, row_bytes in out:
+            self._handed_on(frame_id, row, len(row_bytes))
+        return out
+
+    def _handed_on(self, frame, row, size):
+        c = self.counters
+        c["rows"] += 1
+        c["payload_bytes"] += size
+        c["last_frame"], c["last_row"] = frame, row
+        if not self._seen or records.frame_newer(frame, c["newest_frame"]):
+            c["newest_frame"] = frame
+        self._seen = True

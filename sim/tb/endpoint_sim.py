@@ -13,7 +13,7 @@ from sim.models.frames import Addresses, byte_beats
 from spec import records
 from spec.facts import TEST_DMD
 
-__all__ = ["run", "plain", "assemble_rows"]
+__all__ = ["run", "plain", "assemble_rows", "pixel_sink"]
 
 
 def plain(const, table):
@@ -35,6 +35,23 @@ def assemble_rows(pixels, columns):
         current[2].append(value)
     assert current is None or len(current[2]) == columns, "the last row was cut short"
     return [(f, r, bytes(b)) for f, r, b in rows]
+
+
+def pixel_sink(dut, taken, *, stall=0.0, seed=0, took=None):
+    """A process that takes ``dut.pixels``, not ready on a ``stall`` fraction of cycles, and
+    appends each pixel taken to ``taken`` as ``(frame, row, column, value)`` (then calls
+    ``took(payload)``, if given)."""
+    async def sink(ctx):
+        prng = random.Random(seed)
+        while True:
+            ready = not (stall and prng.random() < stall)
+            ctx.set(dut.pixels.ready, ready)
+            _, _, valid, p = await ctx.tick().sample(dut.pixels.valid, dut.pixels.payload)
+            if valid and ready:
+                taken.append((p.frame, p.row, p.column, p.pixels[0]))
+                if took is not None:
+                    took(p)
+    return sink
 
 
 def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pixel_stall=0.0,
@@ -85,17 +102,12 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
                 "pixel_count": len(out["pixels"]), "tx_count": len(out["tx"]),
                 "triggers": out["triggers"], "register_count": len(out["registers"])}
 
-    async def pixels(ctx):
-        prng = random.Random(seed + 1)
-        while True:
-            ready = not (pixel_stall and prng.random() < pixel_stall)
-            ctx.set(dut.pixels.ready, ready)
-            _, _, valid, p = await ctx.tick().sample(dut.pixels.valid, dut.pixels.payload)
-            if valid and ready:
-                out["pixels"].append((p.frame, p.row, p.column, p.pixels[0]))
-                out["activity"] = out["cycle"]
-                if p.column == 0:
-                    out["first_pixel"].append(out["cycle"])
+    def took(p):
+        out["activity"] = out["cycle"]
+        if p.column == 0:
+            out["first_pixel"].append(out["cycle"])
+
+    pixels = pixel_sink(dut, out["pixels"], stall=pixel_stall, seed=seed + 1, took=took)
 
     async def tx(ctx):
         trng = random.Random(seed + 2)

@@ -175,19 +175,24 @@ def image(dmd, seed):
     return np.random.default_rng(seed).integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8)
 
 
-def image_frames(picture, frame, rows_per_record, rows):
-    return [frames.udp(A, r) for r in codec.image_records(picture[:rows], frame, rows=rows_per_record)]
+def image_frames(picture, frame, rows_per_record, rows, *, pixels=None):
+    """Rows ``0 .. rows - 1`` of ``picture`` in records of ``rows_per_record`` whole rows (or of
+    ``pixels`` pixels, splitting rows)."""
+    step = pixels or rows_per_record * picture.shape[1]
+    return [frames.udp(A, r) for r in codec.image_records(picture[:rows], frame, pixels=step)]
 
 
 @cocotb.test()
 async def good_traffic_back_to_back(dut):
-    """Image records of 1, 3 and 8 rows, ICMP echoes of random size, ARP, status queries and
-    9,018-byte frames for another port, back to back at the minimum gap: 64 to 9,018 bytes on
-    the line. Every row arrives intact, every reply is right, nothing is dropped for room."""
+    """Image records of 1 and 3 rows and of 1,462 pixels (a 1500-byte MTU's, rows split), ICMP
+    echoes of random size, ARP, status queries and 9,018-byte frames for another port, back to
+    back at the minimum gap: 64 to 9,018 bytes on the line. Every row arrives intact, every reply
+    is right, nothing is dropped for room."""
     bench = await Bench.start(dut)
     rng = random.Random(11)
     picture = image(bench.dmd, 1)
-    good = image_frames(picture, 1, 1, 12) + image_frames(picture, 2, 3, 12) + image_frames(picture, 3, 8, 24)
+    good = (image_frames(picture, 1, 1, 12) + image_frames(picture, 2, 3, 12)
+            + image_frames(picture, 3, None, 24, pixels=codec.pixels_per_record(records.record_limit(1500))))
     others = [frames.icmp_echo(A, rng.randbytes(rng.randint(18, 1472)), seq=i) for i in range(4)]
     others += [frames.arp_request(A), frames.udp(A, codec.status_query(7))]
     others += [frames.udp(A, rng.randbytes(8972), dport=A.port + 1) for _ in range(2)]
@@ -241,12 +246,11 @@ def bad_frames(dmd, record):
     out.append(("runt", GmiiFrame.from_raw_payload(mac.with_fcs(frames.udp(A, b"")[:40])), ("mac", "runt")))
     for name, (builder, counter) in frames.BAD_FRAMES.items():
         out.append((name, gmii(builder(A, record)), ("net", counter)))
-    last_row = dmd.rows - 1
     malformed = {
         "unknown_version": (_with_header(record, version=records.VERSION + 1), "drop_app_version"),
-        "zero_length": (_with_header(record, length=0), "drop_app_empty"),
-        "length_not_datagram": (_with_header(record, length=len(record) - 1), "drop_app_length"),
-        "rows_beyond_frame": (_with_image_fields(record, first_row=last_row), "drop_app_rows"),
+        "image_without_pixels": (record[:records.IMAGE_HEADER], "drop_app_empty"),
+        "truncated_header": (record[:wire.size(records.HEADER) - 1], "drop_app_length"),
+        "pixels_beyond_frame": (_with_image_fields(record, offset=dmd.rows * dmd.columns - 1), "drop_app_rows"),
     }
     for name, (bad, counter) in malformed.items():
         out.append((name, gmii(frames.udp(A, bad)), ("app", counter)))
@@ -261,7 +265,7 @@ async def bad_frames_counted_by_cause(dut):
     dmd = bench.dmd
     picture = image(dmd, 2)
     rows_per_record = 2
-    bad = bad_frames(dmd, codec.image_records(picture[:rows_per_record], 6, rows=rows_per_record)[0])
+    bad = bad_frames(dmd, codec.image_records(picture[:rows_per_record], 6, pixels=rows_per_record * dmd.columns)[0])
     good = [gmii(f) for f in image_frames(picture, 5, rows_per_record, (len(bad) + 2) * rows_per_record)]
     traffic = []
     for i, (_name, frame, _cause) in enumerate(bad):

@@ -1,13 +1,23 @@
 """cocotb benchmark run of the whole Ethernet side (:class:`gateware.protocol.port.EthernetPort`) on
-its generated Verilog: XGA image records in jumbo frames sent back to back at the minimum gap on
-the GMII receive pins, ``sync`` at 125 MHz shifted 0.7 ns from the PHY clock, the pixel consumer
-always ready. Writes its figures as JSON to the ``out`` parameter.
+its generated Verilog: one XGA image in image records as large as the MTU (parameter ``mtu``)
+sent back to back at the minimum gap on the GMII receive pins, then the first record of the next
+image; ``sync`` at 125 MHz shifted 0.7 ns from the PHY clock, the pixel consumer always ready.
+Writes its figures as JSON to the ``out`` parameter.
 
-Commit latency: for each record, the ``sync`` rising edges from the one after the receive MAC
-samples the record's last FCS byte (the ``gmii_rx`` edge after the source drives it) up to and
-including the edge on which the record's first pixel is taken from ``pixels``. That first
-transfer is the earliest effect of the record outside the block and the moment its data starts
-flowing on: the stack holds the frame until its FCS verdict, so nothing of it leaves before.
+Payload rate: the pixels of the first image over the line time from its first pixel handed on to
+the next image's first pixel handed on (both records start a row, so the pipeline's latency is the
+same at both ends): the line's time for every record of a whole image, preamble, FCS and gap
+included, the last (short) record too.
+
+Commit latency: for each record that starts a row, the ``sync`` rising edges from the one after
+the receive MAC samples the record's last FCS byte (the ``gmii_rx`` edge after the source drives
+it) up to and including the edge on which the record's first pixel is taken from ``pixels``. That
+first transfer is the earliest effect of the record outside the block and the moment its data
+starts flowing on: the stack holds the frame until its FCS verdict, so nothing of it leaves before.
+The first record's (``latency_first``) is the pipeline's own: nothing is ahead of it. A later
+record that starts a row may wait behind the rows before it (``latency_max``): a row split across
+the two records before it goes on only once its last piece has come, and the next image's record
+comes right after a shorter one that is still flowing out.
 """
 
 import json
@@ -29,11 +39,12 @@ async def line_rate(dut):
     sync_ps = p["sync_ps"]
     bench = await Bench.start(dut, sync_ps=sync_ps, sink=False)
     dmd = bench.dmd
-    rows = codec.rows_per_record(dmd.columns)
-    picture = np.random.default_rng(8).integers(0, 256, (p["records"] * rows, dmd.columns), dtype=np.uint8)
-    encoded = codec.image_records(picture, 1)
+    limit = records.record_limit(p["mtu"])
+    picture = np.random.default_rng(8).integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8)
+    encoded = codec.image_records(picture, 1, limit=limit)
+    following = codec.image_records(picture[:1], 2, limit=limit, sequence=len(encoded))[0]
     fcs_sampled = []
-    gmii_frames = [gmii(frames.udp(A, r)) for r in encoded]
+    gmii_frames = [gmii(frames.udp(A, r)) for r in encoded + [following]]
     for frame in gmii_frames:
         frame.tx_complete = lambda sent: fcs_sampled.append(sent.sim_time_end + GMII_PS)
     await bench.send(gmii_frames, timeout_ms=100)
@@ -41,21 +52,35 @@ async def line_rate(dut):
 
     got = bench.counters()
     delivered = bench.rows()
-    intact = sum(1 for i in range(len(encoded))
-                 if delivered[i * rows:(i + 1) * rows] == [(1, r, picture[r].tobytes())
-                                                            for r in range(i * rows, (i + 1) * rows)])
-    # Pair each record's first pixel with its frame by row number, so a lost record shifts nothing.
-    row_start = {row: t for (_frame, row, _data), t in zip(delivered, bench.row_starts, strict=True)}
-    starts = [row_start[i * rows] for i in range(len(encoded)) if i * rows in row_start]
-    latencies = [math.ceil((row_start[i * rows] - fcs) / sync_ps) for i, fcs in enumerate(fcs_sampled)
-                 if i * rows in row_start]
-    payload = (len(encoded) - 1) * rows * dmd.columns
+    pixels = codec.pixels_per_record(limit)
+    arrived = set(delivered)
+
+    def rows_of(i):
+        """The rows record ``i`` carries a piece of (the last one: the next image's row 0)."""
+        if i == len(encoded):
+            return [(2, 0)]
+        first, end = i * pixels, min((i + 1) * pixels, picture.size)
+        return [(1, row) for row in range(first // dmd.columns, -(-end // dmd.columns))]
+
+    # a record is intact when every row it carries a piece of arrived whole (rows are handed on
+    # whole: a lost record loses the rows it touches)
+    intact = sum(all((frame, row, picture[row].tobytes()) in arrived for frame, row in rows_of(i))
+                 for i in range(len(gmii_frames)))
+    row_start = {(frame, row): t for (frame, row, _data), t in zip(delivered, bench.row_starts, strict=True)}
+    # the records that start a row (their first pixel is the row's), and when that pixel left
+    starting = {i: rows_of(i)[0] for i in range(len(gmii_frames))
+                if i == len(encoded) or i * pixels % dmd.columns == 0}
+    latency = {i: math.ceil((row_start[row] - fcs_sampled[i]) / sync_ps) for i, row in starting.items()
+               if row in row_start}
+    latencies = list(latency.values())
+    span = row_start.get((2, 0), 0) - row_start.get((1, 0), 0)
     with open(p["out"], "w") as f:
         json.dump({
-            "records": len(encoded), "intact": intact, "frame_bytes": len(gmii_frames[0].data) - 8,
+            "records": len(gmii_frames), "intact": intact, "frame_bytes": len(gmii_frames[0].data) - 8,
             "rx_dropped": got["rx_dropped"], "drop_overflow": got["net"]["drop_overflow"],
             "records_image": got["app"]["records_image"], "mac_good": got["mac"]["good"],
-            "payload_bytes": payload, "line_bytes": (starts[-1] - starts[0]) / GMII_PS,
-            "latency_min": min(latencies), "latency_max": max(latencies),
-            "header_bytes": records.image_record_length(rows, dmd.columns) - rows * dmd.columns,
+            "rows_incomplete": got["app"]["rows_incomplete"],
+            "payload_bytes": picture.size, "line_bytes": span / GMII_PS,
+            "latency_first": latency.get(0), "latency_min": min(latencies), "latency_max": max(latencies),
+            "header_bytes": records.IMAGE_HEADER, "pixels_per_record": pixels,
         }, f)

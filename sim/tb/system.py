@@ -244,8 +244,8 @@ class System:
 def bad_records(system, picture):
     """One malformed record of each class the parser checks, with the counter it lands in."""
     good_regs = records.register_wire(system.plan.params.registers(system.dmd))
-    image = codec.image_records(picture[:1], 0, rows=1)[0]
-    n = wire.size(records.HEADER)
+    image = codec.image_records(picture[:1], 0, pixels=system.dmd.columns)[0]
+    n, end = wire.size(records.HEADER), records.IMAGE_HEADER
     head = wire.unpack(records.HEADER, image)
     body = wire.unpack(records.IMAGE, image[n:])
     return [
@@ -255,7 +255,7 @@ def bad_records(system, picture):
         codec.control_record(system.next_sequence(), armed=2),
         codec.control_record(system.next_sequence(), bit_depth=9),
         wire.pack(records.HEADER, {**head, "version": records.VERSION + 1}) + image[n:],
-        image[:n] + wire.pack(records.IMAGE, {**body, "first_row": system.dmd.rows}) + image[n + 8:],
+        image[:n] + wire.pack(records.IMAGE, {**body, "offset": system.dmd.rows * system.dmd.columns}) + image[end:],
     ]
 
 
