@@ -173,6 +173,8 @@ SYSTEM_STATUS = [
     ("store_frames_abandoned", 32),  # incomplete, abandoned for a newer frame (a lost record)
     ("store_rows_refused", 32),      # rows the store refused (outside, stale, shown, duplicate, no slot)
     ("triggers_held", 32),     # triggers that came too early, held and obeyed once every group was ready
+    ("rst_active_late", 32),   # RST_ACTIVE fell later than planned: the settle counted from its fall
+    ("rst_active_faults", 32), # RST_ACTIVE did not rise after a pulse, or stayed high far too long
 ]
 
 #: Status reply body (after :data:`HEADER`).

@@ -404,17 +404,63 @@ def test_rig_runs_as_the_amaranth_bench(test_name):
 
 
 @pytest.mark.verilog
-def test_rule_model_catches_too_short_rst_time(test_name):
-    """Parameters planned for a shorter RST_ACTIVE than the controller's: the rule model stops
-    the run at the first pulse that comes while RST_ACTIVE is high or the first write into a
-    settling block (it is wired in, not a bystander)."""
+def test_rule_model_catches_too_short_settle_time(test_name):
+    """Parameters planned for a shorter settle time than the controller needs: the rule model
+    stops the run at the first write into a settling block (it is wired in, not a bystander)."""
     p = fast_plan(depth=2).params
     model = dlpc410_for(DMD, p)
-    model.rst_active_cycles = p.t_rst + p.t_settle
+    model.settle_cycles = p.t_settle + 200
     ready = next_ready(p, model_frames([(0, 2)], None), [])
     with pytest.raises(RuleBreak) as e:
         run_rig(DMD, p, [(0, 2)], pins=[ready], cycles=ready + 3 * p.lsb, name=test_name, model=model)
-    assert e.value.rule in (RULES["settle"], RULES["rst_active"])
+    assert e.value.rule == RULES["settle"]
+
+
+@pytest.mark.verilog
+def test_rst_active_as_planned_counts_nothing(test_name):
+    """RST_ACTIVE as long as planned: the settle taken from its fall changes nothing (commands
+    equal to the schedule model's, every level exact) and nothing is counted."""
+    p = fast_plan(depth=3).params
+    first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
+    run, _model = check(p, [(0, 3)], None, [first], test_name)
+    assert run.status["rst_late"] == 0 and run.status["rst_faults"] == 0
+
+
+@pytest.mark.verilog
+def test_rst_active_longer_than_planned(test_name):
+    """A controller that holds RST_ACTIVE 20 cycles longer than planned: the sequencer makes
+    no pulse while it is high and changes no block's memory until ``t_settle`` after it fell
+    (the rule model, checking every cycle, stays silent), and counts each late fall; the frame
+    is played whole, its late pulses counted."""
+    p = fast_plan(depth=3).params
+    model = dlpc410_for(DMD, p)
+    model.rst_active_cycles += 20
+    first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
+    planned = schedule.simulate(DMD, p, model_frames([(0, 3)], None), [first + PIN_TO_STROBE])
+    want = len([t for t, k, _a in planned.commands if k == "pulse"])
+    run = run_rig(DMD, p, [(0, 3)], pins=[first], cycles=first + 60 * p.lsb, name=test_name, model=model)
+    pulses = [c for c in run.model.log if c.kind == "pulse"]
+    assert len(pulses) == want
+    assert run.status["rst_late"] == want and run.status["rst_faults"] == 0
+    assert run.status["late"] > 0
+
+
+@pytest.mark.verilog
+def test_rst_active_stuck_high(test_name):
+    """RST_ACTIVE stuck high after each pulse (far beyond ``t_rst + t_settle``): the fault is
+    counted once a pulse, no pulse is made and no memory changes while it is high (the rule model stays
+    silent); when it falls at last, the frame goes on."""
+    p = fast_plan(depth=2).params
+    model = dlpc410_for(DMD, p)
+    model.rst_active_cycles = p.t_rst + 4 * p.t_settle
+    ready = next_ready(p, model_frames([(0, 2)], None), [])
+    planned = schedule.simulate(DMD, p, model_frames([(0, 2)], None), [ready])
+    want = len([t for t, k, _a in planned.commands if k == "pulse"])
+    run = run_rig(DMD, p, [(0, 2)], pins=[ready - PIN_TO_STROBE],
+                  cycles=ready + 2 * want * (p.t_rst + 4 * p.t_settle), name=test_name, model=model)
+    pulses = [c for c in run.model.log if c.kind == "pulse"]
+    assert len(pulses) == want
+    assert run.status["rst_faults"] == want
 
 
 @pytest.mark.verilog

@@ -234,11 +234,12 @@ def test_cli_configure_says_the_rate_and_sends_the_plan(projector, capsys):
     from spec import schedule
     plan = schedule.plan(TEST_DMD, 200e6, depth=6)
     base = ["--address", "127.0.0.1", "--port", str(projector.port)]
-    assert cli.main(base + ["configure", "--dmd", "test", "--depth", "6", "--dry-run"]) == 0
+    # the projector here is built for DCLK 200 MHz (one beat a cycle); the default is 400 MHz
+    assert cli.main(base + ["configure", "--dmd", "test", "--dclk", "200e6", "--depth", "6", "--dry-run"]) == 0
     out = capsys.readouterr().out
     assert f"{plan.rate_hz:.1f} frames/s ({plan.frame_cycles} DCLK cycles per frame)" in out
     assert projector.received == []
-    assert cli.main(base + ["configure", "--dmd", "test", "--depth", "6"]) == 0
+    assert cli.main(base + ["configure", "--dmd", "test", "--dclk", "200e6", "--depth", "6"]) == 0
     assert cli.main(base + ["arm"]) == 0
     assert cli.main(base + ["status"]) == 0
     model = projector.model

@@ -58,7 +58,9 @@ class Status(data.Struct):
     the next one was not loaded yet; ``early`` triggers before initialisation ended; ``late``
     pulses made after their time (a parameter set the schedule model rejects); ``underruns``
     row loads that waited for their data from the store (one each); ``bad_frames`` frames offered with
-    a bit depth outside 1..8, dropped; ``held`` triggers held until every group was ready.
+    a bit depth outside 1..8, dropped; ``held`` triggers held until every group was ready;
+    ``rst_late`` RST_ACTIVE falls later than planned (the settle counted from the fall);
+    ``rst_faults`` RST_ACTIVE missing after a pulse or stuck high.
     """
     now: TIME_BITS
     frames: COUNTER_BITS
@@ -69,3 +71,5 @@ class Status(data.Struct):
     underruns: COUNTER_BITS
     bad_frames: COUNTER_BITS
     held: COUNTER_BITS
+    rst_late: COUNTER_BITS
+    rst_faults: COUNTER_BITS

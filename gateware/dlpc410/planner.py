@@ -3,7 +3,8 @@
 Each group (:func:`spec.registers.group_size` blocks pulsed together) keeps its place in the
 frame (display position, dark or not), the frame slot and bit depth it shows, and four times:
 when its next pulse falls due, when its memory may change again (``t_rst + t_settle`` after its
-last pulse), when RST_ACTIVE allows its next pulse, and whether it is loaded. When the bus makes
+last pulse, and no sooner than ``t_settle`` after RST_ACTIVE fell: :mod:`.reset_watch`), when
+RST_ACTIVE allows its next pulse, and whether it is loaded. When the bus makes
 a pulse, the planner sets the group's next pulse time and queues its next load job: the next
 plane (a plane long enough to hide the load, ``hide``), or clears ended by a dark pulse. At the
 last plane of a frame group 0 takes the newest complete frame, if one is offered (else the frame
@@ -19,6 +20,7 @@ from spec.schedule import INIT_TO_DVALID, row_cycles
 from ..registers import TIME_BITS, Registers, Source
 from ..store.layouts import SLOT_BITS, FrameInfo
 from .layouts import COUNTER_BITS, event, group_bits, load_job
+from .reset_watch import ResetWatch
 from .timebase import diff, exponent
 
 __all__ = ["Planner", "Offer"]
@@ -78,7 +80,8 @@ class Planner(wiring.Component):
     imminent, imminent_clear : Out(1)
         A loaded group's pulse falls due within a row cycle, within a clear (and its no-op rows).
     writable : Out(blocks)
-        Bit g: group g's memory may change (its settle time is over).
+        Bit g: group g's memory may change (its settle time is over, counted from its pulse and
+        from RST_ACTIVE's fall).
     all_ready : Out(1)
         Every group is loaded and waits for a trigger.
     playing : Out(1)
@@ -89,6 +92,9 @@ class Planner(wiring.Component):
         High while a frame is shown (first pulse to the last group's final dark pulse).
     frames_started, late, bad_frames : Out(COUNTER_BITS)
         Frames started; pulses made after their time; frames dropped for their bit depth.
+    rst_late, rst_faults : Out(COUNTER_BITS)
+        RST_ACTIVE falls later than planned; RST_ACTIVE missing after a pulse or stuck high
+        (:class:`~gateware.dlpc410.reset_watch.ResetWatch`).
     """
 
     def __init__(self, dmd, *, beats=1):
@@ -120,6 +126,8 @@ class Planner(wiring.Component):
             "frames_started": Out(COUNTER_BITS),
             "late": Out(COUNTER_BITS),
             "bad_frames": Out(COUNTER_BITS),
+            "rst_late": Out(COUNTER_BITS),
+            "rst_faults": Out(COUNTER_BITS),
         })
 
     def elaborate(self, platform):
@@ -147,6 +155,10 @@ class Planner(wiring.Component):
         for g in range(G):
             m.d.comb += active[g].eq(g < self.n_groups)
 
+        m.submodules.reset_watch = watch = ResetWatch(dmd)
+        m.d.comb += [watch.regs.eq(regs), watch.now.eq(now), watch.rst_active.eq(self.rst_active),
+                     watch.pulse.valid.eq(self.pulse.valid), watch.pulse.payload.eq(self.pulse.payload),
+                     self.rst_late.eq(watch.late), self.rst_faults.eq(watch.faults)]
         # ---- what the bus may do ----
         armed = [Signal(name=f"armed{g}") for g in range(G)]
         for g in range(G):
@@ -154,7 +166,7 @@ class Planner(wiring.Component):
             m.d.comb += [
                 armed[g].eq(active[g] & pending[g] & loaded[g]),
                 self.due[g].eq(armed[g] & (diff(pulse_at[g], now) <= 0) & rst_ok),
-                self.writable[g].eq(diff(writable[g], now) <= 0),
+                self.writable[g].eq((diff(writable[g], now) <= 0) & ~watch.waiting[g]),
             ]
         clear_len = dmd.clear_row_cycles * R
         m.d.comb += [
@@ -251,4 +263,12 @@ class Planner(wiring.Component):
             for g in range(G):
                 with m.If(active[g]):
                     m.d.sync += [pending[g].eq(1), pulse_at[g].eq(self.trigger.payload + regs.stagger * g)]
+
+        # ---- RST_ACTIVE fell: no change before its settle time (last: it may meet a retake) ----
+        settled = watch.fell.payload.settled
+        for g in range(G):
+            base = Mux(self.retake.valid & (diff(writable[g], self.retake.payload.lead) < 0),
+                       self.retake.payload.lead, writable[g])
+            with m.If(watch.fell.valid & watch.fell.payload.groups[g] & (diff(base, settled) < 0)):
+                m.d.sync += writable[g].eq(settled)
         return m

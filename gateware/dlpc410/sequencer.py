@@ -226,6 +226,8 @@ class Sequencer(wiring.Component):
             self.sync_out.eq(planner.sync_out),
             self.status.frames.eq(planner.frames_started),
             self.status.late.eq(planner.late),
+            self.status.rst_late.eq(planner.rst_late),
+            self.status.rst_faults.eq(planner.rst_faults),
             self.status.bad_frames.eq(planner.bad_frames),
             self.status.triggers.eq(control.triggers),
             self.status.overruns.eq(control.overruns),

@@ -208,6 +208,8 @@ class Projector(wiring.Component):
         for name, source in (("triggers", seq.status.triggers), ("trigger_overruns", seq.status.overruns),
                              ("frames_shown", seq.status.frames), ("triggers_early", seq.status.early),
                              ("triggers_held", seq.status.held),
+                             ("rst_active_late", seq.status.rst_late),
+                             ("rst_active_faults", seq.status.rst_faults),
                              ("pulses_late", seq.status.late), ("row_underruns", seq.status.underruns),
                              ("frames_bad_depth", seq.status.bad_frames),
                              ("registers_applied", registers.applied)):
