@@ -6,7 +6,9 @@ schedule model's plans for the DLP7000; the tests prove the gateware's command s
 the model's cycle for cycle (``tests/test_dlpc410_sequencer.py`` on the test DMD in every reset
 mode, ``tests/test_dlpc410_sequencer_verilog.py`` on full XGA, global and single-block), and
 :func:`gateware_binary_period` re-measures one rate on the gateware here.
-Each figure is given in cycles or Hz at 200 MHz DCLK, and again at 400 MHz (``_400mhz``).
+Each figure is given in cycles or Hz at 200 MHz DCLK, and again at 400 MHz (``_400mhz``). Rates
+that come from the schedule model's plans end in ``_model``; the measured rate of frames played
+back to back on the gateware is ``sys.xga_rate_hz_measured`` (:mod:`sim.bench.system_xga`).
 
 Grey error (:func:`gray_error_table`): the schedule model's global MSB-first 8-bit frame of the
 ramp image on the DLP7000 (the case the cocotb test proves equal to the gateware, command for
@@ -93,16 +95,16 @@ def dlp9500_figures(f, sfx):
     mem = schedule.plan(d, f, depth=1, chain=True)
     return {
         f"seq.row_period_cycles_dlp9500_store{sfx}": (gray.params.row_period, "cycle"),
-        f"seq.gray8_rate_hz_dlp9500_global{sfx}": (gray.rate_hz, "Hz"),
-        f"seq.gray8_rate_hz_dlp9500_global_at_row_rate{sfx}": (
+        f"seq.gray8_rate_hz_dlp9500_global{sfx}_model": (gray.rate_hz, "Hz"),
+        f"seq.gray8_rate_hz_dlp9500_global_at_row_rate{sfx}_model": (
             schedule.plan(d, f, words_per_cycle=2.0).rate_hz, "Hz"),
         f"seq.gray8_bound_hz_dlp9500{sfx}": (schedule.bound(d, f), "Hz"),
-        f"seq.binary_rate_hz_memory_dlp9500{sfx}": (mem.rate_hz, "Hz"),
-        f"seq.binary_rate_hz_memory_dlp9500_at_row_rate{sfx}": (
+        f"seq.binary_rate_hz_memory_dlp9500{sfx}_model": (mem.rate_hz, "Hz"),
+        f"seq.binary_rate_hz_memory_dlp9500_at_row_rate{sfx}_model": (
             schedule.plan(d, f, depth=1, chain=True, words_per_cycle=2.0).rate_hz, "Hz"),
-        f"seq.binary_rate_hz_prng_dlp9500{sfx}": (
+        f"seq.binary_rate_hz_prng_dlp9500{sfx}_model": (
             schedule.plan(d, f, depth=1, chain=True, source=Source.PRNG).rate_hz, "Hz"),
-        f"seq.binary_rate_hz_prng_dlp9500_phased_loose{sfx}": (
+        f"seq.binary_rate_hz_prng_dlp9500_phased_loose{sfx}_model": (
             schedule.plan(d, f, depth=1, chain=True, source=Source.PRNG, reset_mode=ResetMode.SINGLE,
                           strict_rst=False).rate_hz, "Hz"),
     }
@@ -215,7 +217,7 @@ def gray_error_figures():
         "seq.gray_error_rms_lsb_at_max_rate": (aligned[5], "LSB"),
         f"seq.gray_error_rms_lsb_misaligned_{MISALIGN_FIGURE_US}us": (off[5], "LSB"),
         f"seq.gray_error_max_lsb_misaligned_{MISALIGN_FIGURE_US}us": (off[4], "LSB"),
-        "seq.gray_error_rate_hz_at_max_rate": (aligned[2], "Hz"),
+        "seq.gray_error_rate_hz_at_max_rate_model": (aligned[2], "Hz"),
     }
 
 
@@ -251,15 +253,15 @@ def run():
         glob = schedule.plan(XGA, f)
         quad = schedule.plan(XGA, f, reset_mode=ResetMode.QUAD)
         single_loose = schedule.plan(XGA, f, reset_mode=ResetMode.SINGLE, strict_rst=False)
-        figures[f"seq.gray8_rate_hz_dlp7000_global{sfx}"] = (glob.rate_hz, "Hz")
+        figures[f"seq.gray8_rate_hz_dlp7000_global{sfx}_model"] = (glob.rate_hz, "Hz")
         figures[f"seq.gray8_frame_cycles_dlp7000_global{sfx}"] = (glob.frame_cycles, "cycle")
         figures[f"seq.gray8_lsb_cycles_dlp7000_global{sfx}"] = (glob.params.lsb, "cycle")
-        figures[f"seq.gray8_rate_hz_dlp7000_phased{sfx}"] = (quad.rate_hz, "Hz")
+        figures[f"seq.gray8_rate_hz_dlp7000_phased{sfx}_model"] = (quad.rate_hz, "Hz")
         figures[f"seq.gray8_lsb_cycles_dlp7000_phased{sfx}"] = (quad.params.lsb, "cycle")
         figures[f"seq.gray8_stagger_cycles_dlp7000_phased{sfx}"] = (quad.params.stagger, "cycle")
         dual = schedule.plan(XGA, f, reset_mode=ResetMode.DUAL)
-        figures[f"seq.gray8_rate_hz_dlp7000_phased_dual{sfx}"] = (dual.rate_hz, "Hz")
-        figures[f"seq.gray8_rate_hz_dlp7000_phased_single_loose{sfx}"] = (single_loose.rate_hz, "Hz")
+        figures[f"seq.gray8_rate_hz_dlp7000_phased_dual{sfx}_model"] = (dual.rate_hz, "Hz")
+        figures[f"seq.gray8_rate_hz_dlp7000_phased_single_loose{sfx}_model"] = (single_loose.rate_hz, "Hz")
         figures[f"seq.gray8_bound_hz_dlp7000{sfx}"] = (schedule.bound(XGA, f), "Hz")
 
         prng = schedule.plan(XGA, f, depth=1, chain=True, source=Source.PRNG)
@@ -268,10 +270,10 @@ def run():
         mem = schedule.plan(XGA, f, depth=1, chain=True, words_per_cycle=DDR2_BYTES_PER_S / 8 / f)
         mem_phased = schedule.plan(XGA, f, depth=1, chain=True, reset_mode=ResetMode.SINGLE, strict_rst=False,
                                    words_per_cycle=DDR2_BYTES_PER_S / 8 / f)
-        figures[f"seq.binary_rate_hz_prng{sfx}"] = (prng.rate_hz, "Hz")
-        figures[f"seq.binary_rate_hz_prng_phased_loose{sfx}"] = (prng_phased.rate_hz, "Hz")
-        figures[f"seq.binary_rate_hz_memory{sfx}"] = (mem.rate_hz, "Hz")
-        figures[f"seq.binary_rate_hz_memory_phased_loose{sfx}"] = (mem_phased.rate_hz, "Hz")
+        figures[f"seq.binary_rate_hz_prng{sfx}_model"] = (prng.rate_hz, "Hz")
+        figures[f"seq.binary_rate_hz_prng_phased_loose{sfx}_model"] = (prng_phased.rate_hz, "Hz")
+        figures[f"seq.binary_rate_hz_memory{sfx}_model"] = (mem.rate_hz, "Hz")
+        figures[f"seq.binary_rate_hz_memory_phased_loose{sfx}_model"] = (mem_phased.rate_hz, "Hz")
         figures.update(dlp9500_figures(f, sfx))
 
     measured, model = gateware_binary_period()
