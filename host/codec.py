@@ -86,7 +86,8 @@ def sequencer_record(registers, sequence=0, *, dmd=None, beats=1):
     fields = registers if all(isinstance(registers.get(n), int) for n in names) \
         else records.register_wire(registers)
     if dmd is not None:
-        failed = [check for check, bad in records.register_faults(fields, row_cycles(dmd, beats)).items() if bad]
+        faults = records.register_faults(fields, row_cycles(dmd, beats), dmd.clear_row_cycles)
+        failed = [check for check, bad in faults.items() if bad]
         if failed:
             raise ValueError(f"the sequencer cannot obey this register set: {', '.join(failed)}")
     body = wire.pack(records.SEQUENCER, fields)

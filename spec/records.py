@@ -200,12 +200,16 @@ def _any(terms):
     return _functools.reduce(_operator.or_, terms)
 
 
-def register_faults(wire, row_cycles):
+def register_faults(wire, row_cycles, clear_row_cycles):
     """Why the sequencer could not obey a register set: ``{check: condition}``, each condition
     true when the set fails the check. ``wire`` maps the :data:`SEQUENCER` field names to ints
     (the host, the reference model) or to Amaranth values (the parser); the conditions are built
-    with operators only, so both get the same checks. ``row_cycles``: the DMD's DCLK cycles per
-    row, the shortest row period."""
+    with operators only, so both get the same checks. ``row_cycles``: cycles of a row cycle, the
+    shortest row period; ``clear_row_cycles``: row cycles a block clear takes on the DMD.
+
+    ``lsb_keepable``: between two clocking pulses of a block come its reset (``t_rst``), its
+    settle time (``t_settle``) and at least a block clear, the shortest way to end a plane
+    (``docs/bounds.md``); a shorter least significant plane cannot be shown at its length."""
     faults = {}
     for f, (_, wire_width) in zip(_registers.FIELDS, SEQUENCER, strict=True):
         if wire_width > f.bits:
@@ -216,6 +220,7 @@ def register_faults(wire, row_cycles):
     faults["dark_gap_even"] = (wire["dark_gap"] & 1) != 0
     faults["stagger_even"] = (wire["stagger"] & 1) != 0
     faults["row_period"] = wire["row_period"] < row_cycles
+    faults["lsb_keepable"] = wire["lsb"] < wire["t_rst"] + wire["t_settle"] + clear_row_cycles * row_cycles
     faults["period_nonzero"] = ((wire["trigger"] == _registers.TriggerMode.PERIODIC.value)
                                 & (wire["period"] == 0))
     return faults

@@ -254,6 +254,8 @@ def test_sequencer_record_refuses_what_the_projector_would_drop():
     codec.sequencer_record(wire, dmd=TEST_DMD)
     with pytest.raises(ValueError, match="lsb_even_nonzero"):
         codec.sequencer_record({**wire, "lsb": 3}, dmd=TEST_DMD)
+    with pytest.raises(ValueError, match="lsb_keepable"):
+        codec.sequencer_record({**wire, "lsb": 2}, dmd=TEST_DMD)
     with pytest.raises(ValueError, match="order_known"):
         codec.sequencer_record({**wire, "order": 3}, dmd=TEST_DMD)
     head, body, rest = codec.decode(codec.sequencer_record(wire, 9))

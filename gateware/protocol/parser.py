@@ -167,7 +167,8 @@ class Parser(wiring.Component):
                        | (applies("sequence_length") & (control.sequence_length == 0)))):
             m.d.comb += cause.eq(1 + causes.index("value"))
         with m.Elif((header.type == RecordType.SEQUENCER)
-                    & Cat(records.register_faults(sequencer, row_cycles(dmd, self._beats)).values()).any()):
+                    & Cat(records.register_faults(sequencer, row_cycles(dmd, self._beats),
+                                                    dmd.clear_row_cycles).values()).any()):
             m.d.comb += cause.eq(1 + causes.index("value"))
 
         sequence_seen = Signal()

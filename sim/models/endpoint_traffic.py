@@ -67,6 +67,7 @@ BAD_REGISTERS = {
     "stagger_odd": {"stagger": 3},
     "dark_gap_odd": {"dark_gap": GOOD_WIRE["dark_gap"] + 1},
     "row_period_short": {"row_period": DMD.dclk_per_row - 1},
+    "lsb_too_short": {"lsb": 2},
     "periodic_without_period": {"trigger": TriggerMode.PERIODIC.value, "period": 0},
 }
 
@@ -137,7 +138,8 @@ def randomized_mix(count=260, seed=11):
             raw, bad = frames.udp(A, control), False
             seq += 1
         elif roll < 0.74:
-            changes = rng.choice([{"lsb": 2 * rng.randrange(1, 1 << 20)}, rng.choice(list(BAD_REGISTERS.values()))])
+            changes = rng.choice([{"lsb": 2 * rng.randrange(GOOD_WIRE["lsb"] // 2, 1 << 20)},
+                                  rng.choice(list(BAD_REGISTERS.values()))])
             raw, bad = frames.udp(A, sequencer_record(seq, **changes)), False
             seq += 1
         else:

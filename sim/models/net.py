@@ -176,7 +176,8 @@ class Model:
                 return "drop_app_value"
         if kind == RecordType.SEQUENCER:
             registers = wire.unpack(records.SEQUENCER, data[header_size:])
-            if any(records.register_faults(registers, row_cycles(self.dmd, self.beats)).values()):
+            if any(records.register_faults(registers, row_cycles(self.dmd, self.beats),
+                                          self.dmd.clear_row_cycles).values()):
                 return "drop_app_value"
         mask = (1 << dict(records.HEADER)["sequence"]) - 1
         if self._sequence is not None and head["sequence"] != (self._sequence + 1) & mask:
