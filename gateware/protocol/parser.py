@@ -90,9 +90,48 @@ class Parser(wiring.Component):
             "counters": Out(layout(records.RECORD_COUNTERS)),
         })
 
+    #: Why a record is dropped, in the order the checks are made (``drop_app_<cause>``).
+    _CAUSES = ["magic", "version", "type", "empty", "length", "rows", "value"]
+
+    def _cause(self, m, header, image, control, sequencer, length, needed):
+        """The first check the record in ``captured`` fails: 1 + its index in :attr:`_CAUSES`,
+        or 0 when it passes every one."""
+        dmd = self._dmd
+        is_image = header.type == RecordType.IMAGE
+        cause = Signal(range(8))
+        causes = self._CAUSES
+        names = [name for name, _ in records.CONFIG]
+
+        def applies(name):
+            return control.apply[names.index(name)]
+        with m.If(header.magic != records.MAGIC):
+            m.d.comb += cause.eq(1 + causes.index("magic"))
+        with m.Elif(header.version != records.VERSION):
+            m.d.comb += cause.eq(1 + causes.index("version"))
+        with m.Elif((header.type != RecordType.IMAGE) & (header.type != RecordType.CONTROL)
+                    & (header.type != RecordType.STATUS_QUERY) & (header.type != RecordType.SEQUENCER)):
+            m.d.comb += cause.eq(1 + causes.index("type"))
+        with m.Elif(length < needed):
+            m.d.comb += cause.eq(1 + causes.index("length"))
+        with m.Elif(is_image & (length == needed)):
+            m.d.comb += cause.eq(1 + causes.index("empty"))
+        with m.Elif(~is_image & (length != needed)):
+            m.d.comb += cause.eq(1 + causes.index("length"))
+        with m.Elif(is_image & (image.offset + (length - _IMAGE_END) > dmd.rows * dmd.columns)):
+            m.d.comb += cause.eq(1 + causes.index("rows"))
+        with m.Elif((header.type == RecordType.CONTROL)
+                    & ((applies("bit_depth") & ((control.bit_depth == 0) | (control.bit_depth > 8)))
+                       | (applies("armed") & (control.armed > 1))
+                       | (applies("sequence_length") & (control.sequence_length == 0)))):
+            m.d.comb += cause.eq(1 + causes.index("value"))
+        with m.Elif((header.type == RecordType.SEQUENCER)
+                    & Cat(records.register_faults(sequencer, row_cycles(dmd, self._beats),
+                                                    dmd.clear_row_cycles).values()).any()):
+            m.d.comb += cause.eq(1 + causes.index("value"))
+        return cause
+
     def elaborate(self, platform):
         m = Module()
-        dmd = self._dmd
         counters = self.counters
         beat = self.datagrams.payload
         taken = self.datagrams.valid & self.datagrams.ready
@@ -135,41 +174,12 @@ class Parser(wiring.Component):
                 m.d.comb += needed.eq(_SEQUENCER_END)
             with m.Default():
                 m.d.comb += needed.eq(_HEADER)
-        is_image = header.type == RecordType.IMAGE
         # one past the image record's last pixel
         until = Signal.like(self.pieces.payload.until)
         m.d.comb += until.eq(image.offset + (length - _IMAGE_END))
 
-        cause = Signal(range(8))
-        causes = ["magic", "version", "type", "empty", "length", "rows", "value"]
-        names = [name for name, _ in records.CONFIG]
-
-        def applies(name):
-            return control.apply[names.index(name)]
-        with m.If(header.magic != records.MAGIC):
-            m.d.comb += cause.eq(1 + causes.index("magic"))
-        with m.Elif(header.version != records.VERSION):
-            m.d.comb += cause.eq(1 + causes.index("version"))
-        with m.Elif((header.type != RecordType.IMAGE) & (header.type != RecordType.CONTROL)
-                    & (header.type != RecordType.STATUS_QUERY) & (header.type != RecordType.SEQUENCER)):
-            m.d.comb += cause.eq(1 + causes.index("type"))
-        with m.Elif(length < needed):
-            m.d.comb += cause.eq(1 + causes.index("length"))
-        with m.Elif(is_image & (length == needed)):
-            m.d.comb += cause.eq(1 + causes.index("empty"))
-        with m.Elif(~is_image & (length != needed)):
-            m.d.comb += cause.eq(1 + causes.index("length"))
-        with m.Elif(is_image & (image.offset + (length - _IMAGE_END) > dmd.rows * dmd.columns)):
-            m.d.comb += cause.eq(1 + causes.index("rows"))
-        with m.Elif((header.type == RecordType.CONTROL)
-                    & ((applies("bit_depth") & ((control.bit_depth == 0) | (control.bit_depth > 8)))
-                       | (applies("armed") & (control.armed > 1))
-                       | (applies("sequence_length") & (control.sequence_length == 0)))):
-            m.d.comb += cause.eq(1 + causes.index("value"))
-        with m.Elif((header.type == RecordType.SEQUENCER)
-                    & Cat(records.register_faults(sequencer, row_cycles(dmd, self._beats),
-                                                    dmd.clear_row_cycles).values()).any()):
-            m.d.comb += cause.eq(1 + causes.index("value"))
+        cause = self._cause(m, header, image, control, sequencer, length, needed)
+        causes = self._CAUSES
 
         sequence_seen = Signal()
         sequence_last = Signal.like(header.sequence)
