@@ -21,10 +21,13 @@ setup: $(STAMP)
 test: $(STAMP)
 	$(PY) -m pytest -n $(JOBS) -q
 
-# The main job: the system simulation on the default scene (DCLK 400 MHz; DCLK=200 for 200 MHz).
+# The main job: the system simulation on the default scene (DCLK 400 MHz; DCLK=200 for 200 MHz;
+# FAULTS=stalls|rst|all: the memory stalls at random, the DLPC410 holds RST_ACTIVE longer than
+# planned, or both).
 DCLK ?= 400
+FAULTS ?=
 sim: $(STAMP)
-	$(PY) -m flow sim --dclk $(DCLK)
+	$(PY) -m flow sim --dclk $(DCLK) $(if $(FAULTS),--faults $(FAULTS))
 
 # The Spartan-6 ISE tree (Verilog, UCF, ISE scripts) and each block's Verilog, in build/spartan6.
 verilog: $(STAMP)

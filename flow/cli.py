@@ -21,6 +21,8 @@ def main(argv=None):
     sim = sub.add_parser("sim", help="the system simulation on the default scene")
     sim.add_argument("--frames", type=int, default=None, help="number of frames to store and show")
     sim.add_argument("--dclk", type=float, default=400, choices=(200, 400), help="DCLK in MHz (default 400)")
+    sim.add_argument("--faults", choices=("stalls", "rst", "all"), default=None,
+                     help="memory stalls at random, RST_ACTIVE held longer than planned, or both (sim.xga.FAULTS)")
     sub.add_parser("waves", help="say where the latest VCD and its GTKWave save file are")
     args = parser.parse_args(argv)
 
@@ -41,7 +43,7 @@ def main(argv=None):
         return run(args.only, resources=not args.no_resources)
     if args.command == "sim":
         from sim.system import main as run
-        return run(frames=args.frames, dclk_hz=args.dclk * 1e6)
+        return run(frames=args.frames, dclk_hz=args.dclk * 1e6, faults=args.faults)
     if args.command == "waves":
         from sim.harness.waves import main as run
         return run()

@@ -76,10 +76,12 @@ def read_rate(timing, dmd_hz):
 
 
 def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cycles, flush,
-                 ecp2_cycles=ECP2_CYCLES, extra=None, layout=None, always=None, domain="dmd"):
+                 ecp2_cycles=ECP2_CYCLES, restart_at=0, restart_cycles=0, restart_ecp2_cycles=0,
+                 extra=None, layout=None, always=None, domain="dmd"):
     """The DLPC410's side of the pins ``dlpc`` (an interface of
     :class:`gateware.dlpc410.interface.Signature`, seen from its driver): the responder drives the
-    controller's outputs (its cycle counts: ints, or signals set at run time), the recorder writes
+    controller's outputs (its cycle counts: ints, or signals set at run time; ``restart_*``: a
+    restart mid-run, none when ``restart_cycles`` is 0), the recorder writes
     the pins and ``extra`` (``{field: signal}`` of ``layout``'s other fields; default layout
     :func:`pin_layout`) to the file of plusarg ``PLUSARGS["pins"]``, on every cycle with DVALID
     or ``always`` high and every cycle something changed. The interface's ``beats`` (DCLK cycles
@@ -88,7 +90,9 @@ def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cyc
     rst_active, init_active, ecp2 = Signal(), Signal(), Signal()
     timing = {name: Value.cast(Const(value, 32) if isinstance(value, int) else value)
               for name, value in (("rst_active_cycles", rst_active_cycles), ("init_cycles", init_cycles),
-                                  ("init_grace_cycles", init_grace_cycles), ("ecp2_cycles", ecp2_cycles))}
+                                  ("init_grace_cycles", init_grace_cycles), ("ecp2_cycles", ecp2_cycles),
+                                  ("restart_at", restart_at), ("restart_cycles", restart_cycles),
+                                  ("restart_ecp2_cycles", restart_ecp2_cycles))}
     m.submodules.responder = Instance(
         "dlpc410_responder",
         p_CYCLES_PER_ROW=dmd.dclk_per_row // beats, **{f"i_{name}": value for name, value in timing.items()},
@@ -185,6 +189,8 @@ class FastSystem(wiring.Component):
         Writes the recorders' buffered lines to their files.
     mcb_fault : Out(8)
         The memory ports' rule-break codes (``mcb_model.v``), 4 bits per port; 0 = none.
+    mcb_stalls : Out(32)
+        Commands the memory model stalled at random (plusargs; none by default).
     """
 
     def __init__(self, dmd, registers, *, mac, ip, port, clocks, init_cycles=200, init_grace_cycles=4,
@@ -204,6 +210,7 @@ class FastSystem(wiring.Component):
             "replay_busy": Out(1),
             "flush": In(1),
             "mcb_fault": Out(8),
+            "mcb_stalls": Out(32),
         })
 
     def _memory(self, m, core):
@@ -233,7 +240,7 @@ class FastSystem(wiring.Component):
             p_WORD_NS=t.word_s * 1e9, p_READ_LATENCY_NS=t.read_latency_s * 1e9,
             p_REFRESH_INTERVAL_NS=t.refresh_interval_s * 1e9, p_REFRESH_NS=t.refresh_s * 1e9,
             i_clk=Cat(ClockSignal("sync"), ClockSignal("dmd")),
-            o_fault=self.mcb_fault,
+            o_fault=self.mcb_fault, o_stalls=self.mcb_stalls,
             **connections)
 
     def _clocks_and_resets(self, m):

@@ -66,6 +66,9 @@ class Timing(data.Struct):
     init_cycles: 32
     init_grace_cycles: 32
     ecp2_cycles: 32
+    restart_at: 32
+    restart_cycles: 32
+    restart_ecp2_cycles: 32
 
 
 def event_layout():
@@ -284,7 +287,9 @@ def run_script(dmd, params, frames, images=None, *, script, name, model=None, se
     report = directory / "report.json"
     report.unlink(missing_ok=True)
     timing = {"rst_active_cycles": model.rst_active_cycles, "init_cycles": model.init_cycles,
-              "init_grace_cycles": model.init_grace_cycles, "ecp2_cycles": model.ecp2_cycles}
+              "init_grace_cycles": model.init_grace_cycles, "ecp2_cycles": model.ecp2_cycles,
+              "restart_at": model.restart_at or 0, "restart_cycles": model.restart_cycles if model.restart_at else 0,
+              "restart_ecp2_cycles": model.restart_ecp2_cycles}
     p = {"regs": pack(Registers, params.registers(dmd)), "timing": pack(Timing, timing),
          "seed": seed, "script": script, "report": str(report), "max_cycles": max_cycles,
          "status": [(n, f.offset, f.width) for n, f in data.Layout.cast(Status)]}

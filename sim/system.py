@@ -75,8 +75,10 @@ def latency(shown):
     return latencies[len(latencies) // 2], latencies[-1]
 
 
-def main(frames=None, dclk_hz=xga.DCLK_HZ):
-    """``make sim``: the full-XGA run of :mod:`sim.xga` on the default scene; prints the figures."""
+def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None):
+    """``make sim``: the full-XGA run of :mod:`sim.xga` on the default scene; prints the figures.
+    ``faults`` (``make sim FAULTS=stalls|rst|all``): the same run with the chips misbehaving
+    (:data:`sim.xga.FAULTS`)."""
     frames = frames or XGA_FRAMES
     dmd = xga.DMD
     print(f"make sim: the projector's core (generated Verilog, Verilator) on the default scene, "
@@ -85,9 +87,16 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ):
           f"one, then {XGA_BACK_TO_BACK} back to back; Verilog MCB model on both memory ports; DLPC410 pins "
           f"recorded and checked afterwards by the rule-checking DLPC410 model and the camera model; TI "
           f"timing (only INIT_ACTIVE shortened)")
+    f = xga.FAULTS[faults] if faults else {}
+    if "mcb_stall_permille" in f:
+        print(f"faults: {f['mcb_stall_permille']} in 1000 memory commands stall up to {f['mcb_stall_max_ns']} ns "
+              f"(seed {f['mcb_stall_seed']})")
+    if "dlpc410_rst_extra" in f:
+        print(f"faults: RST_ACTIVE held {f['dlpc410_rst_extra']} cycles longer than the facts table's time "
+              f"(the plan's)")
     t0 = time.monotonic()
-    r = xga.run("scene", frames=frames, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK,
-                dclk_hz=dclk_hz)
+    r = xga.run(f"scene-{faults}" if faults else "scene", frames=frames, one_by_one=XGA_ONE_BY_ONE,
+                back_to_back=XGA_BACK_TO_BACK, dclk_hz=dclk_hz, faults=faults)
     shown, status = r["frames"], r["status"]
     ns = 1e9 / xga.DMD_HZ
     typical, worst = latency(shown)
@@ -102,8 +111,10 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ):
     print(f"trigger pin to the optical change (+ {optical} cycles, pulse to mirror motion, facts "
           f"t_pulse_to_mirror): typical {typical + optical} cycles ({(typical + optical) * ns / 1e3:.2f} us), "
           f"worst {worst + optical} cycles ({(worst + optical) * ns / 1e3:.2f} us)")
+    agree = ("the sequencer waits for RST_ACTIVE and late rows: not compared with the schedule model" if faults
+             else "frame starts equal the schedule model's")
     print(f"frame period back to back, measured on the pins: {measured} cycles = {xga.DMD_HZ / measured:.1f} Hz "
-          f"(frame starts equal the schedule model's; periods {periods}); schedule model (global reset, MSB "
+          f"({agree}; periods {periods}); schedule model (global reset, MSB "
           f"first, LSB {r['lsb_cycles']} cycles, rows every {r['row_period']} cycles): {r['period_cycles']} "
           f"cycles = {r['rate_hz']:.1f} Hz")
     spans = sorted({f["span_cycles"] for f in shown})
@@ -114,7 +125,10 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ):
           f"{status['records_image']} image records, {status['rows']} rows; "
           f"triggers {status['triggers']} (held {status['triggers_held']}), overruns {status['trigger_overruns']}, "
           f"frames shown {status['frames_shown']}, pulses late {status['pulses_late']}, row loads that waited "
-          f"for the store {status['row_underruns']}")
+          f"for the store {status['row_underruns']}, RST_ACTIVE late {status['rst_active_late']}, RST_ACTIVE "
+          f"faults {status['rst_active_faults']}, controller restarts {status['dlpc410_restarts']}")
+    if faults:
+        print(f"memory commands stalled: {r['mcb_stalls']}")
     print(f"grey error of the reconstructed images: max {max(f['max_error_lsb'] for f in shown):g} LSB "
           f"({sum(f['wrong_pixels'] for f in shown)} pixels wrong)")
     print(f"simulation speed: {r['dmd_cycles'] / r['sim_wall_s']:.0f} dmd cycles per wall second "

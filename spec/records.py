@@ -175,6 +175,7 @@ SYSTEM_STATUS = [
     ("triggers_held", 32),     # triggers that came too early, held and obeyed once every group was ready
     ("rst_active_late", 32),   # RST_ACTIVE fell later than planned: the settle counted from its fall
     ("rst_active_faults", 32), # RST_ACTIVE did not rise after a pulse, or stayed high far too long
+    ("dlpc410_restarts", 32),  # the DLPC410 initialised again mid-run (INIT_ACTIVE high again, ECP2_FINISHED low)
 ]
 
 #: Status reply body (after :data:`HEADER`).

@@ -582,3 +582,37 @@ def test_frame_offered_late_in_a_frame_abandons_the_stale_preload(mode, after, t
         assert 0 < len(stale) < DMD.rows
     # the whole reload took less than a repeat followed by a reload
     assert second + PIN_TO_STROBE < waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + DMD.rows * p.row_period
+
+
+@pytest.mark.verilog
+@pytest.mark.parametrize("ecp2_low", [0, 60])
+def test_controller_restart_mid_frame(ecp2_low, test_name):
+    """The controller initialises again in the middle of a frame (INIT_ACTIVE high again; with
+    ``ecp2_low``, ECP2_FINISHED low for its first cycles too: it was reconfigured): the DMD's
+    memory and mirrors are lost. Once the sequencer has seen it (a synchroniser later) it makes no
+    command and sends the training pattern while INIT_ACTIVE is high, keeps DVALID low for
+    ``init_to_dvalid`` clocks after it falls (the rule model checks every cycle), counts the
+    restart, abandons the frame and starts over from every group's first plane; the next trigger
+    shows the frame whole, every level exact."""
+    p = fast_plan(depth=3).params
+    ready = next_ready(p, model_frames([(0, 3)], None), [])
+    period = next_ready(p, model_frames([(0, 3)], None), [ready]) - ready
+    # mid-frame: the first plane shown, the second being loaded (model cycles)
+    restart_at = INIT_CYCLES + 8 + ready + 2 * p.lsb
+    model = dlpc410_for(DMD, p)
+    model.restart_at, model.restart_cycles, model.restart_ecp2_cycles = restart_at, 300, ecp2_low
+    pins = [ready - PIN_TO_STROBE, ready + 2 * period]
+    run = run_rig(DMD, p, [(0, 3)], pins=pins, cycles=ready + 4 * period, name=test_name, model=model)
+    assert run.status["restarts"] == 1
+    assert run.status["frames"] == 2 and run.status["triggers"] == 2
+    end = restart_at + model.restart_cycles
+    pulses = [c.cycle for c in model.log if c.kind == "pulse"]
+    before = [t for t in pulses if t < restart_at]
+    after = [t for t in pulses if t >= restart_at]
+    assert 0 < len(before) < len(after)
+    assert not [c for c in model.log if restart_at + model.restart_grace_cycles <= c.cycle < end]
+    assert min(c.cycle for c in model.log if c.cycle >= end) >= end + model.init_to_dvalid_clocks
+    lights = frame_lights(model, run.frames())
+    assert len(lights) == 2
+    assert np.array_equal(lights[-1], (ramp_image(DMD, 0).astype(np.int64) >> 5) * p.lsb)
+    assert not np.array_equal(lights[0], lights[-1])

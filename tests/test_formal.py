@@ -100,7 +100,7 @@ def test_checks_quick(check):
 
 
 class Through(wiring.Component):
-    """A synchroniser without its flip-flops: the sequencer then sees the pins a cycle early."""
+    """A synchroniser without its flip-flops: the sequencer then sees the pins two cycles early."""
 
     def __init__(self, i, o, **kwargs):
         self._i, self._o = i, o
@@ -119,4 +119,4 @@ def test_sequencer_init_rule(monkeypatch):
     monkeypatch.setattr(init, "FFSynchronizer", Through)
     with pytest.raises(FormalFailure) as failure:
         run(dataclasses.replace(check, block="Sequencer-unsynchronised"))
-    assert "running before the controller was ready" in failure.value.result.failed
+    assert "running other than the controller's state three cycles ago" in failure.value.result.failed

@@ -17,7 +17,8 @@ WIDTHS = dict(records.SYSTEM_STATUS)
 SEQUENCER = {"frames": "frames_shown", "triggers": "triggers", "overruns": "trigger_overruns",
              "early": "triggers_early", "held": "triggers_held", "late": "pulses_late",
              "underruns": "row_underruns", "bad_frames": "frames_bad_depth",
-             "rst_late": "rst_active_late", "rst_faults": "rst_active_faults"}
+             "rst_late": "rst_active_late", "rst_faults": "rst_active_faults",
+             "restarts": "dlpc410_restarts"}
 #: The store's counters: three reported alone, the row refusals as one sum.
 STORE = {"frames_complete": "store_frames_complete", "frames_replaced": "store_frames_replaced",
          "frames_abandoned": "store_frames_abandoned",

@@ -7,13 +7,19 @@ loads were under way: they are dropped, the words already asked of the store dis
 new loads start exactly ``flush_rows * row_period`` cycles after the frame was taken (the
 schedule model uses the same time). A trigger is obeyed when every group is loaded and waits;
 otherwise it is an overrun (or early, before the groups run).
+
+A controller that initialises again (``initialised`` falls: INIT_ACTIVE high again, or
+ECP2_FINISHED low) has lost the DMD's memory: ``RESTART`` stops every pulse and load, drops the
+loads under way as ``FLUSH`` does, and once the controller is ready again every group starts
+over from its first plane (of the newest frame) as after a reload, no sooner than
+``init_to_dvalid`` clocks later; the groups then wait for a trigger.
 """
 
 from amaranth import Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from spec.schedule import flush_rows
+from spec.schedule import INIT_TO_DVALID, flush_rows
 
 from ..registers import DURATION_BITS, TIME_BITS, Registers, Source
 from ..store.layouts import SLOT_BITS
@@ -37,7 +43,7 @@ class FrameControl(wiring.Component):
     now : In(TIME_BITS)
     n_groups : In(range(blocks + 1))
     initialised : In(1)
-        The DLPC410 has finished initialising.
+        The DLPC410 is initialised (it may fall again: the controller restarts).
     strobe : In(1)
         A trigger (from :class:`~gateware.dlpc410.trigger.Trigger`).
     reload : In(1)
@@ -59,8 +65,8 @@ class FrameControl(wiring.Component):
         Stale loads are being dropped.
     triggers, overruns, early, held : Out(COUNTER_BITS)
         Triggers obeyed; ignored because a frame played or was not loaded yet (and one was held
-        already, or ``trigger_hold`` is low); before the groups ran; held until every group was
-        ready (``trigger_hold``).
+        already, or ``trigger_hold`` is low); before the groups ran (or while the controller
+        restarts); held until every group was ready (``trigger_hold``).
     """
 
     def __init__(self, dmd):
@@ -79,7 +85,7 @@ class FrameControl(wiring.Component):
             "playing": In(1),
             "drained": In(1),
             "start": Out(event(data.StructLayout({"slot": SLOT_BITS, "depth": 4, "take": 1}))),
-            "retake": Out(event(data.StructLayout({"newer": 1, "lead": TIME_BITS}))),
+            "retake": Out(event(data.StructLayout({"newer": 1, "abandon": 1, "lead": TIME_BITS}))),
             "trigger": Out(event(TIME_BITS)),
             "queue_first": Out(event(gb)),
             "running": Out(1),
@@ -100,11 +106,17 @@ class FrameControl(wiring.Component):
         m.d.comb += flush_cycles.eq(flush_rows(self._dmd) * regs.row_period)
         start_group = Signal(group_bits(self._dmd) + 1)
 
+        restarted = Signal()                   # the controller is ready again after a restart
+
         def queue_first_planes():
             m.d.comb += [self.queue_first.valid.eq(1), self.queue_first.payload.eq(start_group)]
             m.d.sync += start_group.eq(start_group + 1)
             with m.If(start_group == self.n_groups - 1):
                 m.next = "RUN"
+
+        def restart_on_init():
+            with m.If(~self.initialised):
+                m.next = "RESTART"
 
         with m.FSM(name="start") as fsm:
             with m.State("WAIT"):
@@ -116,12 +128,14 @@ class FrameControl(wiring.Component):
                     m.next = "QUEUE"
             with m.State("QUEUE"):
                 queue_first_planes()
+                restart_on_init()
             with m.State("RUN"):
                 m.d.comb += self.running.eq(1)
                 with m.If(take_idle):
                     m.next = "RELOAD"
                     with m.If(~self.all_ready):
                         m.next = "FLUSH"
+                restart_on_init()
             with m.State("FLUSH"):
                 # queued loads are dropped by the requester, looked-up ones by the bus, the words
                 # asked for are discarded; then the first planes are queued, exactly
@@ -129,9 +143,17 @@ class FrameControl(wiring.Component):
                 m.d.comb += [self.running.eq(1), self.flushing.eq(1)]
                 with m.If(self.drained & (diff(flush_until, now) <= 0)):
                     m.next = "RELOAD"
+                restart_on_init()
             with m.State("RELOAD"):
                 m.d.comb += self.running.eq(1)
                 queue_first_planes()
+                restart_on_init()
+            with m.State("RESTART"):
+                # no pulse, no load; what was under way is dropped as in FLUSH
+                m.d.comb += self.flushing.eq(1)
+                with m.If(self.initialised & self.drained):
+                    m.d.comb += restarted.eq(1)
+                    m.next = "RELOAD"
 
         # A newer streamed frame offered while no group plays replaces the preloaded first planes (the
         # next frame of a stored sequence waits for its turn); nothing
@@ -148,6 +170,12 @@ class FrameControl(wiring.Component):
             m.d.comb += [self.retake.valid.eq(1), self.retake.payload.newer.eq(newer),
                          self.retake.payload.lead.eq(now + regs.reload_lead + wait)]
             m.d.sync += [start_group.eq(0), flush_until.eq(now + wait)]
+        with m.If(restarted):
+            # every group starts over: nothing it held is on the DMD any more
+            m.d.comb += [self.retake.valid.eq(1), self.retake.payload.newer.eq(newer),
+                         self.retake.payload.abandon.eq(1),
+                         self.retake.payload.lead.eq(now + INIT_TO_DVALID)]
+            m.d.sync += start_group.eq(0)
 
         # a trigger is obeyed when every group is ready; one that comes sooner is held (with
         # ``trigger_hold``) and obeyed on the first cycle they are, before any new one
@@ -159,9 +187,10 @@ class FrameControl(wiring.Component):
             m.d.comb += [self.trigger.valid.eq(1), self.trigger.payload.eq((now + 2) & ~1)]
             m.d.sync += self.triggers.eq(self.triggers + 1)
 
+        with m.If(release | fsm.ongoing("RESTART")):
+            m.d.sync += holding.eq(0)
         with m.If(release):
             obey()
-            m.d.sync += holding.eq(0)
         with m.If(self.strobe):
             with m.If(~self.running):
                 m.d.sync += self.early.eq(self.early + 1)

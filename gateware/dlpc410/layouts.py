@@ -60,7 +60,8 @@ class Status(data.Struct):
     row loads that waited for their data from the store (one each); ``bad_frames`` frames offered with
     a bit depth outside 1..8, dropped; ``held`` triggers held until every group was ready;
     ``rst_late`` RST_ACTIVE falls later than planned (the settle counted from the fall);
-    ``rst_faults`` RST_ACTIVE missing after a pulse or stuck high.
+    ``rst_faults`` RST_ACTIVE missing after a pulse or stuck high; ``restarts`` the controller
+    initialised again mid-run (INIT_ACTIVE high again or ECP2_FINISHED low).
     """
     now: TIME_BITS
     frames: COUNTER_BITS
@@ -73,3 +74,4 @@ class Status(data.Struct):
     held: COUNTER_BITS
     rst_late: COUNTER_BITS
     rst_faults: COUNTER_BITS
+    restarts: COUNTER_BITS

@@ -65,10 +65,11 @@ class Planner(wiring.Component):
     start : In(event(slot, depth, take))
         Every group begins the frame ``slot`` of ``depth`` planes at its first plane; ``take``:
         that frame is the one offered, taken now.
-    retake : In(event(newer, lead))
+    retake : In(event(newer, abandon, lead))
         A newer frame (``newer``: the one offered, taken now) or the same frame under new
         registers replaces what every group holds; each group's memory may change no sooner than
-        ``lead``.
+        ``lead``. ``abandon`` (the controller restarted): every group also leaves the frame it
+        was playing and waits at its first plane.
     trigger : In(event(TIME_BITS))
         A trigger obeyed: group ``g``'s first pulse falls due at ``payload + g * stagger``.
     queue_first : In(event(group))
@@ -111,7 +112,7 @@ class Planner(wiring.Component):
             "pulse": In(event(gb)),
             "loaded": In(event(gb)),
             "start": In(event(data.StructLayout({"slot": SLOT_BITS, "depth": 4, "take": 1}))),
-            "retake": In(event(data.StructLayout({"newer": 1, "lead": TIME_BITS}))),
+            "retake": In(event(data.StructLayout({"newer": 1, "abandon": 1, "lead": TIME_BITS}))),
             "trigger": In(event(TIME_BITS)),
             "queue_first": In(event(gb)),
             "jobs": Out(event(load_job(dmd))),
@@ -259,6 +260,10 @@ class Planner(wiring.Component):
             for g in range(G):
                 m.d.sync += [slot[g].eq(r_slot), depth[g].eq(r_depth), loaded[g].eq(0),
                              writable[g].eq(Mux(diff(writable[g], lead) < 0, lead, writable[g]))]
+                with m.If(self.retake.payload.abandon):
+                    m.d.sync += [pending[g].eq(0), pos[g].eq(0), dark[g].eq(0)]
+            with m.If(self.retake.payload.abandon):
+                m.d.sync += self.sync_out.eq(0)
         with m.If(self.trigger.valid):
             for g in range(G):
                 with m.If(active[g]):

@@ -228,6 +228,7 @@ class Sequencer(wiring.Component):
             self.status.late.eq(planner.late),
             self.status.rst_late.eq(planner.rst_late),
             self.status.rst_faults.eq(planner.rst_faults),
+            self.status.restarts.eq(init.restarts),
             self.status.bad_frames.eq(planner.bad_frames),
             self.status.triggers.eq(control.triggers),
             self.status.overruns.eq(control.overruns),

@@ -210,6 +210,7 @@ class Projector(wiring.Component):
                              ("triggers_held", seq.status.held),
                              ("rst_active_late", seq.status.rst_late),
                              ("rst_active_faults", seq.status.rst_faults),
+                             ("dlpc410_restarts", seq.status.restarts),
                              ("pulses_late", seq.status.late), ("row_underruns", seq.status.underruns),
                              ("frames_bad_depth", seq.status.bad_frames),
                              ("registers_applied", registers.applied)):

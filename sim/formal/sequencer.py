@@ -1,23 +1,22 @@
-"""The DLPC410 start-up rule as a formal property of the sequencer: no command during INIT_ACTIVE.
+"""The DLPC410 initialisation rule as a formal property of the sequencer: no command during INIT_ACTIVE.
 
 The top is :class:`gateware.dlpc410.sequencer.Sequencer` on :data:`DMD` (two buses, two DCLK
 cycles a row, two blocks of four rows) at one beat, every input free: registers, triggers, the
-store's frames, words and occupancy, and the controller's pins, but for ECP2_FINISHED and
-INIT_ACTIVE, which follow the controller's start-up (DLPC410 datasheet, DLPC910): once
-ECP2_FINISHED is high and INIT_ACTIVE low they stay so. INIT_ACTIVE rising again mid-run is a
-controller fault the sequencer does not handle yet (it keeps running), so it is left out.
+store's frames, words and occupancy, and the controller's pins, ECP2_FINISHED and INIT_ACTIVE
+included: the controller may start up, and initialise again mid-run, at any time.
 
-Property: the sequencer drives no command (ROWMD and BLKMD both no-op) until ECP2_FINISHED has
-been high and INIT_ACTIVE low at the pins for the two cycles of its synchroniser; before that
-only the training pattern is on DVALID and the data pins. White box, so that k-induction
-closes: the sequencer's ``running`` is high only once the pins have shown the controller ready.
+Property: the sequencer drives a command (ROWMD or BLKMD not no-op) only when ECP2_FINISHED was
+high and INIT_ACTIVE low at the pins three cycles earlier (the two cycles of its synchroniser and
+the register of ``running``: the soonest it can know); otherwise only the training pattern is on
+DVALID and the data pins. White box, so that k-induction closes: the sequencer's ``running`` is
+high exactly when the pins showed the controller ready three cycles earlier.
 """
 
 import dataclasses
 from contextlib import contextmanager
 
 from amaranth import Signal
-from amaranth.hdl import Assert, Assume, Fragment
+from amaranth.hdl import Assert, Fragment
 
 from spec.facts import TEST_DMD
 
@@ -55,16 +54,14 @@ def _no_command_during_init(running):
 
     def prop(m, top):
         pins = top.dut.pins
-        # ready at the pins (ECP2_FINISHED high, INIT_ACTIVE low), one and two cycles ago
+        # ready at the pins (ECP2_FINISHED high, INIT_ACTIVE low), one, two and three cycles ago
         ready = pins.ecp2_finished & ~pins.init_active
-        ready_1, ready_2 = Signal(), Signal()
-        m.d.sync += [ready_1.eq(ready), ready_2.eq(ready_1)]
-        # the controller's start-up: once ready, it stays ready
-        m.d.comb += Assume(~ready_1 | ready)
+        ready_1, ready_2, ready_3 = Signal(), Signal(), Signal()
+        m.d.sync += [ready_1.eq(ready), ready_2.eq(ready_1), ready_3.eq(ready_2)]
         command = (pins.rowmd != RowMode.NOOP) | (pins.blkmd != BlockMode.NOOP)
         m.d.comb += [
-            Assert(~command | ready_2, "a command before INIT_ACTIVE fell (or before ECP2_FINISHED)"),
-            Assert(~running | ready_2, "running before the controller was ready"),
+            Assert(~command | ready_3, "a command while INIT_ACTIVE was high (or ECP2_FINISHED low)"),
+            Assert(running == ready_3, "running other than the controller's state three cycles ago"),
         ]
 
     return prop

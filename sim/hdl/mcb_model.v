@@ -17,8 +17,13 @@
 // WORD_NS (a 64-bit word) times the port's width over 64; its words move at their times (writes leave the write FIFO, reads reach the read
 // FIFO READ_LATENCY_NS later), seen at the port's next clock edge. Every REFRESH_INTERVAL_NS the
 // memory is busy for REFRESH_NS after the command in progress. Commands are granted in the order
-// the ports' edges see them (the Python model: round robin). Not modelled: random stalls. Times
-// are $realtime, in ns with the 1 ns time unit the system build gives modules.
+// the ports' edges see them (the Python model: round robin). Times are $realtime, in ns with the
+// 1 ns time unit the system build gives modules.
+//
+// Stalls (plusargs, none by default): +mcb_stall_permille=N makes N in 1000 commands wait a
+// random time up to +mcb_stall_max_ns=T before their first word (bank conflicts, the other
+// port's turn), from a xorshift generator seeded by +mcb_stall_seed=S; the memory is busy for
+// everyone meanwhile. `stalls` counts them.
 //
 // Rule breaks (the Python model's McbError kinds) print a message and set the port's sticky
 // `fault` code: 1 before_calib, 2 cmd_full, 3 misaligned, 4 out_of_range, 5 data_missing,
@@ -57,7 +62,8 @@ module mcb_model #(
     output wire [PORTS-1:0]     rd_overflow,
     output wire [PORTS-1:0]     rd_error,
     output wire [PORTS-1:0]     calib_done,
-    output wire [4*PORTS-1:0]   fault
+    output wire [4*PORTS-1:0]   fault,
+    output wire [31:0]          stalls
 );
     // the ports write the one memory from their own clocks (behavioural, simulation only)
     /* verilator lint_off MULTIDRIVEN */
@@ -69,11 +75,32 @@ module mcb_model #(
     real free_at, refresh_at;
     /* verilator lint_on MULTIDRIVEN */
 
+    // random stalls (shared by the ports)
+    integer stall_permille, stall_max_ns, stall_seed;
+    /* verilator lint_off MULTIDRIVEN */
+    reg [31:0] rng, stall_count;
+    /* verilator lint_on MULTIDRIVEN */
+    assign stalls = stall_count;
+
+    function automatic [31:0] xorshift(input [31:0] x);
+        reg [31:0] y;
+        begin
+            y = x ^ (x << 13);
+            y = y ^ (y >> 17);
+            xorshift = y ^ (y << 5);
+        end
+    endfunction
+
     integer i;
     initial begin
         for (i = 0; i < WORDS; i = i + 1) mem[i] = 64'd0;
         free_at = 0.0;
         refresh_at = REFRESH_INTERVAL_NS;
+        if (!$value$plusargs("mcb_stall_permille=%d", stall_permille)) stall_permille = 0;
+        if (!$value$plusargs("mcb_stall_max_ns=%d", stall_max_ns)) stall_max_ns = 0;
+        if (!$value$plusargs("mcb_stall_seed=%d", stall_seed)) stall_seed = 1;
+        rng = stall_seed == 0 ? 32'd1 : stall_seed;
+        stall_count = 0;
     end
 
     genvar p;
@@ -193,6 +220,14 @@ module mcb_model #(
                 while (refresh_at <= next_word_at) begin
                     next_word_at = next_word_at + REFRESH_NS;
                     refresh_at = refresh_at + REFRESH_INTERVAL_NS;
+                end
+                if (stall_permille != 0) begin
+                    rng = xorshift(rng);
+                    if (rng % 1000 < stall_permille) begin
+                        rng = xorshift(rng);
+                        next_word_at = next_word_at + stall_max_ns * (rng % 1024) / 1024.0;
+                        stall_count = stall_count + 1;
+                    end
                 end
                 busy = c_instr[c_head] != 3'd4;
                 writing = !c_instr[c_head][0];

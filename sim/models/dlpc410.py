@@ -66,6 +66,13 @@ Assumptions where the TI documents are uncertain (see also ``docs/dlpc410_model.
   after INIT_ACTIVE falls, except that ``init_grace_cycles`` (default 0) lets the training
   pattern, DVALID included, run on for the FPGA's synchroniser latency. ARSTZ falling again
   resets memory, mirrors and pointer to zero.
+* A restart (a controller fault the tests inject: ``restart_at``): INIT_ACTIVE high again for
+  ``restart_cycles`` from that cycle, ECP2_FINISHED low for the first ``restart_ecp2_cycles`` of
+  them (the controller reconfigured). The DMD's memory, mirrors and row pointer go to zero and
+  the row cycle under way is lost. The FPGA sees INIT_ACTIVE a synchroniser later: for
+  ``restart_grace_cycles`` the pins are ignored; then the rules of initialisation hold as at
+  start-up (no command, the training pattern, DVALID low for ``init_to_dvalid_clocks`` after
+  INIT_ACTIVE falls).
 * Mirrors start at 0 (off). WDT_ENBLZ and PWR_FLOAT are not modelled.
 * DLP650LNIR (32 bits per DCLK, odd pins of A and B) is not modelled: the bit map for it is not
   in :mod:`gateware.dlpc410.beat`.
@@ -186,6 +193,8 @@ class Dlpc410:
         ``init_to_dvalid_clocks`` after the fall is a break from the first cycle.
     ecp2_cycles : int
         ECP2_FINISHED rises on this cycle.
+    restart_at, restart_cycles, restart_ecp2_cycles, restart_grace_cycles : int, optional
+        A restart mid-run (see the module's notes); ``restart_at`` None: none.
     strict_rst_active : bool
         No pulse at all while RST_ACTIVE is high (default), or only none of the same blocks.
     check_training : bool
@@ -212,7 +221,8 @@ class Dlpc410:
 
     def __init__(self, dmd, *, beats=1, clock_hz=200e6, rst_active_cycles=None, settle_cycles=None,
                  init_cycles=None, init_to_dvalid_clocks=None, init_grace_cycles=0, ecp2_cycles=4,
-                 strict_rst_active=True, check_training=True, keep_history=True, ddc_version=0):
+                 strict_rst_active=True, check_training=True, keep_history=True, ddc_version=0,
+                 restart_at=None, restart_cycles=0, restart_ecp2_cycles=0, restart_grace_cycles=4):
         if dmd.bits_per_dclk % 64:
             raise ValueError(f"{dmd.name}: {dmd.bits_per_dclk} bits per DCLK is not modelled")
         if dmd.dclk_per_row % beats:
@@ -229,6 +239,8 @@ class Dlpc410:
             setattr(self, key, facts[key] if value is None else value)
         self.init_grace_cycles = init_grace_cycles
         self.ecp2_cycles = ecp2_cycles
+        self.restart_at, self.restart_cycles = restart_at, restart_cycles
+        self.restart_ecp2_cycles, self.restart_grace_cycles = restart_ecp2_cycles, restart_grace_cycles
         self.strict_rst_active = strict_rst_active
         self.check_training = check_training
         self.keep_history = keep_history
@@ -253,19 +265,35 @@ class Dlpc410:
 
     def init_active(self, cycle=None):
         cycle = self.cycle if cycle is None else cycle
-        return self.init_end is None or cycle < self.init_end
+        return self.init_end is None or cycle < self.init_end or self._in_restart(cycle, 0, self.restart_cycles)
+
+    def _in_restart(self, cycle, begin, end):
+        """``cycle`` is between ``begin`` and ``end`` cycles after the restart began."""
+        return self.restart_at is not None and self.restart_at + begin <= cycle < self.restart_at + end
+
+    def _ignored(self, cycle):
+        """The first cycles of a restart: the FPGA cannot have seen INIT_ACTIVE yet."""
+        return self._in_restart(cycle, 0, self.restart_grace_cycles)
 
     def _initialising(self, cycle):
         """INIT_ACTIVE high, or within ``init_grace_cycles`` after it fell (the training
         pattern may still be on the pins while the FPGA's synchroniser catches up)."""
-        return self.init_end is None or cycle < self.init_end + self.init_grace_cycles
+        return (self.init_end is None or cycle < self.init_end + self.init_grace_cycles
+                or self._in_restart(cycle, 0, self.restart_cycles + self.init_grace_cycles))
+
+    def _init_fell(self, cycle):
+        """The cycle INIT_ACTIVE fell last, up to ``cycle``."""
+        if self.restart_at is not None and cycle >= self.restart_at + self.restart_cycles:
+            return self.restart_at + self.restart_cycles
+        return self.init_end
 
     def outputs(self):
         """The controller's outputs on the current cycle."""
         return {
             "init_active": int(self.init_active()),
             "rst_active": int(self.cycle <= self._rst_until),
-            "ecp2_finished": int(self.cycle >= self.ecp2_cycles),
+            "ecp2_finished": int(self.cycle >= self.ecp2_cycles
+                                 and not self._in_restart(self.cycle, 0, self.restart_ecp2_cycles)),
             "dmd_type": 0b1111 if self.dmd.dmd_type_code is None else self.dmd.dmd_type_code,
             "ddc_version": self.ddc_version,
         }
@@ -277,7 +305,11 @@ class Dlpc410:
         c = self.cycle
         s = signals
         self._track_arstz(c, s.get("arstz", 0))
-        if self._initialising(c):
+        if c == self.restart_at:
+            self._restart(c)
+        if self._ignored(c):
+            pass
+        elif self._initialising(c):
             self._init_cycle(c, s)
         else:
             self._framing(c, s)
@@ -289,19 +321,25 @@ class Dlpc410:
         :meth:`step` each time, faster once nothing but the idle gap can change."""
         s = {"arstz": 1} if signals is None else signals
         assert not s.get("dvalid", 0), "idle() is for DVALID low"
-        while count and (self._arstz != s.get("arstz", 0) or self._initialising(self.cycle) or self._row):
-            self.step(s)
-            count -= 1
-        if count:
+        while count:
+            c = self.cycle
+            if (self._arstz != s.get("arstz", 0) or self._initialising(c) or self._row
+                    or c == self.restart_at or self._ignored(c)):
+                self.step(s)
+                count -= 1
+                continue
+            n = count if self.restart_at is None or c > self.restart_at else min(count, self.restart_at - c)
             if self._gap is not None:
-                self._gap += count * self.beats
-            self.cycle += count
+                self._gap += n * self.beats
+            self.cycle += n
+            count -= n
         return self.outputs()
 
     def quiet(self):
         """True when a DVALID-low cycle with ARSTZ high can only lengthen the idle gap (past
         initialisation, no row cycle open): adapters then need read nothing else."""
-        return bool(self._arstz) and not self._initialising(self.cycle) and self._row is None
+        return (bool(self._arstz) and not self._initialising(self.cycle) and self._row is None
+                and self.cycle != self.restart_at and not self._ignored(self.cycle))
 
     def quiet_outputs_until(self):
         """The first cycle after this one whose outputs differ from this cycle's if only idle
@@ -309,6 +347,9 @@ class Dlpc410:
         changes = [self._rst_until + 1 if self.cycle <= self._rst_until else None,
                    self.ecp2_cycles if self.cycle < self.ecp2_cycles else None,
                    self.init_end if self.init_end is not None and self.cycle < self.init_end else None]
+        if self.restart_at is not None:
+            changes += [c for c in (self.restart_at, self.restart_at + self.restart_ecp2_cycles,
+                                    self.restart_at + self.restart_cycles) if c > self.cycle]
         return min((c for c in changes if c is not None), default=None)
 
     def run(self, items):
@@ -335,13 +376,17 @@ class Dlpc410:
             self.init_end = max(c, self.ecp2_cycles) + self.init_cycles
         elif not arstz and self._arstz:
             self.arstz_rise = self.init_end = None
-            self.memory[:] = 0
-            self.mirrors[:] = 0
-            for b in range(self.dmd.blocks):
-                self._record_state(c, b)
-            self._reset_controller()
-            self._edges = []
+            self._restart(c)
         self._arstz = arstz
+
+    def _restart(self, c):
+        """ARSTZ fell, or the controller initialises again: the DMD's state is lost."""
+        self.memory[:] = 0
+        self.mirrors[:] = 0
+        for b in range(self.dmd.blocks):
+            self._record_state(c, b)
+        self._reset_controller()
+        self._edges = []
 
     def _init_cycle(self, c, s):
         rowmd, blkmd = s.get("rowmd", 0), s.get("blkmd", 0)
@@ -402,10 +447,10 @@ class Dlpc410:
                 self._gap = 0
 
     def _start_row(self, c, s):
-        earliest = self.init_end + self.init_to_dvalid_clocks
-        if c < earliest:
+        fell = self._init_fell(c)
+        if c < fell + self.init_to_dvalid_clocks:
             raise RuleBreak(RULES["init_dvalid"], c,
-                            f"DVALID high {c - self.init_end} clocks after INIT_ACTIVE fell, "
+                            f"DVALID high {c - fell} clocks after INIT_ACTIVE fell, "
                             f"needs {self.init_to_dvalid_clocks}")
         if self._gap is not None and self._gap % 2:
             raise RuleBreak(RULES["dvalid_gap"], c, f"DVALID low for {self._gap} cycles, must be even")

@@ -131,6 +131,7 @@ async def stream_frames(dut):
     await ClockCycles(dut.dmd_clk, 2)
     dut.flush.value = 0
     run.check_memory()
+    run.events["mcb_stalls"] = int(dut.mcb_stalls.value)
     run.events["sim_ns"] = run.now_ns()
     run.events["wall_s"] = time.monotonic() - run.wall0
     Path(p["report"]).write_text(json.dumps(run.events))
