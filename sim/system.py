@@ -11,8 +11,11 @@ in Python per cycle and cocotbext-style GMII from Python: the end-to-end test of
 """
 
 import json
+import math
 import time
 from pathlib import Path
+
+from vcd.gtkw import GTKWSave
 
 from gateware.top.system import Projector
 from sim import xga
@@ -138,9 +141,11 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None):
     print(f"pin check and camera: {r['check_wall_s']:.0f} s over {r['trace_records']} trace records; "
           f"wall time {time.monotonic() - t0:.0f} s including the Verilator build")
     vcd = Path(r["waves"])
-    print(f"waves: {vcd} (DLPC410 pins, trigger, sync and camera outputs from the first trigger "
-          f"through the first planes, written from the pin trace; the full design is not dumped at XGA)\n"
-          f"  GTKWave save file: {write_save_file(vcd, PIN_GROUPS, 'dlpc410')}")
+    save = write_save_file(vcd, PIN_GROUPS, "dlpc410", widths=r["waves_fields"], view=r["waves_view"],
+                           markers=r["waves_markers"])
+    print(f"waves: {vcd} (DLPC410 pins, trigger, sync and camera outputs of the first frame triggered, "
+          f"written from the pin trace; the full design is not dumped at XGA)\n"
+          f"  GTKWave save file: {save} (opens on the trigger; markers A trigger, B first pulse, C last pulse)")
     exact = all(f["max_error_lsb"] == 0 for f in shown) and len(shown) == XGA_ONE_BY_ONE + XGA_BACK_TO_BACK
     return 0 if exact else 1
 
@@ -164,17 +169,35 @@ SAVE_GROUPS = {
 #: The pin trace's fields by what they are, for the XGA run's save file.
 PIN_GROUPS = {
     "trigger, sync and camera": ["trigger_in", "sync_out", "camera_out"],
-    "DLPC410 commands": ["dvalid", "rowmd[1:0]", "rowad[10:0]", "blkmd[1:0]", "blkad[3:0]", "rst2blkz"],
-    "DLPC410 data": ["din_a[31:0]", "din_b[31:0]"],
+    "DLPC410 commands": ["dvalid", "rowmd", "rowad", "blkmd", "blkad", "rst2blkz"],
+    "DLPC410 data": ["din_a", "din_b"],
     "DLPC410 state": ["arstz", "init_active", "rst_active", "ecp2_finished"],
 }
 
 
-def write_save_file(vcd, groups=None, scope="projector"):
-    lines = [f'[dumpfile] "{vcd}"', "[timestart] 0"]
-    for group, signals in (groups or SAVE_GROUPS).items():
-        lines += [f"-{group}", "@28"]
-        lines += [f"{scope}.{name}" for name in signals]
+def write_save_file(vcd, groups=None, scope="projector", *, widths=None, view=None, markers=None):
+    """A GTKWave save file beside ``vcd``: ``groups`` of signals (``widths``: ``{name: bits}``
+    to name them as GTKWave does, ``name[n-1:0]``), buses in hex; ``view``: ``(start, end)`` the
+    window it opens on, ``markers``: ``{name: time}`` named markers A, B, .. (VCD time units)."""
+    def label(name):
+        bits = (widths or {}).get(name, 1)
+        return f"{name}[{bits - 1}:0]" if bits > 1 else name
     path = vcd.with_suffix(".gtkw")
-    path.write_text("\n".join(lines) + "\n")
+    named = list((markers or {}).items())
+    with open(path, "w") as f:
+        save = GTKWSave(f)
+        save.dumpfile(str(vcd))
+        save.savefile(str(path))
+        if view is not None:
+            save.timestart(view[0])
+        # GTKWave's zoom is a power of two of time units per pixel: fit ``view`` in ~1200 pixels
+        zoom = -math.log2(max(1, view[1] - view[0]) / 1200) if view is not None else 0.0
+        save.zoom_markers(zoom, named[0][1] if named else -1,
+                          **{chr(ord("a") + k): t for k, (_name, t) in enumerate(named)})
+        for k, (name, _t) in enumerate(named):
+            f.write(f"[markername] {chr(ord('A') + k)}{name}\n")
+        for group, signals in (groups or SAVE_GROUPS).items():
+            with save.group(group):
+                for name in signals:
+                    save.trace(f"{scope}.{label(name)}" if widths else f"{scope}.{name}", datafmt="hex")
     return path

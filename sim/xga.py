@@ -63,8 +63,10 @@ TOPLEVEL = "fast_system"
 _STALLS = {"mcb_stall_permille": 50, "mcb_stall_max_ns": 2000, "mcb_stall_seed": 7}
 _RST = {"dlpc410_rst_extra": 91}
 FAULTS = {"stalls": _STALLS, "rst": _RST, "all": {**_STALLS, **_RST}}
-#: Cycles before and after the first trigger that the VCD of the pins covers.
-WAVE_WINDOW = (1000, 40000)
+#: The VCD of the pins covers the first triggered frame, from this many cycles before its trigger
+#: to this many after its last pulse; its save file opens on this many cycles from the trigger.
+WAVE_WINDOW = (1000, 2000)
+WAVE_VIEW = 3000
 
 
 def plan(dclk_hz=DCLK_HZ):
@@ -220,11 +222,13 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
     assert faults or starts == want, f"back-to-back frame starts {starts}, the schedule model's {want}"
     periods = [b - a for a, b in zip(starts, starts[1:], strict=False)]
     status = _status(trace.read(files["tx"]))
-    waves = None
+    waves, start = None, triggers[0] - WAVE_WINDOW[0]
+
+    def ps(cycle):
+        return round((cycle - start) * 1e12 / DMD_HZ)
     if triggers:
         waves = trace.write_vcd(Path(files["pins"]).with_suffix(".vcd"), pins, layout,
-                                start=triggers[0] - WAVE_WINDOW[0], end=triggers[0] + WAVE_WINDOW[1],
-                                ns_per_cycle=1e9 / DMD_HZ)
+                                start=start, end=frames[0][1] + WAVE_WINDOW[1], ns_per_cycle=1e9 / DMD_HZ)
     sends = stimulus["sends"]
     first_frame = sends[1]
     return {
@@ -247,6 +251,11 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
         "xga_frame_sim_wall_s": stimulus["wall"]["first_frame_last_pulse"] - first_frame["wall_start"],
         "trace_records": len(pins),
         "waves": str(waves),
+        # the save file's view and named markers (ps in the VCD), the VCD's fields and widths
+        "waves_view": (ps(triggers[0] - WAVE_WINDOW[0] // 4), ps(triggers[0] + WAVE_VIEW)),
+        "waves_markers": {"trigger": ps(triggers[0]), "first pulse": ps(frames[0][0]),
+                          "last pulse": ps(frames[0][1])},
+        "waves_fields": {name: mask.bit_length() for name, _, mask in trace.fields(layout)},
         "check_wall_s": time.monotonic() - t0,
         "build": str(build) if build else None,
     }

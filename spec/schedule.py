@@ -39,9 +39,11 @@ first pulse is then at ``even(s + 1) + g * stagger``; otherwise it is counted as
 Frames: group 0 takes the next offered frame when its last pulse of a frame is made (else the
 frame repeats). Triggered and not chained, a frame offered while no group plays (every group
 has made its frame's last pulse) is taken at once: every group's first plane is loaded again
-from it, no sooner than ``reload_lead`` cycles later (the store's first words); a trigger before
-that load ends is an overrun, so a trigger never shows an older frame than the newest complete
-one it could show. If the first planes of the frame before were still being loaded (a frame
+from it, no sooner than ``reload_lead`` cycles later (the store's first words), unless the
+triggers come at a steady pace and the next one is due before such a reload could end
+(:func:`reload_bound`): then the newer frame waits for the trigger after, and no trigger is
+delayed by it. A trigger before the load ends is held (``trigger_hold``) or an overrun. If the
+first planes of the frame before were still being loaded (a frame
 completed late, just after the last pulse), those loads are abandoned: the row cycle on the bus
 ends, the queued loads are dropped, the words already asked of the store are discarded, and
 the new loads start no sooner than ``reload_lead + flush_rows * row_period`` cycles later (nor
@@ -63,7 +65,7 @@ from .registers import PlaneOrder, ResetMode, Source, TriggerMode, group_size
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate", "FABRIC_HZ",
            "beats_at", "row_cycles",
            "plan", "bound", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS", "flush_rows",
-           "RST_MARGIN", "even", "ready_cycle"]
+           "RST_MARGIN", "even", "ready_cycle", "reload_bound"]
 
 #: The ``dmd`` domain's clock: every cycle count of the model and the sequencer is in its cycles.
 #: DCLK is this (one beat per cycle) or twice this (two beats per cycle: 400 MHz through the
@@ -288,6 +290,11 @@ class _Model:
         self.t = 0
         self.holding = False                # a trigger held until every group is ready
         self.idle_take = not p.chain and p.source != Source.PRNG
+        # the trigger's pace (the guard of take_while_waiting): the periodic timer's is known
+        # from the start (its first strobe comes ``period - 1`` cycles in), a pin's after two
+        periodic = p.trigger == TriggerMode.PERIODIC
+        self.last_strobe, self.interval = (-1, p.period) if periodic else (None, 0)
+        self.reload_bound = reload_bound(dmd, p)
 
     # -- the planner -------------------------------------------------------------------------
 
@@ -350,6 +357,24 @@ class _Model:
             self.st[g].pos = ("plane", fi, 0)
             self.enqueue(g, fi, 0)
 
+    def fits(self, t):
+        """A newer frame may replace the waiting one at ``t`` unless the triggers come at a steady
+        pace (the periodic timer's, or the last two ``interval`` apart) and the next one is due
+        before a reload could end (:func:`reload_bound`): that trigger is not delayed, the newer
+        frame is shown at the one after. Once the next trigger is an eighth of an interval
+        overdue, the pace counts as broken."""
+        if not self.interval:
+            return True
+        due = self.last_strobe + self.interval
+        return t > due + (self.interval >> 3) or t + self.reload_bound < due
+
+    def fits_from(self, t):
+        """The first cycle from ``t`` on at which :meth:`fits` holds (it only grows more
+        likely once the next trigger is overdue)."""
+        if self.fits(t):
+            return t
+        return self.last_strobe + self.interval + (self.interval >> 3) + 1
+
     def take_while_waiting(self, t):
         """A newer frame offered while no group plays: load its first plane, abandoning the
         stale loads still queued (their words are discarded for ``flush_rows`` row periods)."""
@@ -379,6 +404,9 @@ class _Model:
     def strobe(self, s_t):
         """A trigger strobe at ``s_t`` (reads the state before this cycle's decision): obeyed,
         held (``trigger_hold``, one at a time) or an overrun."""
+        if self.last_strobe is not None and self.p.trigger != TriggerMode.PERIODIC:
+            self.interval = s_t - self.last_strobe
+        self.last_strobe = s_t
         if self.waiting(s_t):
             self.obey(s_t)
         elif self.p.trigger_hold and not self.holding:
@@ -455,7 +483,7 @@ class _Model:
         nxt = self.frames.offer()
         take_at = None
         if self.idle_take and nxt is not None and not self.playing() and not self.frames.offered[nxt[0]].sequence:
-            take_at = max(nxt[1], self.queued_at, t + 1)
+            take_at = self.fits_from(max(nxt[1], self.queued_at, t + 1))
             cands.append(take_at)
         hold_at = None
         if self.holding and self.ready_at() is not None:
@@ -478,7 +506,7 @@ class _Model:
             t = self.t
             nxt = self.frames.offer()
             take_now = (self.idle_take and nxt is not None and nxt[1] <= t and t >= self.queued_at
-                        and not self.playing() and not self.frames.offered[nxt[0]].sequence)
+                        and not self.playing() and not self.frames.offered[nxt[0]].sequence and self.fits(t))
             if t % 2 == 0 and t >= self.bus_free and self.decide(t):
                 if max_frames is not None and len(self.res.frame_starts) > max_frames:
                     break
@@ -719,6 +747,15 @@ def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
             if tries == 4:
                 break
     return best
+
+
+def reload_bound(dmd, p):
+    """Cycles a newer frame taken while the groups wait may need before every group is loaded
+    again, at most: the flush of stale words, the reload lead, queueing the first planes, every
+    row of the first planes at the row period, and a row cycle's slack for the bus's parity."""
+    R = row_cycles(dmd, p.beats)
+    rp = max(p.row_period, R)
+    return flush_rows(dmd) * rp + p.reload_lead + dmd.blocks + 1 + dmd.rows * rp + 2 * R
 
 
 def ready_cycle(dmd, p, fr):

@@ -81,6 +81,23 @@ def test_rising_edges_and_vcd(tmp_path):
     assert [line for line in vcd.splitlines() if line.startswith("#")] == ["#0", "#5000", "#25000", "#80000"]
 
 
+def test_save_file_opens_on_the_markers(tmp_path):
+    """The XGA run's GTKWave save file: it opens on the given window (zoomed to fit it), with
+    named markers, buses named with their widths as GTKWave names them, in hex."""
+    from sim.system import write_save_file
+    records = [(0, pack(LAYOUT, {"trigger_in": 0})), (5, pack(LAYOUT, {"trigger_in": 1}))]
+    vcd = trace.write_vcd(tmp_path / "w.vcd", records, LAYOUT, start=0, end=10, ns_per_cycle=5)
+    save = write_save_file(vcd, {"pins": ["trigger_in", "rowad"]}, "dlpc410", widths={"trigger_in": 1, "rowad": 11},
+                           view=(1000, 1000 + 1200 * 64), markers={"trigger": 25000, "first pulse": 40000})
+    text = save.read_text().splitlines()
+    assert "[timestart] 1000" in text
+    zoom, primary, *named = next(line for line in text if line.startswith("*"))[1:].split()
+    assert float(zoom) == -6 and primary == "25000" and named[:3] == ["25000", "40000", "-1"] and len(named) == 26
+    assert "[markername] Atrigger" in text and "[markername] Bfirst pulse" in text
+    assert "dlpc410.rowad[10:0]" in text and "dlpc410.trigger_in" in text
+    assert "@22" in text[:text.index("dlpc410.trigger_in")]         # hex, right-justified, for both
+
+
 def test_gmii_frames_from_a_transmit_trace():
     frames = [bytes(range(60)), bytes(range(100, 180))]
     records, cycle = [(0, 0)], 3

@@ -5,8 +5,12 @@ plane, ``RUN``; a newer frame offered while no group plays (or new registers at 
 once and every group's first plane loaded again from it (``RELOAD``), after ``FLUSH`` when stale
 loads were under way: they are dropped, the words already asked of the store discarded, and the
 new loads start exactly ``flush_rows * row_period`` cycles after the frame was taken (the
-schedule model uses the same time). A trigger is obeyed when every group is loaded and waits;
-otherwise it is an overrun (or early, before the groups run).
+schedule model uses the same time). A newer frame does not delay a trigger: while the triggers
+come at a steady pace (the last two an interval apart, the next not yet an eighth of an interval
+overdue), it replaces the waiting frame only if the reload ends before the next trigger is due
+(:func:`spec.schedule.reload_bound`), else it is shown at the trigger after. A trigger is obeyed
+when every group is loaded and waits; otherwise it is an overrun (or early, before the groups
+run).
 
 A controller that initialises again (``initialised`` falls: INIT_ACTIVE high again, or
 ECP2_FINISHED low) has lost the DMD's memory: ``RESTART`` stops every pulse and load, drops the
@@ -19,9 +23,9 @@ from amaranth import Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from spec.schedule import INIT_TO_DVALID, flush_rows
+from spec.schedule import INIT_TO_DVALID, flush_rows, row_cycles
 
-from ..registers import DURATION_BITS, TIME_BITS, Registers, Source
+from ..registers import DURATION_BITS, TIME_BITS, Registers, Source, TriggerMode
 from ..store.layouts import SLOT_BITS
 from .layouts import COUNTER_BITS, event, group_bits
 from .planner import Offer
@@ -36,6 +40,8 @@ class FrameControl(wiring.Component):
     Parameters
     ----------
     dmd : :class:`spec.facts.DmdType`
+    beats : int
+        DCLK beats per cycle (a row cycle's length in cycles).
 
     Members
     -------
@@ -69,8 +75,8 @@ class FrameControl(wiring.Component):
         restarts); held until every group was ready (``trigger_hold``).
     """
 
-    def __init__(self, dmd):
-        self._dmd = dmd
+    def __init__(self, dmd, *, beats=1):
+        self._dmd, self._beats = dmd, beats
         gb = group_bits(dmd)
         super().__init__({
             "regs": In(Registers),
@@ -163,7 +169,7 @@ class FrameControl(wiring.Component):
         newer = ~use_prng & ~regs.chain & self.offer.valid & ~self.offer.sequence
         idle = fsm.ongoing("RUN") & ~self.playing
         resting = fsm.ongoing("RUN") & self.all_ready
-        m.d.comb += [take_idle.eq((idle & newer) | (resting & self.reload)),
+        m.d.comb += [take_idle.eq((idle & newer & self._fits(m)) | (resting & self.reload)),
                      self.at_rest.eq(fsm.ongoing("WAIT") | resting)]
         with m.If(take_idle):
             wait = Mux(self.all_ready, 0, flush_cycles)
@@ -201,3 +207,30 @@ class FrameControl(wiring.Component):
             with m.Else():
                 m.d.sync += self.overruns.eq(self.overruns + 1)
         return m
+
+    def _fits(self, m):
+        """A newer frame may replace the waiting one now (:meth:`spec.schedule._Model.fits`):
+        the triggers keep no steady pace, or the next one is overdue, or a reload ends first."""
+        # (a pin's ``last`` starts at -1 too, unused until ``measured`` is set)
+        dmd, regs, now = self._dmd, self.regs, self.now
+        # the periodic timer's pace is known from the start (its first strobe comes
+        # ``period - 1`` cycles in), a pin's after two strobes
+        last, measured = Signal(TIME_BITS, init=2**TIME_BITS - 1), Signal(TIME_BITS)
+        seen = Signal()
+        with m.If(self.strobe & self.running):
+            m.d.sync += [last.eq(now), seen.eq(1)]
+            with m.If(seen):
+                m.d.sync += measured.eq(now - last)
+        interval = Signal(TIME_BITS)
+        m.d.comb += interval.eq(Mux(regs.trigger == TriggerMode.PERIODIC, regs.period, measured))
+        R = row_cycles(dmd, self._beats)
+        row_period = Signal(DURATION_BITS)
+        bound = Signal(TIME_BITS)
+        m.d.comb += [
+            row_period.eq(Mux(regs.row_period > R, regs.row_period, R)),
+            bound.eq((flush_rows(dmd) + dmd.rows) * row_period + regs.reload_lead + dmd.blocks + 1 + 2 * R),
+        ]
+        due = last + interval
+        fits = Signal()
+        m.d.comb += fits.eq((interval == 0) | (diff(now, due + (interval >> 3)) > 0) | (diff(due, now + bound) > 0))
+        return fits

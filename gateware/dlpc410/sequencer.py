@@ -135,7 +135,7 @@ class Sequencer(wiring.Component):
         m.submodules.init = init = Init()
         m.submodules.trigger = trig = Trigger()
         m.submodules.planner = planner = Planner(dmd, beats=beats)
-        m.submodules.control = control = FrameControl(dmd)
+        m.submodules.control = control = FrameControl(dmd, beats=beats)
         m.submodules.jobs = jobs = Queue(load_job(dmd), depth=G + 1)
         m.submodules.requester = requester = Requester(dmd)
         m.submodules.loads = loads = Queue(ready_load(dmd), depth=G + 1)
