@@ -114,9 +114,20 @@ class Through(wiring.Component):
 
 def test_sequencer_init_rule(monkeypatch):
     from gateware.dlpc410 import init
-    check, = sequencer.sequencer_checks()
+    check, _ = sequencer.sequencer_checks()
     assert run(check).status == "proven"
     monkeypatch.setattr(init, "FFSynchronizer", Through)
     with pytest.raises(FormalFailure) as failure:
         run(dataclasses.replace(check, block="Sequencer-unsynchronised"))
     assert "running other than the controller's state three cycles ago" in failure.value.result.failed
+
+
+def test_sequencer_rst_active_rule():
+    """Proven; and not vacuous: claimed one cycle sooner than the synchroniser allows, it fails
+    (a pulse is reached with RST_ACTIVE rising just before it)."""
+    _, check = sequencer.sequencer_checks()
+    assert run(check).status == "proven"
+    with pytest.raises(FormalFailure) as failure:
+        run(dataclasses.replace(check, block="Sequencer-rst-one-cycle", induction=None,
+                                build=lambda: sequencer.rst_top(latency=1, init_to_dvalid=2)), depth=24)
+    assert "a clocking pulse while RST_ACTIVE was high" in failure.value.result.failed

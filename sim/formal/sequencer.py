@@ -1,15 +1,22 @@
-"""The DLPC410 initialisation rule as a formal property of the sequencer: no command during INIT_ACTIVE.
+"""The DLPC410's rules as formal properties of the sequencer: no command during INIT_ACTIVE, no
+clocking pulse while RST_ACTIVE is high.
 
 The top is :class:`gateware.dlpc410.sequencer.Sequencer` on :data:`DMD` (two buses, two DCLK
 cycles a row, two blocks of four rows) at one beat, every input free: registers, triggers, the
-store's frames, words and occupancy, and the controller's pins, ECP2_FINISHED and INIT_ACTIVE
-included: the controller may start up, and initialise again mid-run, at any time.
+store's frames, words and occupancy, and the controller's pins, ECP2_FINISHED, INIT_ACTIVE and
+RST_ACTIVE included: the controller may start up, initialise again mid-run, and raise or drop
+RST_ACTIVE at any time.
 
-Property: the sequencer drives a command (ROWMD or BLKMD not no-op) only when ECP2_FINISHED was
-high and INIT_ACTIVE low at the pins three cycles earlier (the two cycles of its synchroniser and
-the register of ``running``: the soonest it can know); otherwise only the training pattern is on
-DVALID and the data pins. White box, so that k-induction closes: the sequencer's ``running`` is
-high exactly when the pins showed the controller ready three cycles earlier.
+Properties, white box so that k-induction closes (a part's signal is copied out while the
+sequencer is elaborated):
+
+* the sequencer drives a command (ROWMD or BLKMD not no-op) only when ECP2_FINISHED was high and
+  INIT_ACTIVE low at the pins three cycles earlier (the two cycles of its synchroniser and the
+  register of ``running``: the soonest it can know); otherwise only the training pattern is on
+  DVALID and the data pins. ``running`` is high exactly when the pins showed the controller
+  ready three cycles earlier;
+* the bus decides a clocking pulse (on the pins the next cycle) only when RST_ACTIVE was low at
+  the pins two cycles earlier (its synchroniser), in the strict and the loose reading alike.
 """
 
 import dataclasses
@@ -22,7 +29,7 @@ from spec.facts import TEST_DMD
 
 from .harness import Check, FormalTop
 
-__all__ = ["sequencer_checks", "DMD"]
+__all__ = ["sequencer_checks", "rst_top", "DMD"]
 
 #: Two words a row on two buses (two DCLK cycles a row at one beat, the fewest the sequencer
 #: takes), eight rows in two blocks: the smallest geometry the sequencer builds for.
@@ -30,23 +37,27 @@ DMD = dataclasses.replace(TEST_DMD, name="formal 128x8", rows=8, blocks=2, rows_
 
 
 @contextmanager
-def _watched_init(running):
-    """While the sequencer is elaborated, its start-up part copies ``running`` out to the
-    property (the part is made inside the sequencer's ``elaborate``)."""
+def _watched(part, member, out):
+    """While the sequencer is elaborated, its part ``part`` (a class name in
+    :mod:`gateware.dlpc410.sequencer`, made inside the sequencer's ``elaborate``) copies its
+    member ``member`` (dotted: ``"pulse.valid"``) out to ``out``, for a property."""
     from gateware.dlpc410 import sequencer
-    original = sequencer.Init
+    original = getattr(sequencer, part)
 
-    class WatchedInit(original):
+    class Watched(original):
         def elaborate(self, platform):
             m = super().elaborate(platform)
-            m.d.comb += running.eq(self.running)
+            value = self
+            for name in member.split("."):
+                value = getattr(value, name)
+            m.d.comb += out.eq(value)
             return m
 
-    sequencer.Init = WatchedInit
+    setattr(sequencer, part, Watched)
     try:
         yield
     finally:
-        sequencer.Init = original
+        setattr(sequencer, part, original)
 
 
 def _no_command_during_init(running):
@@ -67,13 +78,45 @@ def _no_command_during_init(running):
     return prop
 
 
-def _top():
+def _no_pulse_while_rst_active(pulse, latency):
+    def prop(m, top):
+        seen = top.dut.pins.rst_active
+        for k in range(latency):
+            later = Signal(name=f"rst_{k + 1}")
+            m.d.sync += later.eq(seen)
+            seen = later
+        m.d.comb += Assert(~pulse | ~seen, "a clocking pulse while RST_ACTIVE was high")
+
+    return prop
+
+
+def _init_top():
     from gateware.dlpc410.sequencer import Sequencer
     running = Signal()
-    with _watched_init(running):
+    with _watched("Init", "running", running):
         top = FormalTop(Sequencer(DMD, beats=1, store_words=1), [_no_command_during_init(running)])
         return Fragment.get(top, None)
 
 
+def rst_top(latency=2, init_to_dvalid=None):
+    """The RST_ACTIVE property's top; ``latency``: cycles from the pins to the decision it allows
+    (the synchroniser's two; one is too few, and the check must then fail). ``init_to_dvalid``:
+    a shorter wait before the first load than the facts' 64 clocks, so that a bounded check
+    reaches a pulse within a few tens of steps (15 with 2)."""
+    from gateware.dlpc410 import planner
+    from gateware.dlpc410.sequencer import Sequencer
+    pulse = Signal()
+    original = planner.INIT_TO_DVALID
+    planner.INIT_TO_DVALID = original if init_to_dvalid is None else init_to_dvalid
+    try:
+        with _watched("Bus", "pulse.valid", pulse):
+            top = FormalTop(Sequencer(DMD, beats=1, store_words=1), [_no_pulse_while_rst_active(pulse, latency)])
+            return Fragment.get(top, None)
+    finally:
+        planner.INIT_TO_DVALID = original
+
+
 def sequencer_checks():
-    return [Check("no command during INIT_ACTIVE", "Sequencer", _top, depth=12, induction=4, quick=4)]
+    return [Check("no command during INIT_ACTIVE", "Sequencer", _init_top, depth=12, induction=4, quick=4),
+            Check("no clocking pulse while RST_ACTIVE is high", "Sequencer", rst_top, depth=12, induction=4,
+                  quick=4)]
