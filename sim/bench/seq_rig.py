@@ -47,7 +47,36 @@ def run():
         figures[f"seq_rig.build_s_{name}"] = (first - second, "s")
         figures[f"seq_rig.sim_cycles_per_s_{name}"] = (again.report["cycles"] / again.report["wall_s"], "dmd cycle/s")
         figures[f"seq_rig.run_cycles_per_s_{name}"] = (again.report["cycles"] / second, "dmd cycle/s")
+    figures.update(trigger_pace())
     return figures
+
+
+def trigger_pace(frames=16, seed=5):
+    """A periodic trigger exactly at the back-to-back frame rate on the test DMD (the rig: the
+    generated Verilog), newer frames completing at random phases of it (seeded): triggers lost
+    (overruns) and delayed (held) on the gateware; the same run in the schedule model without the
+    rule that a newer frame never delays a steady trigger, for comparison (``_model``)."""
+    import numpy as np
+
+    from spec.registers import TriggerMode
+    plan = schedule.plan(TEST_DMD, 200e6, depth=3, t_rst_s=20 / 200e6, t_settle_s=30 / 200e6)
+    p = plan.params
+    p.trigger, p.trigger_hold, p.period = TriggerMode.PERIODIC, True, plan.frame_cycles
+    rng = np.random.default_rng(seed)
+    offered = [(0, 3, 0)] + [(k % 2, 3, int((k + rng.random()) * p.period)) for k in range(1, frames)]
+    strobes = [k * p.period - 1 for k in range(1, frames)]
+    until = strobes[-1] + p.period // 2
+    run = run_rig(TEST_DMD, p, offered, cycles=until, name="bench_trigger_pace")
+    unguarded = schedule._Model(TEST_DMD, p, [schedule.Frame(s, d, None, r) for s, d, r in offered], strobes)
+    unguarded.fits = lambda t: True
+    before = unguarded.run(until=until)
+    return {
+        "seq.triggers_at_frame_rate": (len(strobes), "trigger"),
+        "seq.triggers_lost_at_frame_rate": (len(strobes) - run.status["triggers"], "trigger"),
+        "seq.triggers_delayed_at_frame_rate": (run.status["held"], "trigger"),
+        "seq.triggers_lost_at_frame_rate_unguarded_model": (before.overruns, "trigger"),
+        "seq.triggers_delayed_at_frame_rate_unguarded_model": (before.held, "trigger"),
+    }
 
 
 if __name__ == "__main__":

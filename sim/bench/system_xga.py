@@ -24,4 +24,26 @@ def run():
         "sys.xga_trigger_latency_cycles": (typical, "cycle"),
         "sys.xga_trigger_latency_cycles_worst": (worst, "cycle"),
         "sys.xga_gray_error_lsb_max": (max(f["max_error_lsb"] for f in r["frames"]), "LSB"),
+        **faulty(),
     }
+
+
+def faulty():
+    """The same run with the chips misbehaving (``make sim FAULTS=stalls`` and ``=all``,
+    :data:`sim.xga.FAULTS`): every rule checked on the pins as always; the figures say what it
+    cost."""
+    figures = {}
+    for kind in ("stalls", "all"):
+        r = xga.run(f"bench-{kind}", frames=XGA_FRAMES, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK,
+                    faults=kind, log=lambda _text: None)
+        periods = sorted(r["periods_measured"])
+        status = r["status"]
+        figures.update({
+            f"sys.xga_faults_{kind}_gray_error_lsb_max": (max(f["max_error_lsb"] for f in r["frames"]), "LSB"),
+            f"sys.xga_faults_{kind}_rate_hz_measured": (xga.DMD_HZ / periods[len(periods) // 2], "Hz"),
+            f"sys.xga_faults_{kind}_memory_stalls": (r["mcb_stalls"], "command"),
+            f"sys.xga_faults_{kind}_row_underruns": (status["row_underruns"], "row"),
+            f"sys.xga_faults_{kind}_pulses_late": (status["pulses_late"], "pulse"),
+            f"sys.xga_faults_{kind}_rst_active_late": (status["rst_active_late"], "pulse"),
+        })
+    return figures
