@@ -1,4 +1,5 @@
 import os
+import secrets
 import time
 
 import pytest
@@ -24,6 +25,16 @@ _started = time.monotonic()
 def test_name(request):
     """The test's node id, used to name its VCD and build directory."""
     return request.node.name
+
+
+@pytest.fixture
+def seed(request):
+    """A fresh seed for a randomised test each run, or ``SEED=n`` to replay one. It is printed
+    (pytest shows it with a failing test's output) with the command that replays it."""
+    value = int(os.environ.get("SEED") or secrets.randbits(32))
+    print(f"seed {value}: replay with SEED={value} pytest '{request.node.nodeid}'")
+    request.node.user_properties.append(("seed", value))
+    return value
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config):

@@ -184,10 +184,10 @@ def test_four_buses(mode, order, test_name):
 
 
 @pytest.mark.verilog
-def test_random_images_every_depth_with_empty_blocks(test_name):
-    """Random images at bit depths 1..8 back to back (triggered as soon as ready); one slot has
-    empty blocks and empty planes, cleared instead of loaded."""
-    rng = np.random.default_rng(5)
+def test_random_images_every_depth_with_empty_blocks(seed, test_name):
+    """Random images (a fresh seed each run) at bit depths 1..8 back to back (triggered as soon as
+    ready); one slot has empty blocks and empty planes, cleared instead of loaded."""
+    rng = np.random.default_rng(seed)
     a = rng.integers(0, 256, (DMD.rows, DMD.columns), dtype=np.uint8)
     b = rng.integers(0, 256, (DMD.rows, DMD.columns), dtype=np.uint8) & 0b10110101
     b[:DMD.rows_per_block] = 0
@@ -619,13 +619,12 @@ def test_controller_restart_mid_frame(ecp2_low, test_name):
 
 
 @pytest.mark.verilog
-def test_periodic_trigger_at_the_frame_rate_loses_none(test_name):
+def test_periodic_trigger_at_the_frame_rate_loses_none(seed, test_name):
     """A periodic trigger exactly at the back-to-back frame rate, trigger_hold on, and newer frames
     completing at random phases of it (a fresh seed each run, in the messages): no trigger is
     lost, held or delayed. A newer frame that cannot be reloaded before the next trigger is due
     waits for the trigger after (without that rule the same run loses triggers: checked on the
     schedule model). Commands equal the schedule model's; every frame shown is exact."""
-    seed = int(np.random.SeedSequence().entropy % 2**32)
     rng = np.random.default_rng(seed)
     plan = fast_plan(depth=3)
     p = plan.params

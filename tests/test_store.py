@@ -487,13 +487,13 @@ def test_read_rate_under_ingest_is_the_plans():
     assert xga.plan().params.row_period == row_period(xga.DMD, figure["words_per_cycle"])
 
 
-def test_random_events_against_policy_model(test_name):
+def test_random_events_against_policy_model(seed, test_name):
     """Random records (new frames, parts and rests of frames, stale and shown ids, rows beyond
-    the frame, overlaps), asks and releases: after each event the gateware's counters and the
-    frames it gives equal the reference model's (sim.models.slots)."""
+    the frame, overlaps), asks and releases, a fresh seed each run: after each event the
+    gateware's counters and the frames it gives equal the reference model's (sim.models.slots)."""
     from sim.models.slots import SlotPolicy
 
-    rng = random.Random(14)
+    rng = random.Random(seed)
     bench = Bench(SHORT_DMD, slots=4)
     dut = bench.dut
     rows = SHORT_DMD.rows
@@ -505,10 +505,15 @@ def test_random_events_against_policy_model(test_name):
     state = {"turn": "producer", "event": None}
     newest = 1
 
-    events = []
+    # first, every outcome once for certain (replaced, abandoned, outside, stale, duplicate,
+    # shown), then random events
+    events = [("rows", 2, list(range(rows))), ("rows", 3, list(range(rows))),
+              ("rows", 4, [0, 1, 2]), ("rows", 5, list(range(rows))), ("rows", 5, [rows - 1, rows, rows + 1]),
+              ("rows", 2, [0]), ("rows", 6, [0, 1]), ("rows", 6, [1, 2]), ("ask", None, None), ("shown", None, [3])]
+    newest = 6
     for _ in range(44):
         kind = rng.choice(["full", "newpart", "part", "part", "rest", "old", "beyond", "ask", "ask",
-                           "release"])
+                           "release", "shown"])
         if kind == "full":
             newest += rng.choice([1, 1, 2])
             events.append(("rows", newest, list(range(rows))))
@@ -524,6 +529,8 @@ def test_random_events_against_policy_model(test_name):
             events.append(("rows", newest - rng.randrange(1, 4), list(range(rng.randrange(rows // 12), rows // 8))))
         elif kind == "beyond":
             events.append(("rows", newest, list(range(rows - 2, rng.randrange(rows + 1, FIELD_ROWS + 1)))))
+        elif kind == "shown":
+            events.append(("shown", None, [rng.randrange(rows)]))
         else:
             events.append((kind, None, None))
     # then for certain: overlapping records, and a sequencer holding three of the four slots
@@ -532,7 +539,7 @@ def test_random_events_against_policy_model(test_name):
                ("rows", n + 1, list(range(rows // 10, rows * 3 // 10)))]
     for k in range(2, 5):
         events += [("rows", n + k, list(range(rows))), ("ask", None, None)]
-    events += [("rows", n + 5, list(range(rows))), ("rows", n + 6, list(range(4)))]
+    events += [("shown", None, [0]), ("rows", n + 5, list(range(rows))), ("rows", n + 6, list(range(4)))]
 
     async def producer(ctx):
         ctx.set(dut.bit_depth, 1)
@@ -540,6 +547,10 @@ def test_random_events_against_policy_model(test_name):
             if kind == "rest":
                 have = policy.frames.get(frame, {"rows": set()})["rows"]
                 kind, record = "rows", [r for r in range(rows) if r not in have]
+            if kind == "shown":
+                # a row of a frame the sequencer holds (none: no row)
+                shown = policy.in_state("SHOWN")
+                kind, frame, record = "rows", (shown[0] if shown else newest), (record if shown else [])
             if kind == "rows":
                 for row in record:
                     policy.row(frame & 0xFFFF, row, 1)
