@@ -1,5 +1,6 @@
-"""The sequencer's generated Verilog on full XGA (and on the small four-bus geometry), on the
-sequencer rig (:mod:`sim.seq_rig`): one triggered frame of the ramp image (every grey level on
+"""The sequencer's generated Verilog on full XGA, on the full DLP9500 (1080p, four buses) at DCLK
+400 MHz, and on the small four-bus geometry, on the sequencer rig (:mod:`sim.seq_rig`): one
+triggered frame of the ramp image (every grey level on
 every row), RST_ACTIVE and settle scaled down (run-time parameters). The rule-checking DLPC410
 model, on the replayed pin trace, must break no rule and agree with the responder; its command
 log must equal the schedule model's cycle for cycle, and the camera model must see every pixel
@@ -18,14 +19,15 @@ from spec.registers import PlaneOrder, ResetMode
 
 
 @pytest.mark.verilog
-@pytest.mark.parametrize("dmd,mode,strict,order,depth", [
-    ("dlp7000", "GLOBAL", True, "MSB_FIRST", 8),     # every grey level 0..255
-    ("dlp7000", "SINGLE", False, "LSB_FIRST", 4),    # phased: 16 groups; 4 bits keep it short
-    ("test4", "QUAD", True, "MSB_FIRST", 8),         # four buses (DIN_A..D), 1080p-style clears
+@pytest.mark.parametrize("dmd,mode,strict,order,depth,dclk", [
+    ("dlp7000", "GLOBAL", True, "MSB_FIRST", 8, 200e6),     # every grey level 0..255
+    ("dlp7000", "SINGLE", False, "LSB_FIRST", 4, 200e6),    # phased: 16 groups; 4 bits keep it short
+    ("test4", "QUAD", True, "MSB_FIRST", 8, 200e6),         # four buses (DIN_A..D), 1080p-style clears
+    ("dlp9500", "GLOBAL", True, "MSB_FIRST", 8, 400e6),     # full 1080p, four buses, two beats a cycle
 ])
-def test_sequencer_verilog_xga(dmd, mode, strict, order, depth, test_name):
+def test_sequencer_verilog_xga(dmd, mode, strict, order, depth, dclk, test_name):
     dmd = DMDS[dmd]
-    p = schedule.plan(dmd, 200e6, t_rst_s=40 / 200e6, t_settle_s=80 / 200e6, reset_mode=ResetMode[mode],
+    p = schedule.plan(dmd, dclk, t_rst_s=40 / 200e6, t_settle_s=80 / 200e6, reset_mode=ResetMode[mode],
                       strict_rst=strict, order=PlaneOrder[order], depth=depth).params
     frames = [schedule.Frame(0, depth)]   # repeated: a newer frame offered while waiting would be reloaded
     pin = max(g.loaded_at for g in schedule.simulate(dmd, p, frames).groups) + 6

@@ -7,6 +7,7 @@ each comes from a simulation or a synthesis run made by the benchmark itself.
 
 MODULES = [
     "sim.bench.bitplane",
+    "sim.bench.camera",
     "sim.bench.dlpc410_model",
     "sim.bench.formal",
     "sim.bench.host",

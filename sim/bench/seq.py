@@ -22,11 +22,10 @@ fastest single-block plan (loose RST_ACTIVE reading, the phased mode the cocotb 
 XGA), window holding the frame.
 """
 
-import csv
-
 import numpy as np
 
 from gateware.dlpc410.trigger import PIN_TO_STROBE
+from sim.bench.tables import pyplot, write_table
 from sim.harness.paths import build_dir
 from sim.models.camera import Camera, to_lsb
 from sim.models.dlpc410 import Dlpc410
@@ -169,16 +168,10 @@ def gray_error_table(dclk=200e6):
 
 def write_gray_error(rows):
     """``build/seq_gray_error.csv`` and the plot ``build/seq_gray_error.png``."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    write_table("seq_gray_error", ["lsb_cycles", "frame_cycles", "rate_hz", "misalign_us", "max_lsb", "rms_lsb"],
+                [[r[0], r[1], f"{r[2]:.3f}", r[3], f"{r[4]:.4f}", f"{r[5]:.4f}"] for r in rows])
+    plt = pyplot()
     out = build_dir()
-    with open(out / "seq_gray_error.csv", "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["lsb_cycles", "frame_cycles", "rate_hz", "misalign_us", "max_lsb", "rms_lsb"])
-        for r in rows:
-            w.writerow([r[0], r[1], f"{r[2]:.3f}", r[3], f"{r[4]:.4f}", f"{r[5]:.4f}"])
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharex=True)
     for us in MISALIGN_US:
         pts = [(r[1] / 200e3, r[4], r[5]) for r in rows if r[3] == us]

@@ -1,0 +1,104 @@
+"""A camera out of step with the projector: grey error against the misalignment of its window.
+
+The experiment of the seed design (2014): a camera integrates exactly one frame period, but its
+window starts before (leads) or after (lags) the frame by 0 to 100 % of a frame. The projector
+plays three stored frames back to back, triggered at the frame rate: black, a ramp holding every
+grey level, black (a target that appears for one frame). The pins come from the sequencer's
+generated Verilog on the test DMD (:mod:`sim.seq_rig`), the mirrors from the rule-checking
+DLPC410 model, the light from the camera model; the error of each grey level is what the camera
+sees less the level, in LSB. With MSB first the most significant plane fills the first half of
+the frame, so a lagging window loses up to 128 LSB from every level of 128 and up while the
+levels below lose only their low planes: the error jumps at 128. With LSB first the jump moves to
+a leading window. ``build/camera_misalignment.csv`` and ``.png``.
+"""
+
+import numpy as np
+
+from sim.bench.tables import pyplot, write_table
+from sim.harness.paths import build_dir
+from sim.models.camera import Camera, to_lsb
+from sim.seq_rig import run_rig
+from sim.tb.seq_sim import CAMERA_DELAY, CAMERA_RAMP
+from spec import schedule
+from spec.facts import TEST_DMD
+from spec.registers import PlaneOrder, TriggerMode
+
+__all__ = ["misalignment", "run", "SHIFTS_PCT"]
+
+#: Window start minus the ramp frame's first pulse, in % of the frame period (- leads, + lags).
+SHIFTS_PCT = tuple(range(-100, 101, 5))
+#: The shifts the figures and the plot name.
+SHOWN_PCT = (-50, -10, 10, 50)
+
+
+def misalignment(order, shifts=SHIFTS_PCT, *, name=None):
+    """Per shift (% of a frame), the mean error (LSB) of each grey level 0..255, for the plane
+    ``order``: ``{shift: array of 256}``."""
+    dmd = TEST_DMD
+    plan = schedule.plan(dmd, 200e6, depth=8, order=order, t_rst_s=20 / 200e6, t_settle_s=30 / 200e6)
+    p = plan.params
+    p.trigger, p.trigger_hold, p.period = TriggerMode.PERIODIC, True, plan.frame_cycles
+    # every grey level 0..255 on the 128 columns: odd rows hold the upper half
+    rows, columns = np.indices((dmd.rows, dmd.columns))
+    ramp = ((columns + 128 * (rows % 2)) & 255).astype(np.uint8)
+    images = {0: np.zeros_like(ramp), 1: ramp}
+    frames = [(slot, 8, 0, 1) for slot in (0, 1, 0)]
+    until = 4 * p.period
+    run = run_rig(dmd, p, frames, images, cycles=until, name=name or f"camera_{order.name.lower()}")
+    starts = [first for first, _last in run.frames()]
+    assert len(starts) >= 3, f"three frames expected, got {len(starts)}"
+    period = starts[2] - starts[1]
+    camera = Camera(run.model, ramp_cycles=CAMERA_RAMP, delay_cycles=CAMERA_DELAY)
+    levels = np.arange(256)
+    out = {}
+    for pct in shifts:
+        t0 = starts[1] + round(pct * period / 100)
+        seen = to_lsb(camera.image(t0, t0 + period), p.lsb)
+        error = seen - ramp
+        out[pct] = np.array([error[ramp == g].mean() for g in levels])
+    return out
+
+
+def _write(curves):
+    write_table("camera_misalignment", ["order", "shift_pct_of_frame", *[f"error_lsb_grey_{g}" for g in range(256)]],
+                [[order, pct, *[f"{e:.3f}" for e in errors]]
+                 for order, by_shift in curves.items() for pct, errors in by_shift.items()])
+    plt = pyplot()
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4))
+    for k, (order, by_shift) in enumerate(curves.items()):
+        for pct in SHOWN_PCT:
+            axes[k].plot(range(256), by_shift[pct], label=f"{pct:+d} %")
+        axes[k].set_title(f"{order}: error against grey level")
+        axes[k].set_xlabel("grey level")
+        axes[k].set_ylabel("camera error (LSB)")
+        axes[k].axvline(128, color="grey", alpha=0.3)
+        axes[k].legend(title="window start (% of a frame)")
+        axes[k].grid(True, alpha=0.3)
+        axes[2].plot(list(by_shift), [np.abs(e).max() for e in by_shift.values()], "o-", label=order)
+    axes[2].set_title("largest error against misalignment")
+    axes[2].set_xlabel("window start - frame start (% of a frame; - leads, + lags)")
+    axes[2].set_ylabel("max |error| (LSB)")
+    axes[2].legend()
+    axes[2].grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(build_dir() / "camera_misalignment.png", dpi=100)
+    plt.close(fig)
+
+
+def run():
+    curves = {order.name.lower(): misalignment(order) for order in (PlaneOrder.MSB_FIRST, PlaneOrder.LSB_FIRST)}
+    _write(curves)
+    figures = {}
+    for order, by_shift in curves.items():
+        figures[f"cam.error_lsb_max_aligned_{order}"] = (float(np.abs(by_shift[0]).max()), "LSB")
+        for pct in SHOWN_PCT:
+            when = f"lag_{pct}pct" if pct > 0 else f"lead_{-pct}pct"
+            errors = by_shift[pct]
+            figures[f"cam.error_lsb_max_{when}_{order}"] = (float(np.abs(errors).max()), "LSB")
+            figures[f"cam.jump_at_128_lsb_{when}_{order}"] = (float(errors[128] - errors[127]), "LSB")
+    return figures
+
+
+if __name__ == "__main__":
+    for figure, (value, unit) in run().items():
+        print(f"{figure:50s} {value:10.3f} {unit}")

@@ -1,0 +1,23 @@
+"""The camera misalignment experiment (:mod:`sim.bench.camera`) on the sequencer's generated
+Verilog: a window holding the frame sees every level exact; a window lagging an MSB-first frame
+by a tenth of it loses the MSB's share from every level of 128 and up (the jump at 128), much
+less below; leading it loses only the low planes' share at the end of the frame."""
+
+import numpy as np
+import pytest
+
+from sim.bench.camera import misalignment
+from spec.registers import PlaneOrder
+
+
+@pytest.mark.verilog
+def test_the_jump_at_128_on_the_gateware(test_name):
+    curves = misalignment(PlaneOrder.MSB_FIRST, shifts=(0, 10, -10), name=test_name)
+    assert np.abs(curves[0]).max() == 0
+    lag, lead = curves[10], curves[-10]
+    # a tenth of the frame is about 25.6 LSB of the MSB's time (the frame is not all light)
+    assert -28 < lag[128:].max() and lag[128:].min() < -20
+    assert lag[:128].min() > -20
+    assert lag[128] - lag[127] < -20
+    # leading: the frame's end is lost (its low planes); 128 has none there
+    assert lead[127] < -10 and lead[128] - lead[127] > 10
