@@ -114,7 +114,7 @@ class Through(wiring.Component):
 
 def test_sequencer_init_rule(monkeypatch):
     from gateware.dlpc410 import init
-    check, _ = sequencer.sequencer_checks()
+    check, _, _ = sequencer.sequencer_checks()
     assert run(check).status == "proven"
     monkeypatch.setattr(init, "FFSynchronizer", Through)
     with pytest.raises(FormalFailure) as failure:
@@ -125,9 +125,20 @@ def test_sequencer_init_rule(monkeypatch):
 def test_sequencer_rst_active_rule():
     """Proven; and not vacuous: claimed one cycle sooner than the synchroniser allows, it fails
     (a pulse is reached with RST_ACTIVE rising just before it)."""
-    _, check = sequencer.sequencer_checks()
+    _, check, _ = sequencer.sequencer_checks()
     assert run(check).status == "proven"
     with pytest.raises(FormalFailure) as failure:
         run(dataclasses.replace(check, block="Sequencer-rst-one-cycle", induction=None,
                                 build=lambda: sequencer.rst_top(latency=1, init_to_dvalid=2)), depth=24)
     assert "a clocking pulse while RST_ACTIVE was high" in failure.value.result.failed
+
+
+def test_sequencer_settle_rule():
+    """Checked to the suite's depth (a pulse comes at step 15, the loads after it from step 23);
+    and not vacuous: claimed one cycle longer after a pulse than the sequencer waits, it fails."""
+    _, _, check = sequencer.sequencer_checks()
+    assert run(check, depth=check.quick).status == "checked"
+    with pytest.raises(FormalFailure) as failure:
+        run(dataclasses.replace(check, block="Sequencer-settle-one-more", build=lambda: sequencer.settle_top(extra=1)),
+            depth=check.quick)
+    assert "a load sooner than t_rst + t_settle after a pulse" in failure.value.result.failed

@@ -7,7 +7,10 @@ since the fall, whichever is later than the planner's time; so a controller that
 RST_ACTIVE longer than the facts table says delays the loads instead of breaking the settle
 rule. A fall later than planned is counted. So are RST_ACTIVE never rising after a pulse (the
 group is released ``t_rst + t_settle`` after the planned fall) and RST_ACTIVE stuck high as long
-past it (the group waits for the fall; no pulse is made while it is high).
+past it (the group waits for the fall; no pulse is made while it is high). RST_ACTIVE seen in
+the synchroniser's cycles after a pulse was high before the pulse reached the pins: it is not
+this pulse's (a high that lasts is seen again two cycles later), so a short high just before a
+pulse cannot pass for the pulse's own reset and end its wait early.
 """
 
 from amaranth import Array, Cat, Module, Signal
@@ -79,6 +82,8 @@ class ResetWatch(wiring.Component):
         m = Module()
         regs, now, G = self.regs, self.now, self._dmd.blocks
         phase = Array(Signal(Phase, name=f"phase{g}") for g in range(G))
+        # cycles after a group's pulse in which RST_ACTIVE still shows the pins before it
+        blind = Array(Signal(range(FALL_LATENCY + 1), name=f"blind{g}") for g in range(G))
         # RST_ACTIVE is one pin for every group: the fall the last pulse plans
         planned_fall = Signal(TIME_BITS)
         fell_at = Signal(TIME_BITS)
@@ -91,9 +96,11 @@ class ResetWatch(wiring.Component):
 
         missing, stuck = Signal(), Signal()
         for g in range(G):
+            with m.If(blind[g] != 0):
+                m.d.sync += blind[g].eq(blind[g] - 1)
             with m.Switch(phase[g]):
                 with m.Case(Phase.RISE):
-                    with m.If(self.rst_active):
+                    with m.If(self.rst_active & (blind[g] == 0)):
                         m.d.sync += phase[g].eq(Phase.FALL)
                     with m.Elif(overdue):
                         m.d.comb += missing.eq(1)
@@ -108,7 +115,8 @@ class ResetWatch(wiring.Component):
                          self.fell.payload.groups[g].eq(falls & ((phase[g] == Phase.FALL)
                                                                  | (phase[g] == Phase.STUCK)))]
         with m.If(self.pulse.valid):
-            m.d.sync += [phase[self.pulse.payload].eq(Phase.RISE), planned_fall.eq(now + regs.t_rst)]
+            m.d.sync += [phase[self.pulse.payload].eq(Phase.RISE), blind[self.pulse.payload].eq(FALL_LATENCY),
+                         planned_fall.eq(now + regs.t_rst)]
 
         m.d.comb += [self.fell.valid.eq(falls), self.fell.payload.settled.eq(fell_at + regs.t_settle)]
         with m.If(falls & (diff(fell_at, planned_fall) > 0)):

@@ -16,20 +16,24 @@ sequencer is elaborated):
   DVALID and the data pins. ``running`` is high exactly when the pins showed the controller
   ready three cycles earlier;
 * the bus decides a clocking pulse (on the pins the next cycle) only when RST_ACTIVE was low at
-  the pins two cycles earlier (its synchroniser), in the strict and the loose reading alike.
+  the pins two cycles earlier (its synchroniser), in the strict and the loose reading alike;
+* after a clocking pulse, no row load or block clear reaches the pins before ``t_rst + t_settle``
+  cycles have passed, and, when RST_ACTIVE rises within ``t_rst`` of the pulse, none while it is
+  high nor before ``t_settle`` cycles after it fell (bounded: global pulses, registers held, the
+  first load's wait shortened so that a pulse and the loads after it are reached).
 """
 
 import dataclasses
 from contextlib import contextmanager
 
-from amaranth import Signal
-from amaranth.hdl import Assert, Fragment
+from amaranth import Mux, Signal
+from amaranth.hdl import Assert, Assume, Fragment
 
 from spec.facts import TEST_DMD
 
 from .harness import Check, FormalTop
 
-__all__ = ["sequencer_checks", "rst_top", "DMD"]
+__all__ = ["sequencer_checks", "rst_top", "settle_top", "DMD"]
 
 #: Two words a row on two buses (two DCLK cycles a row at one beat, the fewest the sequencer
 #: takes), eight rows in two blocks: the smallest geometry the sequencer builds for.
@@ -90,33 +94,91 @@ def _no_pulse_while_rst_active(pulse, latency):
     return prop
 
 
-def _init_top():
+def _settle_after_pulse(pulse, extra):
+    from gateware.dlpc410.interface import BlockMode, RowMode
+    from gateware.registers import ResetMode
+
+    def prop(m, top):
+        pins, regs = top.dut.pins, top.dut.regs
+        # the environment: global pulses, registers held from the start, times not too short for
+        # RST_ACTIVE's synchroniser (a real plan's are hundreds of cycles)
+        held, first = Signal.like(regs), Signal(init=1)
+        m.d.sync += [held.eq(regs), first.eq(0)]
+        m.d.comb += [Assume(first | (regs.as_value() == held.as_value())),
+                     Assume(regs.reset_mode == ResetMode.GLOBAL),
+                     Assume((regs.t_rst >= 4) & (regs.t_settle >= 4))]
+        # on the pins: the pulse's row cycle starts the cycle after the decision
+        on_pins = Signal()
+        m.d.sync += on_pins.eq(pulse)
+        write = (pins.rowmd != RowMode.NOOP) | (pins.blkmd == BlockMode.CLEAR)
+        pulsed, rose, fell = Signal(), Signal(), Signal()
+        since_pulse, since_fall = Signal(16), Signal(16)
+        rst = pins.rst_active
+        with m.If(on_pins):
+            m.d.sync += [pulsed.eq(1), since_pulse.eq(1), rose.eq(rst), fell.eq(0)]
+        with m.Else():
+            with m.If(since_pulse != 2**16 - 1):
+                m.d.sync += since_pulse.eq(since_pulse + 1)
+            with m.If(pulsed & ~rose & rst & (since_pulse <= regs.t_rst)):
+                m.d.sync += rose.eq(1)
+            with m.If(rose & ~fell & ~rst):
+                m.d.sync += [fell.eq(1), since_fall.eq(1)]
+            with m.Elif(fell & (since_fall != 2**16 - 1)):
+                m.d.sync += since_fall.eq(since_fall + 1)
+        # ``since_*`` counts the cycles after the pulse's first pins cycle (0 on it) and after
+        # the fall (0 on the first cycle RST_ACTIVE is low)
+        age = Mux(on_pins, 0, since_pulse)
+        risen = rose | (on_pins & rst)
+        m.d.comb += [
+            Assert(~(write & pulsed) | (age >= regs.t_rst + regs.t_settle + extra),
+                   "a load sooner than t_rst + t_settle after a pulse"),
+            Assert(~(write & risen & ~(fell | (rose & ~rst))),
+                   "a load while RST_ACTIVE was high after a pulse"),
+            Assert(~(write & fell) | (since_fall >= regs.t_settle),
+                   "a load sooner than t_settle after RST_ACTIVE fell"),
+        ]
+
+    return prop
+
+
+def _sequencer_top(part, member, prop, init_to_dvalid=None):
+    """The sequencer with ``prop(watched)`` as its property, ``watched`` a copy of the member
+    ``member`` of its part ``part`` (:func:`_watched`); ``init_to_dvalid``: a shorter wait before
+    the first load than the facts' 64 clocks, so that a bounded check reaches a pulse within a few
+    tens of steps (15 with 2)."""
+    from gateware.dlpc410 import planner
     from gateware.dlpc410.sequencer import Sequencer
-    running = Signal()
-    with _watched("Init", "running", running):
-        top = FormalTop(Sequencer(DMD, beats=1, store_words=1), [_no_command_during_init(running)])
-        return Fragment.get(top, None)
+    watched = Signal()
+    original = planner.INIT_TO_DVALID
+    planner.INIT_TO_DVALID = original if init_to_dvalid is None else init_to_dvalid
+    try:
+        with _watched(part, member, watched):
+            return Fragment.get(FormalTop(Sequencer(DMD, beats=1, store_words=1), [prop(watched)]), None)
+    finally:
+        planner.INIT_TO_DVALID = original
+
+
+def _init_top():
+    return _sequencer_top("Init", "running", _no_command_during_init)
 
 
 def rst_top(latency=2, init_to_dvalid=None):
     """The RST_ACTIVE property's top; ``latency``: cycles from the pins to the decision it allows
-    (the synchroniser's two; one is too few, and the check must then fail). ``init_to_dvalid``:
-    a shorter wait before the first load than the facts' 64 clocks, so that a bounded check
-    reaches a pulse within a few tens of steps (15 with 2)."""
-    from gateware.dlpc410 import planner
-    from gateware.dlpc410.sequencer import Sequencer
-    pulse = Signal()
-    original = planner.INIT_TO_DVALID
-    planner.INIT_TO_DVALID = original if init_to_dvalid is None else init_to_dvalid
-    try:
-        with _watched("Bus", "pulse.valid", pulse):
-            top = FormalTop(Sequencer(DMD, beats=1, store_words=1), [_no_pulse_while_rst_active(pulse, latency)])
-            return Fragment.get(top, None)
-    finally:
-        planner.INIT_TO_DVALID = original
+    (the synchroniser's two; one is too few, and the check must then fail)."""
+    return _sequencer_top("Bus", "pulse.valid", lambda pulse: _no_pulse_while_rst_active(pulse, latency),
+                          init_to_dvalid)
+
+
+def settle_top(init_to_dvalid=2, extra=0):
+    """The settle property's top. ``extra``: claim this many cycles more after a pulse than the
+    sequencer keeps (1: the check must fail, for the sequencer loads right at ``t_rst +
+    t_settle``)."""
+    return _sequencer_top("Bus", "pulse.valid", lambda pulse: _settle_after_pulse(pulse, extra), init_to_dvalid)
 
 
 def sequencer_checks():
     return [Check("no command during INIT_ACTIVE", "Sequencer", _init_top, depth=12, induction=4, quick=4),
             Check("no clocking pulse while RST_ACTIVE is high", "Sequencer", rst_top, depth=12, induction=4,
-                  quick=4)]
+                  quick=4),
+            Check("no load within the settle time after a pulse and after RST_ACTIVE fell", "Sequencer",
+                  settle_top, depth=36, quick=28)]
