@@ -26,9 +26,9 @@ from spec.registers import PlaneOrder, TriggerMode
 __all__ = ["misalignment", "run", "SHIFTS_PCT"]
 
 #: Window start minus the ramp frame's first pulse, in % of the frame period (- leads, + lags).
-SHIFTS_PCT = tuple(range(-100, 101, 5))
-#: The shifts the figures and the plot name.
-SHOWN_PCT = (-50, -10, 10, 50)
+SHIFTS_PCT = tuple(sorted({*range(-100, 101, 5), -1, 1}))
+#: The shifts the figures name (the plot shows those of 10 % and more).
+SHOWN_PCT = (-50, -10, -1, 1, 10, 50)
 
 
 def misalignment(order, shifts=SHIFTS_PCT, *, name=None):
@@ -66,7 +66,7 @@ def _write(curves):
     plt = pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(15, 4))
     for k, (order, by_shift) in enumerate(curves.items()):
-        for pct in SHOWN_PCT:
+        for pct in (p for p in SHOWN_PCT if abs(p) >= 10):
             axes[k].plot(range(256), by_shift[pct], label=f"{pct:+d} %")
         axes[k].set_title(f"{order}: error against grey level")
         axes[k].set_xlabel("grey level")
@@ -90,12 +90,17 @@ def run():
     _write(curves)
     figures = {}
     for order, by_shift in curves.items():
-        figures[f"cam.error_lsb_max_aligned_{order}"] = (float(np.abs(by_shift[0]).max()), "LSB")
+        figures[f"cam.aligned_error_lsb_max_{order}"] = (float(np.abs(by_shift[0]).max()), "LSB")
         for pct in SHOWN_PCT:
             when = f"lag_{pct}pct" if pct > 0 else f"lead_{-pct}pct"
             errors = by_shift[pct]
-            figures[f"cam.error_lsb_max_{when}_{order}"] = (float(np.abs(errors).max()), "LSB")
-            figures[f"cam.jump_at_128_lsb_{when}_{order}"] = (float(errors[128] - errors[127]), "LSB")
+            figures[f"cam.{when}_error_lsb_max_{order}"] = (float(np.abs(errors).max()), "LSB")
+            figures[f"cam.{when}_jump_at_128_lsb_{order}"] = (float(errors[128] - errors[127]), "LSB")
+    # the plane order with the smaller worst error a 1 % misalignment either way leaves:
+    # 0 MSB first, 1 LSB first
+    worst = {order: max(figures[f"cam.{w}_1pct_error_lsb_max_{order}"][0] for w in ("lag", "lead"))
+             for order in curves}
+    figures["cam.best_order_1pct"] = (list(curves).index(min(worst, key=worst.get)), "0 msb_first, 1 lsb_first")
     return figures
 
 
