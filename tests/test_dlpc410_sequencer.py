@@ -654,3 +654,15 @@ def test_periodic_trigger_at_the_frame_rate_loses_none(seed, test_name):
     for k, light in enumerate(lights[:len(shown)]):
         want = (ramp_image(DMD, shown[k].slot).astype(np.int64) >> (8 - shown[k].depth)) * p.lsb
         assert np.array_equal(light, want), f"seed {seed}: frame {k}"
+
+
+@pytest.mark.verilog
+def test_loose_phased_at_ti_timing(test_name):
+    """Single-block pulses under the loose RST_ACTIVE reading at TI's RST_ACTIVE and settle times
+    (not scaled down): groups pulse while another's RST_ACTIVE is high, which lengthens the one
+    pin's high. A group does not wait for that longer high (it is another group's reset): the
+    commands equal the schedule model's, no pulse is late, every level exact."""
+    p = schedule.plan(DMD, 200e6, reset_mode=ResetMode.SINGLE, strict_rst=False, depth=4).params
+    first = next_ready(p, model_frames([(0, 4)], None), []) - PIN_TO_STROBE
+    run, _model = check(p, [(0, 4)], None, [first], test_name)
+    assert run.status["late"] == 0

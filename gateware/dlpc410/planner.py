@@ -53,7 +53,7 @@ class Planner(wiring.Component):
     n_groups : In(range(blocks + 1))
         Groups of the reset mode.
     rst_active : In(1)
-        RST_ACTIVE, synchronised: no group's pulse is due while it is high.
+        RST_ACTIVE, synchronised: with ``strict_rst``, no group's pulse is due while it is high.
     frames : In(stream.Signature(FrameInfo))
         The newest complete frame. A bit depth outside 1..8 is dropped when offered, and counted.
     offer : Out(Offer)
@@ -163,7 +163,10 @@ class Planner(wiring.Component):
         # ---- what the bus may do ----
         armed = [Signal(name=f"armed{g}") for g in range(G)]
         for g in range(G):
-            rst_ok = Mux(regs.strict_rst, diff(rst_any, now) <= 0, diff(rst_free[g], now) <= 0) & ~self.rst_active
+            # strict: no pulse while RST_ACTIVE may be high, by the plan or at the pin; loose: a
+            # group's own reset only (RST_ACTIVE at the pin may be another group's; a group whose
+            # reset has not ended is kept unloaded by the RST_ACTIVE watch, so it cannot pulse)
+            rst_ok = Mux(regs.strict_rst, (diff(rst_any, now) <= 0) & ~self.rst_active, diff(rst_free[g], now) <= 0)
             m.d.comb += [
                 armed[g].eq(active[g] & pending[g] & loaded[g]),
                 self.due[g].eq(armed[g] & (diff(pulse_at[g], now) <= 0) & rst_ok),

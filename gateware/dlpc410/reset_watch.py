@@ -10,7 +10,9 @@ group is released ``t_rst + t_settle`` after the planned fall) and RST_ACTIVE st
 past it (the group waits for the fall; no pulse is made while it is high). RST_ACTIVE seen in
 the synchroniser's cycles after a pulse was high before the pulse reached the pins: it is not
 this pulse's (a high that lasts is seen again two cycles later), so a short high just before a
-pulse cannot pass for the pulse's own reset and end its wait early.
+pulse cannot pass for the pulse's own reset and end its wait early. With the loose reading
+(``strict_rst`` low) another group may pulse while RST_ACTIVE is high; the one pin then no
+longer tells when the earlier group's reset ended, and that group falls back on the planned time.
 """
 
 from amaranth import Array, Cat, Module, Signal
@@ -115,6 +117,9 @@ class ResetWatch(wiring.Component):
                          self.fell.payload.groups[g].eq(falls & ((phase[g] == Phase.FALL)
                                                                  | (phase[g] == Phase.STUCK)))]
         with m.If(self.pulse.valid):
+            with m.If(~regs.strict_rst):
+                for g in range(G):
+                    m.d.sync += phase[g].eq(Phase.IDLE)
             m.d.sync += [phase[self.pulse.payload].eq(Phase.RISE), blind[self.pulse.payload].eq(FALL_LATENCY),
                          planned_fall.eq(now + regs.t_rst)]
 

@@ -13,6 +13,7 @@ MODULES = [
     "sim.bench.host",
     "sim.bench.mac",
     "sim.bench.net",
+    "sim.bench.rates",
     "sim.bench.store",
     "sim.bench.seq",
     "sim.bench.seq_rig",
