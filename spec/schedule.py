@@ -65,7 +65,7 @@ from .registers import PlaneOrder, ResetMode, Source, TriggerMode, group_size
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate", "FABRIC_HZ",
            "beats_at", "row_cycles",
            "plan", "bound", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS", "flush_rows",
-           "RST_MARGIN", "even", "ready_cycle", "reload_bound"]
+           "RST_MARGIN", "even", "ready_cycle", "reload_bound", "reload_cycles"]
 
 #: The ``dmd`` domain's clock: every cycle count of the model and the sequencer is in its cycles.
 #: DCLK is this (one beat per cycle) or twice this (two beats per cycle: 400 MHz through the
@@ -753,9 +753,13 @@ def reload_bound(dmd, p):
     """Cycles a newer frame taken while the groups wait may need before every group is loaded
     again, at most: the flush of stale words, the reload lead, queueing the first planes, every
     row of the first planes at the row period, and a row cycle's slack for the bus's parity."""
-    R = row_cycles(dmd, p.beats)
-    rp = max(p.row_period, R)
-    return flush_rows(dmd) * rp + p.reload_lead + dmd.blocks + 1 + dmd.rows * rp + 2 * R
+    return reload_cycles(dmd, p.beats, max(p.row_period, row_cycles(dmd, p.beats)), p.reload_lead)
+
+
+def reload_cycles(dmd, beats, row_period, reload_lead):
+    """:func:`reload_bound` of a ``row_period`` of at least a row cycle and a ``reload_lead``:
+    operators only, so that the gateware builds the same sum from its registers."""
+    return (flush_rows(dmd) + dmd.rows) * row_period + reload_lead + dmd.blocks + 1 + 2 * row_cycles(dmd, beats)
 
 
 def ready_cycle(dmd, p, fr):

@@ -23,7 +23,7 @@ from amaranth import Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from spec.schedule import INIT_TO_DVALID, flush_rows, row_cycles
+from spec.schedule import INIT_TO_DVALID, flush_rows, reload_cycles, row_cycles
 
 from ..registers import DURATION_BITS, TIME_BITS, Registers, Source, TriggerMode
 from ..store.layouts import SLOT_BITS
@@ -211,10 +211,10 @@ class FrameControl(wiring.Component):
     def _fits(self, m):
         """A newer frame may replace the waiting one now (:meth:`spec.schedule._Model.fits`):
         the triggers keep no steady pace, or the next one is overdue, or a reload ends first."""
-        # (a pin's ``last`` starts at -1 too, unused until ``measured`` is set)
         dmd, regs, now = self._dmd, self.regs, self.now
         # the periodic timer's pace is known from the start (its first strobe comes
-        # ``period - 1`` cycles in), a pin's after two strobes
+        # ``period - 1`` cycles in), a pin's after two strobes (its ``last`` starts at -1 too,
+        # unused until ``measured`` is set)
         last, measured = Signal(TIME_BITS, init=2**TIME_BITS - 1), Signal(TIME_BITS)
         seen = Signal()
         with m.If(self.strobe & self.running):
@@ -228,7 +228,7 @@ class FrameControl(wiring.Component):
         bound = Signal(TIME_BITS)
         m.d.comb += [
             row_period.eq(Mux(regs.row_period > R, regs.row_period, R)),
-            bound.eq((flush_rows(dmd) + dmd.rows) * row_period + regs.reload_lead + dmd.blocks + 1 + 2 * R),
+            bound.eq(reload_cycles(dmd, self._beats, row_period, regs.reload_lead)),
         ]
         due = last + interval
         fits = Signal()

@@ -15,7 +15,6 @@ from .interface import BlockMode, RowMode
 __all__ = ["group_bits", "block_bits", "load_job", "ready_load", "event", "Command", "Status", "COUNTER_BITS"]
 
 
-
 def group_bits(dmd):
     return max(1, ceil_log2(dmd.blocks))
 
