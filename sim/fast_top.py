@@ -241,6 +241,8 @@ class FastSystem(wiring.Component):
             p_REFRESH_INTERVAL_NS=t.refresh_interval_s * 1e9, p_REFRESH_NS=t.refresh_s * 1e9,
             i_clk=Cat(ClockSignal("sync"), ClockSignal("dmd")),
             o_fault=self.mcb_fault, o_stalls=self.mcb_stalls,
+            # unread, but Verilator warns of an output left out of the instance (PINMISSING)
+            o_calib_losses=Signal(32, name="mcb_calib_losses"),
             **connections)
 
     def _clocks_and_resets(self, m):

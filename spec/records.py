@@ -176,6 +176,8 @@ SYSTEM_STATUS = [
     ("rst_active_late", 32),   # RST_ACTIVE fell later than planned: the settle counted from its fall
     ("rst_active_faults", 32), # RST_ACTIVE did not rise after a pulse, or stayed high far too long
     ("dlpc410_restarts", 32),  # the DLPC410 initialised again mid-run (INIT_ACTIVE high again, ECP2_FINISHED low)
+    ("store_calibration_losses", 32),  # the DDR2 lost its calibration: every stored frame forgotten
+    ("store_frames_lost", 32),         # frames forgotten (stored, arriving or held) when the DDR2 was lost
 ]
 
 #: Status reply body (after :data:`HEADER`).

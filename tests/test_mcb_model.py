@@ -211,3 +211,102 @@ def test_random_stalls_slow_it_down():
     calm = run(McbTiming())
     stalled = run(McbTiming(stall_chance=0.5, stall_max_s=1e-6))
     assert stalled > calm * 1.5
+
+
+
+LOSS_AT, LOSS_S = 5e-6, 2e-6
+
+
+def lost_and_regained(**model_args):
+    """A port that wrote 8 words at 0x100, then lost the calibration at ``LOSS_AT`` with a word
+    in its write FIFO and a read under way (words in the read FIFO and on their way), and waited
+    until calibrated again; its FIFOs stay empty meanwhile."""
+    model = McbModel(1 << 16, timing=McbTiming(calib_lost_at_s=LOSS_AT, calib_lost_s=LOSS_S), **model_args)
+    clk = PortDriver(model)
+    clk.until_calibrated()
+    data = [0x0123456789ABCDEF * (i + 1) & (2**64 - 1) for i in range(8)]
+    clk.write(0x100, data)
+    assert clk.read(0x100, 8) == data                   # before the loss, as always
+    while (clk.cycle + 20) * clk.period < LOSS_AT:
+        clk.tick()
+    clk.tick(cmd_en=1, cmd_instr=READ, cmd_bl=63, cmd_byte_addr=0x400)
+    clk.tick(wr_en=1, wr_data=1)
+    while clk.port.outputs["calib_done"]:
+        before = clk.port.outputs
+        clk.tick()
+    assert before["wr_count"] == 1 and before["rd_count"] > 0
+    lost = clk.cycle
+    assert model.calib_losses == 1
+    while not clk.port.outputs["calib_done"]:
+        out = clk.tick()
+        for name, value in dict(cmd_empty=1, wr_empty=1, wr_count=0, rd_empty=1, rd_count=0).items():
+            assert out[name] == value, name
+    assert (clk.cycle - lost) * clk.period == pytest.approx(LOSS_S, abs=clk.period)
+    return model, clk, data
+
+
+def test_calibration_lost_and_regained():
+    """The port is reset (FIFOs empty, the read under way gone for good), the memory garbage."""
+    model, clk, _data = lost_and_regained()
+    for _ in range(200):                                # nothing of the lost read arrives
+        assert clk.tick()["rd_empty"]
+    assert int(model.memory[0x100 // 8]) == 0xDEAD_0000_0000_0000 | 0x100 // 8
+    assert model.calib_losses == 1
+
+
+def test_read_of_a_word_lost_with_the_calibration():
+    _model, clk, _data = lost_and_regained()
+    with pytest.raises(McbError) as error:
+        clk.read(0x100, 1)
+    assert error.value.kind == "read_lost"
+
+
+def rewritten():
+    """After the loss: 0x100 written again on a 64-bit port, the low half of 0x200 on a 32-bit
+    one, the high half of 0x300 with a masked 64-bit write."""
+    model, wide, data = lost_and_regained(ports=2, widths=(64, 32))
+    half = PortDriver(model, 1)
+    wide.write(0x100, data[::-1])
+    assert wide.read(0x100, 8) == data[::-1]
+    half.cycle = wide.cycle
+    half.write(0x200, [0x1234_5678])
+    assert half.read(0x200, 1) == [0x1234_5678]
+    wide.cycle = half.cycle
+    wide.write(0x300, [0x0123_4567_89AB_CDEF], masks=[0x0F])     # bytes 4-7 only
+    half.cycle = wide.cycle
+    assert half.read(0x304, 1) == [0x0123_4567]
+    return wide, half
+
+
+def test_words_written_again_after_the_loss():
+    rewritten()
+
+
+@pytest.mark.parametrize("port, address", [(1, 0x204), (0, 0x200), (0, 0x300)])
+def test_words_written_in_part_after_the_loss(port, address):
+    """The bytes not written since the loss are still lost."""
+    drivers = rewritten()
+    driver = drivers[port]
+    driver.cycle = max(d.cycle for d in drivers)
+    with pytest.raises(McbError) as error:
+        driver.read(address, 1)
+    assert error.value.kind == "read_lost"
+
+
+def test_traffic_during_the_calibration_loss():
+    def action(clk):
+        while clk.cycle * clk.period < LOSS_AT + 1e-7:
+            clk.tick()
+        assert not clk.port.outputs["calib_done"]
+        clk.tick(cmd_en=1, cmd_instr=READ, cmd_bl=0, cmd_byte_addr=0)
+    violation("before_calib", action, timing=McbTiming(calib_lost_at_s=LOSS_AT, calib_lost_s=LOSS_S))
+
+
+def test_no_calibration_loss_by_default():
+    model = McbModel(1 << 16)
+    clk = PortDriver(model)
+    clk.until_calibrated()
+    for _ in range(2000):
+        assert clk.tick()["calib_done"]
+    assert clk.read(0x100, 4) == [0] * 4               # never written, not lost: legal
+    assert model.calib_losses == 0 and model.lost is None

@@ -19,9 +19,10 @@ SEQUENCER = {"frames": "frames_shown", "triggers": "triggers", "overruns": "trig
              "underruns": "row_underruns", "bad_frames": "frames_bad_depth",
              "rst_late": "rst_active_late", "rst_faults": "rst_active_faults",
              "restarts": "dlpc410_restarts"}
-#: The store's counters: three reported alone, the row refusals as one sum.
+#: The store's counters: five reported alone, the row refusals as one sum.
 STORE = {"frames_complete": "store_frames_complete", "frames_replaced": "store_frames_replaced",
-         "frames_abandoned": "store_frames_abandoned",
+         "frames_abandoned": "store_frames_abandoned", "calibration_losses": "store_calibration_losses",
+         "frames_lost": "store_frames_lost",
          **{name: "store_rows_refused" for name in ("rows_outside", "rows_stale", "rows_shown",
                                                     "rows_duplicate", "rows_no_slot")}}
 

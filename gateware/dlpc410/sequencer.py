@@ -98,6 +98,10 @@ class Sequencer(wiring.Component):
     release : Out(stream.Signature(SLOT_BITS))
         A slot the sequencer will request no more rows from (every group has moved on to a
         frame in another slot); the store may reuse it once it has answered those requests.
+    store_lost : In(1)
+        The store lost its memory and has not recovered: the groups stop as when the DLPC410
+        restarts (the loads under way dropped, the words owed taken as the store answers them),
+        and start over once it has (what they hold then reads empty: dark).
     status : Out(Status)
     """
 
@@ -124,6 +128,7 @@ class Sequencer(wiring.Component):
             "seed": In(64),
             "reseed": In(1),
             "release": Out(stream.Signature(SLOT_BITS)),
+            "store_lost": In(1),
             "status": Out(Status),
         })
 
@@ -176,7 +181,7 @@ class Sequencer(wiring.Component):
         wiring.connect(m, wiring.flipped(self.frames), planner.frames)
         m.d.comb += [
             planner.rst_active.eq(init.rst_active_synced),
-            control.initialised.eq(init.running),
+            control.initialised.eq(init.running & ~self.store_lost),
             control.strobe.eq(trig.strobe),
             control.reload.eq(self.reload),
             self.at_rest.eq(control.at_rest),

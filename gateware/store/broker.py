@@ -5,6 +5,9 @@ wants a frame offered whenever one is due and the occupancy of a whole slot at o
 keeps one ask outstanding, copies the answered slot's occupancy into a small cache (one byte per
 block), and only then offers the frame, so that the sequencer never sees a frame whose map is not
 yet known.
+
+While the store has lost its memory (``store_lost``) every slot's map reads empty, so that the
+frames the sequencer holds from before play dark and nothing is read for them.
 """
 
 from amaranth import Array, Module, Signal
@@ -39,6 +42,8 @@ class FrameBroker(wiring.Component):
         The sequencer's occupancy lookup ...
     occupancy : Out(ArrayLayout(8, blocks))
         ... answered one cycle later for every block.
+    store_lost : In(1)
+        The store lost its memory: forget every map.
     """
 
     def __init__(self, dmd, *, slots=4):
@@ -50,6 +55,7 @@ class FrameBroker(wiring.Component):
             "frames": Out(stream.Signature(FrameInfo)),
             "occ_slot": In(SLOT_BITS),
             "occupancy": Out(data.ArrayLayout(8, dmd.blocks)),
+            "store_lost": In(1),
         })
 
     def elaborate(self, platform):
@@ -83,6 +89,9 @@ class FrameBroker(wiring.Component):
                 with m.If(self.frames.ready):
                     m.next = "ASK"
 
+        with m.If(self.store_lost):
+            # written last, so this wins over a scan under way
+            m.d.sync += [cache[s][b].eq(0) for s in range(self._slots) for b in range(blocks)]
         for b in range(blocks):
             m.d.sync += self.occupancy[b].eq(cache[self.occ_slot][b])
         return m

@@ -16,6 +16,12 @@ takes every word from the MCB's read FIFO as soon as it is there: that FIFO neve
 
 A request that does not fit the frame (slot beyond the slots, no rows, rows past the last) is
 dropped and counted; it produces no words.
+
+A lost memory (``calib_done`` falls after it rose, or the store says it is ``store_lost``,
+:mod:`gateware.store.recovery`): the MCB has dropped the commands and words in flight, so the
+reader forgets them too (nothing reserved, nothing taken from the port) and answers every word
+still owed beyond those it holds, and every request taken until the store has recovered, with
+zeros; the sequencer is never left waiting for words that will not come.
 """
 
 from amaranth import DomainRenamer, Module, Mux, Signal
@@ -57,6 +63,8 @@ class Reader(wiring.Component):
         MCB port 1; only the read half is used.
     bad_requests : Out(16)
         Requests dropped because they do not fit the frame.
+    store_lost : In(1)
+        The store has lost its contents and not recovered yet (answer with zeros).
     """
 
     def __init__(self, dmd, *, slots=16, fifo_depth=256, domain="dmd", width=128):
@@ -72,6 +80,7 @@ class Reader(wiring.Component):
             "planes": Out(stream.Signature(width)),
             "mcb": Out(mcb.PortSignature(width)),
             "bad_requests": Out(16),
+            "store_lost": In(1),
         })
 
     def elaborate(self, platform):
@@ -81,8 +90,21 @@ class Reader(wiring.Component):
         depth = self._fifo_depth // words        # port words
         port_words_per_row = dmd.words_per_row // words
 
+        # the memory is lost (after it was calibrated): the words owed are answered as zeros
+        calibrated = Signal()
+        with m.If(port.calib_done):
+            m.d.sync += calibrated.eq(1)
+        lost = Signal()
+        zero = Signal()
+        m.d.comb += lost.eq(calibrated & (~port.calib_done | self.store_lost))
+
         m.submodules.fifo = fifo = SyncFIFOBuffered(width=self._width, depth=depth)
-        wiring.connect(m, fifo.r_stream, wiring.flipped(self.planes))
+        owed = Signal(range(depth + dmd.rows * port_words_per_row + 1))     # port words taken, not handed on
+        # the words read before the loss go first (a word offered stays offered), then zeros
+        with m.If(zero & ~fifo.r_stream.valid):
+            m.d.comb += [self.planes.valid.eq(owed != 0), self.planes.payload.eq(0)]
+        with m.Else():
+            wiring.connect(m, fifo.r_stream, wiring.flipped(self.planes))
 
         address = Signal(30)
         remaining = Signal(range(dmd.words_per_plane // words + 1))     # port words
@@ -90,16 +112,26 @@ class Reader(wiring.Component):
         burst = Signal(range(mcb.MAX_BURST + 1))
         m.d.comb += burst.eq(Mux(remaining > mcb.MAX_BURST, mcb.MAX_BURST, remaining))
 
+        request = self.requests.payload
         issue = Signal()
         handed = Signal()
+        accepted = Signal()
         m.d.comb += handed.eq(self.planes.valid & self.planes.ready)
-        m.d.sync += reserved.eq(reserved + Mux(issue, burst, 0) - handed)
+        m.d.sync += [reserved.eq(reserved + Mux(issue, burst, 0) - handed),
+                     owed.eq(owed + Mux(accepted, request.row_count * port_words_per_row, 0)
+                             - (handed & (owed != 0)))]
+        with m.If(lost | zero):
+            m.d.sync += reserved.eq(0)
+        with m.If(lost):
+            m.d.sync += zero.eq(1)
+        with m.Elif((owed == 0) & ~accepted):
+            m.d.sync += zero.eq(0)
 
         # every word in the read FIFO has room in ours (reserved covers it): take it at once
         arriving = fifo.w_stream
         m.d.comb += [
             port.rd_en.eq(port.calib_done & ~port.rd_empty),
-            arriving.valid.eq(port.rd_en),
+            arriving.valid.eq(port.rd_en & ~lost & ~zero),     # (none come: the MCB dropped them)
             arriving.payload.eq(port.rd_data),
             port.cmd_instr.eq(mcb.Instr.READ),
             port.cmd_bl.eq(burst - 1),
@@ -108,23 +140,28 @@ class Reader(wiring.Component):
             port.wr_en.eq(0),
         ]
 
-        request = self.requests.payload
         with m.FSM():
             with m.State("IDLE"):
-                m.d.comb += self.requests.ready.eq(1)
+                # (answering zeros: one request at a time)
+                m.d.comb += self.requests.ready.eq(~zero | (owed == 0))
                 with m.If(self.requests.valid):
                     fits = ((request.slot < self._slots) & (request.row_count != 0)
                             & (request.first_row + request.row_count <= dmd.rows))
                     with m.If(fits):
+                        m.d.comb += accepted.eq(1)
                         m.d.sync += [
                             address.eq(self._map.address(request.slot, request.plane, request.first_row)),
                             remaining.eq(request.row_count * port_words_per_row),
                         ]
                         m.next = "ISSUE"
+                        with m.If(lost | zero):
+                            m.next = "IDLE"            # answered as zeros
                     with m.Else():
                         m.d.sync += self.bad_requests.eq(self.bad_requests + 1)
             with m.State("ISSUE"):
-                with m.If(port.calib_done & ~port.cmd_full & (reserved + burst <= depth)):
+                with m.If(lost):
+                    m.next = "IDLE"                    # the rest of the request is answered as zeros
+                with m.Elif(port.calib_done & ~port.cmd_full & (reserved + burst <= depth)):
                     m.d.comb += issue.eq(1)
                     m.d.sync += [address.eq(address + burst * (words * WORD_BYTES)),
                                  remaining.eq(remaining - burst)]

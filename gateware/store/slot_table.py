@@ -6,6 +6,11 @@ ingest opens and completes, and applies one housekeeping event per cycle: a chan
 (only between rows), a slot written (from the writer), a release or an ask (from the sequencer,
 in their order). The ingest only ever changes FREE and RECEIVING slots, housekeeping only the
 others, so the two never change one slot on the same cycle.
+
+A memory that lost its calibration (``lose``, :mod:`gateware.store.recovery`) holds every row
+back and, between rows, makes the table forget every frame before any other event: each slot
+not shown is freed, and each shown one is marked stale (its words are gone) so that it is freed,
+not put back in a sequence, when the sequencer hands it back. Both are counted as frames lost.
 """
 
 from amaranth import Array, Module, Signal
@@ -80,6 +85,8 @@ class TableCounters(data.Struct):
     :class:`~gateware.store.slots.SlotCounters`."""
     frames_replaced: COUNTER_BITS
     bad_releases: COUNTER_BITS
+    calibration_losses: COUNTER_BITS
+    frames_lost: COUNTER_BITS
 
 
 class SlotTable(wiring.Component):
@@ -110,6 +117,10 @@ class SlotTable(wiring.Component):
         Slots the sequencer hands back (taken before an ask waiting beside them).
     answers : Out(stream.Signature(FrameInfo))
         One answer per ask: the frame the sequencer now holds.
+    lose : In(1)
+        The memory's contents are lost: hold rows back, forget every frame once, answer no ask.
+    forgotten : Out(1)
+        Every frame has been forgotten since ``lose`` rose.
     counters : Out(TableCounters)
     """
 
@@ -124,6 +135,8 @@ class SlotTable(wiring.Component):
             "asks": In(stream.Signature(0)),
             "releases": In(stream.Signature(SLOT_BITS)),
             "answers": Out(stream.Signature(FrameInfo)),
+            "lose": In(1),
+            "forgotten": Out(1),
             "counters": Out(TableCounters),
         })
 
@@ -142,6 +155,7 @@ class SlotTable(wiring.Component):
             m.d.comb += wanted_len.eq(n_slots)
         mode_pending = Signal()
         sequence = Signal()
+        stale = Array(Signal(name=f"stale{s}") for s in range(n_slots))
         m.d.comb += [mode_pending.eq(wanted_len != seq_len), sequence.eq(seq_len != 0)]
 
         self._place(m, t, seq_len, mode_pending, sequence)
@@ -189,7 +203,19 @@ class SlotTable(wiring.Component):
         offered = Signal()
         m.d.sync += offered.eq(self.answers.valid & ~self.answers.ready)
         released = self.releases.payload
-        with m.If(mode_pending & self.placement.between_rows & ~offered):
+        with m.If(~self.lose):
+            m.d.sync += self.forgotten.eq(0)
+        with m.If(self.lose & ~self.forgotten & self.placement.between_rows & ~offered):
+            m.d.sync += [self.forgotten.eq(1), t.recv_active.eq(0), t.last_valid.eq(0),
+                         count.calibration_losses.eq(count.calibration_losses + 1),
+                         count.frames_lost.eq(count.frames_lost
+                                              + sum(state[s] != SlotState.FREE for s in range(n_slots)))]
+            for s in range(n_slots):
+                with m.If(state[s] == SlotState.SHOWN):
+                    m.d.sync += stale[s].eq(1)
+                with m.Else():
+                    m.d.sync += state[s].eq(SlotState.FREE)
+        with m.Elif(mode_pending & self.placement.between_rows & ~offered):
             m.d.sync += [seq_len.eq(wanted_len), play.eq(0), t.recv_active.eq(0), t.last_valid.eq(0)]
             for s in range(n_slots):
                 with m.If(state[s] != SlotState.SHOWN):
@@ -208,13 +234,14 @@ class SlotTable(wiring.Component):
                                      count.frames_replaced.eq(count.frames_replaced + 1)]
         with m.Elif(self.releases.valid):
             m.d.comb += self.releases.ready.eq(1)
+            m.d.sync += stale[released].eq(0)
             with m.If(state[released] != SlotState.SHOWN):
                 m.d.sync += count.bad_releases.eq(count.bad_releases + 1)
-            with m.Elif(in_sequence[released] & sequence):
+            with m.Elif(in_sequence[released] & sequence & ~stale[released]):
                 m.d.sync += state[released].eq(SlotState.READY)
             with m.Else():
                 m.d.sync += state[released].eq(SlotState.FREE)
-        with m.Elif(self.asks.valid & can_answer):
+        with m.Elif(self.asks.valid & can_answer & ~self.lose):
             m.d.comb += self.answers.valid.eq(1)
             with m.If(self.answers.ready):
                 m.d.comb += self.asks.ready.eq(1)
@@ -245,7 +272,7 @@ class SlotTable(wiring.Component):
 
         m.d.comb += place.depth.eq(t.depth[place.slot])
         seq_slot = place.frame[:SLOT_BITS]
-        with m.If(mode_pending):
+        with m.If(mode_pending | self.lose):
             verdict(Placement.HOLD)
         with m.Elif(sequence):
             with m.If(place.frame >= seq_len):

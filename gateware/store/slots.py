@@ -58,6 +58,8 @@ class SlotCounters(data.Struct):
     rows_duplicate: COUNTER_BITS      # row already received (overlapping records): refused
     rows_no_slot: COUNTER_BITS        # no slot free (the sequencer holds too many): refused
     bad_releases: COUNTER_BITS        # release of a slot that was not shown
+    calibration_losses: COUNTER_BITS  # the memory lost its calibration: every frame forgotten
+    frames_lost: COUNTER_BITS         # frames (held or not) forgotten when the memory was lost
 
 
 class FrameSlots(wiring.Component):
@@ -82,8 +84,9 @@ class FrameSlots(wiring.Component):
     words, rows, store, bit_depth
         The row ingest's (``sync``): the serialiser's words and row flags in, the accepted words
         to the writer out, the bit depth of frames that start from now on.
-    written, sequence_length
-        The slot table's (``sync``): slots the writer has written, and the mode.
+    written, sequence_length, lose, forgotten
+        The slot table's (``sync``): slots the writer has written, the mode, and the memory's
+        loss (:mod:`gateware.store.recovery`).
     counters : Out(SlotCounters)
         (``sync``).
     ask, frames, release
@@ -95,7 +98,7 @@ class FrameSlots(wiring.Component):
     #: The ports each part gives the whole.
     _PORTS = {
         "ingest": ("words", "rows", "store", "bit_depth"),
-        "table": ("written", "sequence_length"),
+        "table": ("written", "sequence_length", "lose", "forgotten"),
         "crossing": ("ask", "frames", "release"),
         "maps": ("occupancy",),
     }

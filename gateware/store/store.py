@@ -5,14 +5,19 @@ memory controller (port 0 in ``sync`` for writing, 64 bits; port 1 in ``dmd`` fo
 128 bits). The system top connects ``mcb_write`` and ``mcb_read`` to
 :class:`gateware.platform.mcb_instance.McbInstance`; simulations connect them to
 :mod:`sim.models.mcb`.
+
+A memory that loses its calibration loses every frame (:mod:`.recovery`); ``lost`` tells the
+sequencer's side, which plays what it holds dark and waits for a frame stored after it.
 """
 
 from amaranth import DomainRenamer, Module
 from amaranth.lib import stream, wiring
+from amaranth.lib.cdc import FFSynchronizer
 from amaranth.lib.wiring import Out
 
 from ..compose import forward, members
 from .reader import Reader
+from .recovery import Recovery
 from .slots import FrameSlots
 from .split import Split
 from .writer import Writer
@@ -54,6 +59,9 @@ class Store(wiring.Component):
         The writer's MCB port 0 (``sync``).
     mcb_read : Out(mcb.PortSignature(read_width))
         The reader's MCB port 1 (``dmd``).
+    lost : Out(1)
+        (``dmd``) The memory lost its calibration and the store has not recovered yet: no frame
+        held from before holds its words any more.
     """
 
     #: The reader's ports the store gives as its own.
@@ -67,11 +75,12 @@ class Store(wiring.Component):
         self._writer = Writer(dmd, slots=slots)
         self._reader = Reader(dmd, slots=slots, fifo_depth=fifo_depth, width=read_width)
         super().__init__({
-            **members(self._slots, exclude=("store", "written")),
+            **members(self._slots, exclude=("store", "written", "lose", "forgotten")),
             **members(self._reader, self._READER_PORTS),
             "planes": Out(stream.Signature(64 * self._plane_words)),
             "mcb_write": self._writer.signature.members["mcb"],
             "mcb_read": self._reader.signature.members["mcb"],
+            "lost": Out(1),
         })
 
     def elaborate(self, platform):
@@ -92,4 +101,15 @@ class Store(wiring.Component):
         wiring.connect(m, writer.written, slots.written)
         wiring.connect(m, writer.mcb, wiring.flipped(self.mcb_write))
         wiring.connect(m, reader.mcb, wiring.flipped(self.mcb_read))
+
+        m.submodules.recovery = recovery = Recovery()
+        m.d.comb += [
+            recovery.calib_done.eq(self.mcb_write.calib_done),
+            recovery.forgotten.eq(slots.forgotten),
+            recovery.between_rows.eq(writer.between_rows),
+            slots.lose.eq(recovery.lost),
+            writer.discard.eq(recovery.lost),
+        ]
+        m.submodules.lost_cdc = FFSynchronizer(recovery.lost, self.lost, o_domain="dmd")
+        m.d.comb += reader.store_lost.eq(self.lost)
         return m

@@ -164,6 +164,7 @@ class Projector(wiring.Component):
         wiring.connect(m, broker.ask, store.ask)
         wiring.connect(m, store.frames, broker.offered)
         wiring.connect(m, broker.store_occupancy, store.occupancy)
+        m.d.comb += broker.store_lost.eq(store.lost)
 
         m.submodules.sequencer = seq = DomainRenamer("dmd")(Sequencer(dmd, beats=self._beats,
                                                                       store_words=store_words))
@@ -172,6 +173,7 @@ class Projector(wiring.Component):
         wiring.connect(m, seq.requests, store.requests)
         wiring.connect(m, store.planes, seq.words)
         wiring.connect(m, seq.release, store.release)
+        m.d.comb += seq.store_lost.eq(store.lost)
         wiring.connect(m, seq.pins, wiring.flipped(self.dlpc))
         m.d.comb += [
             seq.trigger_in.eq(self.trigger_in),
@@ -226,6 +228,8 @@ class Projector(wiring.Component):
             status.store_frames_complete.eq(store_counts.frames_complete),
             status.store_frames_replaced.eq(store_counts.frames_replaced),
             status.store_frames_abandoned.eq(store_counts.frames_abandoned),
+            status.store_calibration_losses.eq(store_counts.calibration_losses),
+            status.store_frames_lost.eq(store_counts.frames_lost),
             status.store_rows_refused.eq(sum(store_counts[name] for name in (
                 "rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot"))),
         ]

@@ -25,9 +25,19 @@
 // port's turn), from a xorshift generator seeded by +mcb_stall_seed=S; the memory is busy for
 // everyone meanwhile. `stalls` counts them.
 //
+// Calibration lost (plusargs, never by default): +mcb_calib_lost_at_ns=T loses the calibration
+// at time T (0: never) and regains it +mcb_calib_lost_ns=D later, once per run: calib_done is
+// low from T to T + D on every port. At a port's first edge at or after T, after that edge's
+// inputs, the port is reset as the MCB does: its command, write and read FIFOs, its read words
+// in flight and its command under way are discarded. The first port to see it also loses the
+// memory: every word becomes 64'hDEAD_0000_0000_0000 | its index, and each of its bytes is
+// marked lost until written again (per byte: a masked or 32-bit write covers part of a word).
+// `calib_losses` counts the losses.
+//
 // Rule breaks (the Python model's McbError kinds) print a message and set the port's sticky
-// `fault` code: 1 before_calib, 2 cmd_full, 3 misaligned, 4 out_of_range, 5 data_missing,
-// 6 wr_full, 7 rd_empty, 8 underrun, 9 overflow, 10 bad_instruction.
+// `fault` code: 1 before_calib (also traffic while the calibration is lost), 2 cmd_full,
+// 3 misaligned, 4 out_of_range, 5 data_missing, 6 wr_full, 7 rd_empty, 8 underrun, 9 overflow,
+// 10 bad_instruction, 11 read_lost (a read fetching a byte lost with the calibration).
 module mcb_model #(
     parameter PORTS = 2,
     parameter WORDS = 1 << 21,
@@ -63,11 +73,14 @@ module mcb_model #(
     output wire [PORTS-1:0]     rd_error,
     output wire [PORTS-1:0]     calib_done,
     output wire [4*PORTS-1:0]   fault,
-    output wire [31:0]          stalls
+    output wire [31:0]          stalls,
+    output wire [31:0]          calib_losses
 );
     // the ports write the one memory from their own clocks (behavioural, simulation only)
     /* verilator lint_off MULTIDRIVEN */
     reg [63:0] mem [0:WORDS-1];
+    // per word, one bit per byte: lost with the calibration and not written since
+    reg [7:0] lost [0:WORDS-1];
     /* verilator lint_on MULTIDRIVEN */
 
     // when the memory is free, and when the next refresh is due (ns); shared by the ports
@@ -82,6 +95,13 @@ module mcb_model #(
     /* verilator lint_on MULTIDRIVEN */
     assign stalls = stall_count;
 
+    // calibration loss (shared): when, how long, and whether the memory was lost yet
+    integer lost_at_ns, lost_ns;
+    /* verilator lint_off MULTIDRIVEN */
+    reg [31:0] loss_count;
+    /* verilator lint_on MULTIDRIVEN */
+    assign calib_losses = loss_count;
+
     function automatic [31:0] xorshift(input [31:0] x);
         reg [31:0] y;
         begin
@@ -93,7 +113,7 @@ module mcb_model #(
 
     integer i;
     initial begin
-        for (i = 0; i < WORDS; i = i + 1) mem[i] = 64'd0;
+        for (i = 0; i < WORDS; i = i + 1) begin mem[i] = 64'd0; lost[i] = 8'd0; end
         free_at = 0.0;
         refresh_at = REFRESH_INTERVAL_NS;
         if (!$value$plusargs("mcb_stall_permille=%d", stall_permille)) stall_permille = 0;
@@ -101,6 +121,9 @@ module mcb_model #(
         if (!$value$plusargs("mcb_stall_seed=%d", stall_seed)) stall_seed = 1;
         rng = stall_seed == 0 ? 32'd1 : stall_seed;
         stall_count = 0;
+        if (!$value$plusargs("mcb_calib_lost_at_ns=%d", lost_at_ns)) lost_at_ns = 0;
+        if (!$value$plusargs("mcb_calib_lost_ns=%d", lost_ns)) lost_ns = 0;
+        loss_count = 0;
     end
 
     genvar p;
@@ -132,8 +155,9 @@ module mcb_model #(
         integer words_left, addr, owed;
         real now, next_word_at;
         reg [31:0] cycle;
-        reg calib, bad_write;
+        reg calib, bad_write, saw_loss;
         reg [63:0] word;
+        reg read_lost;
         reg [127:0] port_word;
         integer b, j, k;
         // registered outputs
@@ -161,7 +185,7 @@ module mcb_model #(
         initial begin
             c_head = 0; c_n = 0; w_head = 0; w_n = 0; r_head = 0; r_n = 0; f_head = 0; f_n = 0;
             busy = 0; writing = 0; words_left = 0; addr = 0; owed = 0; next_word_at = 0.0;
-            cycle = 0; calib = 0;
+            cycle = 0; calib = 0; saw_loss = 0;
             o_cmd_full = 0; o_cmd_empty = 1; o_wr_full = 0; o_wr_empty = 1; o_underrun = 0;
             o_rd_full = 0; o_rd_empty = 1; o_overflow = 0; o_calib_done = 0;
             o_wr_count = 0; o_rd_count = 0; o_rd_data = 0; o_fault = 0;
@@ -176,9 +200,10 @@ module mcb_model #(
 
         always @(posedge clk[p]) begin
             cycle = cycle + 1;
+            now = $realtime;
             // -- the fabric side, in the Python model's order: read, command, write word
             if ((cmd_en[p] || wr_en[p] || rd_en[p]) && !calib)
-                break_rule(1, "traffic before calib_done");
+                break_rule(1, "traffic while not calibrated");
             if (rd_en[p]) begin
                 if (r_n == 0) break_rule(7, "rd_en while rd_empty");
                 else begin r_head = (r_head + 1) % 64; r_n = r_n - 1; end
@@ -213,8 +238,20 @@ module mcb_model #(
                     w_n = w_n + 1;
                 end
             end
+            // -- the calibration lost: this edge's inputs go with the rest of the port's state
+            if (lost_at_ns != 0 && !saw_loss && now >= lost_at_ns) begin
+                saw_loss = 1;
+                if (loss_count == 0) begin
+                    for (j = 0; j < WORDS; j = j + 1) begin
+                        mem[j] = 64'hDEAD_0000_0000_0000 | j;
+                        lost[j] = 8'hFF;
+                    end
+                    loss_count = 1;
+                end
+                c_n = 0; w_n = 0; r_n = 0; f_n = 0;
+                busy = 0; owed = 0;
+            end
             // -- the controller side
-            now = $realtime;
             if (!busy && c_n != 0 && cycle >= c_time[c_head] + CMD_WAIT) begin
                 next_word_at = free_at > now ? free_at : now;
                 while (refresh_at <= next_word_at) begin
@@ -245,27 +282,35 @@ module mcb_model #(
                         o_underrun <= 1'b1;
                     end else begin
                         if (W >= 64 && w_mask[w_head] == 0)
-                            for (j = 0; j < W / 64; j = j + 1)
+                            for (j = 0; j < W / 64; j = j + 1) begin
                                 mem[addr / 8 + j] = w_data[w_head][64*j +: 64];
+                                lost[addr / 8 + j] = 8'd0;
+                            end
                         else
                             for (b = 0; b < BYTES; b = b + 1)
                                 if (!w_mask[w_head][b]) begin
                                     word = mem[(addr + b) / 8];
                                     word[8*((addr + b) % 8) +: 8] = w_data[w_head][8*b +: 8];
                                     mem[(addr + b) / 8] = word;
+                                    lost[(addr + b) / 8][(addr + b) % 8] = 1'b0;
                                 end
                         w_head = (w_head + 1) % 64;
                         w_n = w_n - 1;
                         owed = owed - 1;
                     end
                 end else begin
+                    read_lost = 0;
                     if (W >= 64)
-                        for (j = 0; j < W / 64; j = j + 1)
+                        for (j = 0; j < W / 64; j = j + 1) begin
                             port_word[64*j +: 64] = mem[addr / 8 + j];
+                            read_lost = read_lost || lost[addr / 8 + j] != 8'd0;
+                        end
                     else begin
                         word = mem[addr / 8];
                         port_word = {96'd0, word[32*((addr / 4) % 2) +: 32]};
+                        read_lost = lost[addr / 8][4*((addr / 4) % 2) +: 4] != 4'd0;
                     end
+                    if (read_lost) break_rule(11, "read of a word lost with the calibration");
                     k = (f_head + f_n) % 64;
                     f_data[k] = port_word;
                     f_time[k] = next_word_at + READ_LATENCY_NS;
@@ -287,7 +332,8 @@ module mcb_model #(
                 f_head = (f_head + 1) % 64;
                 f_n = f_n - 1;
             end
-            if (cycle >= CALIB) calib = 1;
+            calib = cycle >= CALIB
+                    && !(lost_at_ns != 0 && now >= lost_at_ns && now < lost_at_ns + lost_ns);
             // -- registered outputs for the next cycle
             o_cmd_full <= c_n >= 4;
             o_cmd_empty <= c_n == 0;

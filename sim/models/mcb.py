@@ -22,6 +22,17 @@ the memory; written words leave the write FIFO one per word time. Every ``refres
 ``calib_done`` rises ``calib_delay_s`` after time 0. With ``stall_chance`` > 0, a command waits
 up to ``stall_max_s`` more before it starts, at random (seeded): stalls at unpredictable times.
 
+Calibration lost
+----------------
+With ``calib_lost_at_s`` set, the calibration is lost at that time and regained
+``calib_lost_s`` later (once per run): ``calib_done`` is low in between on every port. At a
+port's first edge at or after the loss, after that edge's inputs, the port is reset as the MCB
+does: its command, write and read FIFOs, its read words in flight and its command under way are
+discarded. The first port to see it also loses the memory: every 64-bit word becomes
+``0xDEAD << 48 | word index`` and its bytes are marked lost until written again
+(``calib_losses`` counts the losses). Until a port has seen the loss, the memory moves none of
+its words (as in the Verilog model, where a port's words move only at its own edges).
+
 Errors
 ------
 :class:`McbError` (with a ``kind``) is raised on: traffic before ``calib_done``
@@ -32,7 +43,8 @@ multiple of the port's word (4, 8 or 16 bytes) or a burst outside the memory (``
 pushed while ``wr_full`` (``wr_full``), a read word taken while ``rd_empty`` (``rd_empty``), the
 controller finding the write FIFO empty during a write (``underrun``, reachable only with
 ``check_write_data=False``, as the real MCB does not check at push time), read data arriving at
-a full read FIFO (``overflow``).
+a full read FIFO (``overflow``), a read fetching a byte lost with the calibration and not written
+since (``read_lost``). Traffic while ``calib_done`` is low after a loss is ``before_calib`` too.
 """
 
 import random
@@ -73,6 +85,17 @@ class McbTiming:
     refresh_s: float = 160e-9
     stall_chance: float = 0.0           # chance that a command waits a random extra time first
     stall_max_s: float = 0.0            # (bank conflicts, the other port's turn, ...)
+    calib_lost_at_s: float | None = None    # the calibration is lost at this time (None: never)
+    calib_lost_s: float = 0.0           # and regained this much later
+
+    def calib_lost(self, now):
+        """Whether the calibration is lost at time ``now``."""
+        at = self.calib_lost_at_s
+        return at is not None and at <= now < at + self.calib_lost_s
+
+    def loss_due(self, now):
+        """Whether the loss has happened by time ``now``."""
+        return self.calib_lost_at_s is not None and now >= self.calib_lost_at_s
 
     @property
     def byte_s(self):
@@ -113,9 +136,35 @@ class McbModel:
         self._next_port = 0
         #: every word written, as (byte address, port): to check nothing was written outside
         self.write_log = []
+        #: per byte, lost with the calibration and not written since (None until a loss)
+        self.lost = None
+        self.calib_losses = 0
+        #: callables that wake adapters resting on quiet ports (:meth:`lose_calibration`)
+        self.wakers = []
 
     def calibrated(self, now):
-        return now >= self.timing.calib_delay_s
+        return now >= self.timing.calib_delay_s and not self.timing.calib_lost(now)
+
+    def lose_calibration(self, at_s, for_s):
+        """Lose the calibration at time ``at_s`` (the ports' time, ahead of every port's last
+        edge), for ``for_s``: a loss decided during a run. Adapters resting on a quiet port are
+        woken (``wakers``) so that every port sees ``calib_done`` fall."""
+        self.timing.calib_lost_at_s = at_s
+        self.timing.calib_lost_s = for_s
+        for port in self.ports:
+            port._quiet = False
+        for wake in self.wakers:
+            wake()
+
+    def lose_memory(self):
+        """The calibration is lost: every word takes a garbage value, every byte is lost."""
+        self.memory[:] = np.uint64(0xDEAD << 48) | np.arange(len(self.memory), dtype="<u8")
+        self.lost = np.ones(self.memory_bytes, dtype=bool)
+        self.calib_losses += 1
+
+    def _frozen(self, port):
+        # lost the memory, but the port has not seen the loss yet: its work waits to be discarded
+        return self.lost is not None and not port.saw_loss
 
     def _next_command(self):
         """(start time, port) of the next command the arbiter would grant, or (inf, None)."""
@@ -123,7 +172,7 @@ class McbModel:
         n = len(self.ports)
         for k in range(n):
             port = self.ports[(self._next_port + k) % n]
-            if port.commands:
+            if port.commands and not self._frozen(port):
                 ready = max(self.busy_until, port.commands[0][0] + self.timing.command_latency_s)
                 if ready < best:
                     best, chosen = ready, port
@@ -152,7 +201,8 @@ class McbModel:
             self._next_port = (port.index + 1) % len(self.ports)
             self._execute(port, start, *port.commands.popleft()[1:])
         for port in self.ports:
-            port._deliver(now)
+            if not self._frozen(port):
+                port._deliver(now)
         self.now = now
 
     def read_word(self, address, size):
@@ -164,10 +214,18 @@ class McbModel:
         new = data.to_bytes(size, "little")
         if not mask:
             self._bytes[address:address + size] = np.frombuffer(new, np.uint8)
+            if self.lost is not None:
+                self.lost[address:address + size] = False
             return
         for i in range(size):
             if not mask >> i & 1:
                 self._bytes[address + i] = new[i]
+                if self.lost is not None:
+                    self.lost[address + i] = False
+
+    def is_lost(self, address, size):
+        """Whether any of the ``size`` bytes from byte ``address`` was lost and not written since."""
+        return self.lost is not None and bool(self.lost[address:address + size].any())
 
     def _execute(self, port, start, instr, words, address):
         t = self.timing
@@ -207,6 +265,7 @@ class McbPort:
         self.underrun = self.overflow = False
         self.words_written = self.words_read = 0
         self.command_log = []        # (instr, words, byte address) of every command taken
+        self.saw_loss = False        # the calibration loss reached this port
         self.outputs = self._outputs(0.0)
         self._quiet = False
 
@@ -231,6 +290,9 @@ class McbPort:
                     self.overflow = True
                     raise McbError("overflow", f"port {self.index}: read data arrived at a full read FIFO "
                                                f"(byte address {address:#x})")
+                if model.is_lost(address, self.word_bytes):
+                    raise McbError("read_lost", f"port {self.index}: read of a word lost with the "
+                                                f"calibration (byte address {address:#x})")
                 self.read_fifo.append(model.read_word(address, self.word_bytes))
                 self.words_read += 1
 
@@ -242,7 +304,7 @@ class McbPort:
         there. Returns the outputs for the next cycle (a dict)."""
         seen = self.outputs
         if (cmd_en or wr_en or rd_en) and not seen["calib_done"]:
-            raise McbError("before_calib", f"port {self.index}: traffic before calib_done")
+            raise McbError("before_calib", f"port {self.index}: traffic while not calibrated")
         if rd_en:
             if seen["rd_empty"]:
                 raise McbError("rd_empty", f"port {self.index}: rd_en while rd_empty")
@@ -253,10 +315,26 @@ class McbPort:
             if seen["wr_full"]:
                 raise McbError("wr_full", f"port {self.index}: wr_en while wr_full")
             self.write_fifo.append((wr_data & self._data_mask, wr_mask & ((1 << self.word_bytes) - 1)))
+        if not self.saw_loss and self.model.timing.loss_due(now):
+            self._lose()
         self.model.advance(now)
         self.outputs = self._outputs(now)
-        self._quiet = bool(self.outputs["calib_done"]) and self.idle()
+        # a loss still to come changes the outputs without a strobe
+        self._quiet = (bool(self.outputs["calib_done"]) and self.idle()
+                       and (self.saw_loss or self.model.timing.calib_lost_at_s is None))
         return self.outputs
+
+    def _lose(self):
+        """The port's first edge at or after the calibration loss: reset as the MCB does (this
+        edge's inputs, already taken, go with the rest)."""
+        self.saw_loss = True
+        if self.model.lost is None:
+            self.model.lose_memory()
+        self.commands.clear()
+        self.write_fifo.clear()
+        self.read_fifo.clear()
+        self.events.clear()
+        self.claimed = self.draining = 0
 
     def _command(self, now, instr, bl, address, seen):
         model = self.model
@@ -395,9 +473,11 @@ class CocotbPort:
         return values
 
     async def run(self):
-        from cocotb.triggers import First, RisingEdge
+        from cocotb.triggers import Event, First, RisingEdge
         from cocotb.utils import get_sim_steps, get_sim_time
         edge = RisingEdge(self.clock_signal)
+        wake = Event()
+        self.model.model.wakers.append(wake.set)
         strobes = [self.inputs[name].value_change for name in ("cmd_en", "wr_en", "rd_en")]
         period = get_sim_steps(self.period_ns, "ns")
         await edge
@@ -407,7 +487,8 @@ class CocotbPort:
             if not (inputs["cmd_en"] or inputs["wr_en"] or inputs["rd_en"]) and self.model.quiet():
                 # a Python call per edge of an idle port is most of a long run's time: none until
                 # a strobe changes, then the edges again from the next, numbered from the time
-                await First(*strobes)
+                await First(*strobes, wake.wait())
+                wake.clear()
                 await edge
                 steps = get_sim_time("step") - first
                 assert steps % period == 0, "the port's clock is not periodic"

@@ -5,19 +5,22 @@
 function on both models. It follows the port's rules (write data before its command, no push
 while full, read commands only when the read FIFO has room for every word in flight) and keeps
 the words it read. :data:`CASES` are scripts that each break one rule, named by the Python
-model's :class:`~sim.models.mcb.McbError` kind, for a port of a given width.
+model's :class:`~sim.models.mcb.McbError` kind, for a port of a given width. :class:`LossClient`
+runs a port through a calibration loss (:data:`LOSS_CASES`).
 """
 
 import random
 
-from sim.models.mcb import FIFO_DEPTH, READ, WRITE, McbError, McbModel
+from sim.models.mcb import FIFO_DEPTH, READ, WRITE, McbError, McbModel, McbTiming
 
 __all__ = ["Client", "traffic", "writes", "reads", "python_reads", "python_fault", "CASES", "FAULTS",
-           "PERIODS_S", "WIDTHS"]
+           "PERIODS_S", "WIDTHS", "LossClient", "LOSS_CASES", "LOSS_AT_NS", "LOSS_NS", "loss_plusargs",
+           "python_loss"]
 
 #: ``mcb_model.v`` fault codes -> the Python model's error kinds.
 FAULTS = {1: "before_calib", 2: "cmd_full", 3: "misaligned", 4: "out_of_range", 5: "data_missing",
-          6: "wr_full", 7: "rd_empty", 8: "underrun", 9: "overflow", 10: "bad_instruction"}
+          6: "wr_full", 7: "rd_empty", 8: "underrun", 9: "overflow", 10: "bad_instruction",
+          11: "read_lost"}
 #: The port clock periods and widths the Verilog model's default parameters stand for (the
 #: store's: a 64-bit writer port, a 128-bit reader port).
 PERIODS_S = (8e-9, 5e-9)
@@ -154,3 +157,114 @@ CASES = {
     "cmd_full": lambda width: _after_calib(*[_read(64 * width // 8 * i, 64) for i in range(8)]),
     "overflow": lambda width: _after_calib(_read(0, 64), _read(64 * width // 8, 64)),
 }
+
+
+#: The calibration loss of :class:`LossClient`'s runs: at 3 us for 1 us, well after both ports
+#: calibrated and filled their FIFOs at either model's clock periods.
+LOSS_AT_NS, LOSS_NS = 3000, 1000
+#: What :class:`LossClient` does once calibrated again (or during the loss), and the rule each
+#: breaks (None: none).
+LOSS_CASES = {"read_lost": "read_lost", "rewrite": None, "before_calib": "before_calib"}
+#: The outputs that show a port's FIFOs.
+FIFO_OUTPUTS = ("cmd_empty", "wr_empty", "wr_count", "rd_empty", "rd_count")
+
+
+def loss_plusargs():
+    """The Verilog model's plusargs for :data:`LOSS_AT_NS` and :data:`LOSS_NS`."""
+    return [f"+mcb_calib_lost_at_ns={LOSS_AT_NS}", f"+mcb_calib_lost_ns={LOSS_NS}"]
+
+
+class LossClient:
+    """A port through a calibration loss: once calibrated, writes two port words at ``address``,
+    then leaves words in its FIFOs (three write words with no command, the two words read back
+    not taken) and waits for the loss. It keeps its FIFO outputs of the last edge before the
+    loss (``before``) and of the first calibrated one after it (``after``), then does ``case``
+    (:data:`LOSS_CASES`): ``read_lost`` reads the words written before the loss, ``rewrite``
+    writes them again and reads them back (into ``read``), ``before_calib`` sends a read
+    command while ``calib_done`` is low. ``step(outputs) -> inputs`` on either model."""
+
+    def __init__(self, case, width, address=0):
+        assert case in LOSS_CASES, case
+        self.case, self.width, self.address = case, width, address
+        self.data = [(0x0123_4567_89AB_CDEF_FEDC_BA98_7654_3210 * (i + 1)) & ((1 << width) - 1) for i in range(2)]
+        self.new = [d ^ ((1 << width) - 1) for d in self.data]
+        self.stale = int("A5" * (width // 8), 16)     # the words left in the write FIFO
+        self.before = self.after = None
+        self.read = []
+        self._finished = False
+        self._script = self._run()
+        next(self._script)
+
+    def step(self, out):
+        return self._script.send(out)
+
+    def done(self):
+        return self._finished
+
+    def _write(self, words):
+        for word in words:
+            yield {"wr_en": 1, "wr_data": word}
+        return (yield {"cmd_en": 1, "cmd_instr": WRITE, "cmd_bl": len(words) - 1, "cmd_byte_addr": self.address})
+
+    def _read(self, words):
+        out = yield {"cmd_en": 1, "cmd_instr": READ, "cmd_bl": words - 1, "cmd_byte_addr": self.address}
+        got = []
+        while len(got) < words:
+            if out["rd_empty"]:
+                out = yield {}
+            else:
+                got.append(out["rd_data"])
+                out = yield {"rd_en": 1}
+        return out, got
+
+    def _run(self):
+        out = yield
+        while not out["calib_done"]:
+            out = yield {}
+        out = yield from self._write(self.data)
+        while not (out["cmd_empty"] and out["wr_empty"]):
+            out = yield {}
+        # words left in the FIFOs for the loss to take
+        out = yield {"cmd_en": 1, "cmd_instr": READ, "cmd_bl": 1, "cmd_byte_addr": self.address}
+        for _ in range(3):
+            out = yield {"wr_en": 1, "wr_data": self.stale}
+        while out["calib_done"]:
+            self.before = {name: out[name] for name in FIFO_OUTPUTS}
+            out = yield {}
+        if self.case == "before_calib":
+            out = yield {"cmd_en": 1, "cmd_instr": READ, "cmd_bl": 0, "cmd_byte_addr": self.address}
+        while not out["calib_done"]:
+            out = yield {}
+        self.after = {name: out[name] for name in FIFO_OUTPUTS}
+        if self.case == "read_lost":
+            out, self.read = yield from self._read(2)
+        elif self.case == "rewrite":
+            out = yield from self._write(self.new)
+            while not (out["cmd_empty"] and out["wr_empty"]):
+                out = yield {}
+            out, self.read = yield from self._read(2)
+        self._finished = True
+        while True:
+            yield {}
+
+
+def python_loss(case, port):
+    """(error kind or None, client, model) of :class:`LossClient` ``case`` on ``port`` of the
+    Python model with the loss of :data:`LOSS_AT_NS` and :data:`LOSS_NS`."""
+    timing = McbTiming(calib_lost_at_s=LOSS_AT_NS * 1e-9, calib_lost_s=LOSS_NS * 1e-9)
+    model = McbModel(WORDS * 8, widths=WIDTHS, timing=timing)
+    client = LossClient(case, WIDTHS[port], address=port << 16)
+    outputs = model.ports[port].outputs
+    try:
+        for cycle in range(1, 3000):
+            outputs = model.ports[port].clock(cycle * PERIODS_S[port], **client.step(outputs))
+            if client.done():
+                break
+        for _ in range(100):            # words still on their way
+            cycle += 1
+            model.ports[port].clock(cycle * PERIODS_S[port])
+    except McbError as error:
+        return error.kind, client, model
+    assert client.done(), "the client did not finish on the Python model"
+    assert model.calib_losses == 1
+    return None, client, model

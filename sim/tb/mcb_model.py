@@ -3,7 +3,8 @@
 The same client (:class:`sim.models.mcb_client.Client`) runs on both, with the model's default
 ports (64 bits on port 0, 128 on port 1): the words it reads back must agree. Scripted rule
 breaks, one per port and run (the Verilog fault code is sticky), must give the rule the Python
-model names.
+model names; so must a calibration loss (:class:`sim.models.mcb_client.LossClient`), with the
+same FIFOs before and after it and the same words read back.
 """
 
 import cocotb
@@ -108,3 +109,32 @@ async def scripted_rule_breaks(dut):
         want = mcb_client.python_fault(mcb_client.CASES[name](widths[port]), port)
         assert want == name, f"the Python model says {want} for case {name}"
         assert ports.fault(port) == want, f"port {port}: Verilog says {ports.fault(port)}, Python {want}"
+
+
+@cocotb.test()
+async def calibration_loss(dut):
+    """A loss case per port (plusargs: :func:`sim.models.mcb_client.loss_plusargs`), each
+    against the Python model's run of it: same rule broken, FIFOs, words read back (the lost
+    words' garbage too)."""
+    p = params()
+    ports = await start(dut)
+    widths = mcb_client.WIDTHS
+    clients = [mcb_client.LossClient(name, widths[port], address=port << 16) for port, name in enumerate(p["case"])]
+    await run_ports(dut, ports, [c.step for c in clients], 2000)
+    assert int(dut.calib_losses.value) == 1
+    for port, (name, client) in enumerate(zip(p["case"], clients, strict=True)):
+        want, reference, model = mcb_client.python_loss(name, port)
+        assert want == mcb_client.LOSS_CASES[name], f"the Python model says {want} for case {name}"
+        assert ports.fault(port) == want, f"port {port}: Verilog says {ports.fault(port)}, Python {want}"
+        assert client.before == reference.before, \
+            f"port {port}: before the loss {client.before}, Python {reference.before}"
+        if name != "before_calib":       # the Python run stops at the rule break, the Verilog one goes on
+            assert client.after == reference.after, \
+                f"port {port}: after the loss {client.after}, Python {reference.after}"
+        if name == "rewrite":
+            assert client.done() and client.read == reference.read == client.new, \
+                f"port {port}: read back {client.read}, Python {reference.read}"
+        if name == "read_lost":
+            size = widths[port] // 8
+            garbage = [model.read_word(client.address + i * size, size) for i in range(2)]
+            assert client.read == garbage, f"port {port}: read {client.read}, the Python model holds {garbage}"

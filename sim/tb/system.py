@@ -16,7 +16,9 @@ its own ledger of what the MAC, the sequencer and the store must have counted.
 Faults during the run: frames with a bad FCS, frames for another UDP port and malformed records
 (each class the parser drops) interleaved with the scene; a trigger while disarmed; a burst of
 triggers faster than the frame rate; a new register set while a frame plays; a frame with a
-lost record, then a whole one. Every frame shown must be a whole, correct frame.
+lost record, then a whole one; the DDR2 losing its calibration while a frame plays (that frame
+goes on dark, the next trigger shows dark, the next frame sent is shown). Every other frame shown
+must be a whole, correct frame.
 """
 
 import json
@@ -266,7 +268,7 @@ async def frames_over_gmii_are_shown_exactly(dut):
     await system.start()
     dmd = system.dmd
     faults = p.get("faults", True)
-    count = p["frames"] + (4 if faults else 0)
+    count = p["frames"] + (5 if faults else 0)
     if p.get("scene"):
         images = default_scene(count, dmd.rows, dmd.columns)
     else:
@@ -276,7 +278,7 @@ async def frames_over_gmii_are_shown_exactly(dut):
     wall0 = time.monotonic()
     report = {"frames": [], "period_cycles": system.plan.frame_cycles, "rate_hz": system.plan.rate_hz,
               "lsb_cycles": system.plan.params.lsb}
-    expect = {"triggers": 0, "trigger_overruns": 0, "registers_applied": 0}
+    expect = {"triggers": 0, "trigger_overruns": 0, "registers_applied": 0, "frames_cut": 0}
 
     def encoded(index, *, interleave=True, lose=None):
         """Frame ``index``'s datagrams, with bad ones between them; ``lose``: a record left out."""
@@ -292,9 +294,10 @@ async def frames_over_gmii_are_shown_exactly(dut):
             frames[3:3] = [system.datagram(r) for r in bad_records(system, images[index])]
         return frames, bad_fcs
 
-    async def show(index, plan, *, sending=None, burst=0):
-        """Trigger, and check that the camera sees frame ``index`` exactly under ``plan``;
-        ``sending``: frames to send meanwhile; ``burst``: extra triggers while it plays."""
+    async def show(index, plan, *, sending=None, burst=0, dark=False):
+        """Trigger, and check that the camera sees frame ``index`` exactly under ``plan`` (or
+        nothing: ``dark``); ``sending``: frames to send meanwhile; ``burst``: extra triggers
+        while it plays."""
         period = plan.frame_cycles
         pin = await system.trigger()
         expect["triggers"] += 1
@@ -310,13 +313,14 @@ async def frames_over_gmii_are_shown_exactly(dut):
             raise AssertionError(f"frame {index}: the trigger produced no clocking pulse; sequencer {counters}")
         first = pulses[0].cycle
         light = to_lsb(Camera(system.dlpc, ramp_cycles=0).image(first, first + period), plan.params.lsb)
-        error = np.abs(light - images[index].astype(np.float64))
-        report["frames"].append({"index": index, "latency_cycles": first - pin, "max_error_lsb": float(error.max())})
+        error = np.abs(light - (0 if dark else images[index].astype(np.float64)))
+        report["frames"].append({"index": index, "latency_cycles": first - pin, "max_error_lsb": float(error.max()),
+                                 "dark": dark})
         dut._log.info("frame %d: trigger to first pulse %d cycles, max error %.3g LSB", index, first - pin,
                       error.max())
         if error.max() >= 1e-9:     # what the store made of the rows, to say why
             matches = [j for j, other in enumerate(images) if np.abs(light - other).max() < 1e-9]
-            dut._log.info("store counters %s", unpack(SlotCounters, int(dut.store.counters.value)))
+            dut._log.info("store counters %s", unpack(SlotCounters, int(dut.counters.value)))
             raise AssertionError(f"frame {index}: {int((error > 1e-9).sum())} pixels wrong; the image shown "
                                  f"equals sent frame(s) {matches}; period {period}, send ended at dmd cycle "
                                  f"{system.sent_at}, pulses {[(c.cycle, c.kind) for c in pulses[:3]]}")
@@ -359,6 +363,22 @@ async def frames_over_gmii_are_shown_exactly(dut):
         # ... until a newer whole frame comes
         await system.deliver(*encoded(n + 3, interleave=False))
         await show(n + 3, later)
+        # the DDR2 loses its calibration a third into a frame and regains it 5 us later: the
+        # frame goes on dark, and every frame is forgotten (the model raises on any word read
+        # of the lost memory); the next trigger shows the frame held dark, and a frame sent
+        # after the memory is back is shown exactly
+        pin = await system.trigger()
+        expect["triggers"] += 1
+        expect["frames_cut"] += 1
+        await system.dmd_clock.cycles(later.frame_cycles // 3)
+        system.memory.lose_calibration(_now_ps() * 1e-12 + 100e-9, 5e-6)
+        await system.dmd_clock.cycles(later.frame_cycles)
+        assert system.memory.calib_losses == 1
+        await show(n + 3, later, dark=True)
+        await system.deliver(*encoded(n + 4, interleave=False))
+        # (the triggers' pace is broken first: the frame is taken at once, not at the trigger after)
+        await system.dmd_clock.cycles(later.frame_cycles)
+        await show(n + 4, later)
 
     # ---- the status reply: every counter as the test's ledger and the reference model say ----
     status = await system.status()
@@ -367,7 +387,7 @@ async def frames_over_gmii_are_shown_exactly(dut):
         assert status[name] == system.net.counters[name], (name, status[name], system.net.counters[name])
     for verdict in ("good", "bad_fcs"):
         assert status[f"mac_{verdict}"] == system.mac[verdict], (verdict, status[f"mac_{verdict}"])
-    shown = len(report["frames"])
+    shown = len(report["frames"]) + expect["frames_cut"]
     assert status["frames_shown"] == shown and status["triggers"] == expect["triggers"] == shown
     assert status["trigger_overruns"] == expect["trigger_overruns"]
     assert status["registers_applied"] == expect["registers_applied"] and status["registers_superseded"] == 0
@@ -376,6 +396,9 @@ async def frames_over_gmii_are_shown_exactly(dut):
         assert status[name] == 0, (name, status[name])
     assert status["store_frames_abandoned"] == (1 if faults else 0)
     assert status["store_frames_complete"] == count - (1 if faults else 0)
+    # the loss: the frame held, the one it was about to take (the same) ... every slot in use
+    assert status["store_calibration_losses"] == (1 if faults else 0)
+    assert status["store_frames_lost"] == (1 if faults else 0), status["store_frames_lost"]
     assert status["dlpc410_state"] & 0b1001 == 0b1000, "DLPC410 initialised and memory calibrated"
     assert status["clock_hz"] == 125_000_000
     report["wall_s"] = time.monotonic() - wall0
