@@ -13,10 +13,10 @@ when every group is loaded and waits; otherwise it is an overrun (or early, befo
 run).
 
 A controller that initialises again (``initialised`` falls: INIT_ACTIVE high again, or
-ECP2_FINISHED low) has lost the DMD's memory: ``RESTART`` stops every pulse and load, drops the
-loads under way as ``FLUSH`` does, and once the controller is ready again every group starts
-over from its first plane (of the newest frame) as after a reload, no sooner than
-``init_to_dvalid`` clocks later; the groups then wait for a trigger.
+ECP2_FINISHED low; or the store lost its memory) has lost the DMD's memory: ``RESTART`` stops
+every pulse and load, drops the loads under way as ``FLUSH`` does, and once the controller is
+ready again every group starts over from its first plane (of the newest frame) as after a
+reload, no sooner than ``init_to_dvalid`` clocks later; the groups then wait for a trigger.
 """
 
 from amaranth import Module, Mux, Signal
@@ -49,7 +49,8 @@ class FrameControl(wiring.Component):
     now : In(TIME_BITS)
     n_groups : In(range(blocks + 1))
     initialised : In(1)
-        The DLPC410 is initialised (it may fall again: the controller restarts).
+        The DLPC410 is initialised and the store holds its frames (it may fall again: the
+        controller restarts, or the DDR2 loses its calibration).
     strobe : In(1)
         A trigger (from :class:`~gateware.dlpc410.trigger.Trigger`).
     reload : In(1)

@@ -17,11 +17,11 @@ takes every word from the MCB's read FIFO as soon as it is there: that FIFO neve
 A request that does not fit the frame (slot beyond the slots, no rows, rows past the last) is
 dropped and counted; it produces no words.
 
-A lost memory (``calib_done`` falls after it rose, or the store says it is ``store_lost``,
-:mod:`gateware.store.recovery`): the MCB has dropped the commands and words in flight, so the
-reader forgets them too (nothing reserved, nothing taken from the port) and answers every word
-still owed beyond those it holds, and every request taken until the store has recovered, with
-zeros; the sequencer is never left waiting for words that will not come.
+A lost memory (``store_lost``, from :mod:`gateware.store.recovery`): the MCB has dropped the
+commands and words in flight, so the reader forgets them too (nothing reserved, nothing taken
+from the port) and answers every word still owed beyond those it holds, and every request taken
+until the store has recovered, with zeros; the sequencer is never left waiting for words that
+will not come.
 """
 
 from amaranth import DomainRenamer, Module, Mux, Signal
@@ -90,13 +90,9 @@ class Reader(wiring.Component):
         depth = self._fifo_depth // words        # port words
         port_words_per_row = dmd.words_per_row // words
 
-        # the memory is lost (after it was calibrated): the words owed are answered as zeros
-        calibrated = Signal()
-        with m.If(port.calib_done):
-            m.d.sync += calibrated.eq(1)
-        lost = Signal()
+        # the memory is lost: the words owed are answered as zeros (until none is owed)
+        lost = self.store_lost
         zero = Signal()
-        m.d.comb += lost.eq(calibrated & (~port.calib_done | self.store_lost))
 
         m.submodules.fifo = fifo = SyncFIFOBuffered(width=self._width, depth=depth)
         owed = Signal(range(depth + dmd.rows * port_words_per_row + 1))     # port words taken, not handed on

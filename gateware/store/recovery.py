@@ -6,8 +6,9 @@ port FIFOs. From that cycle the store is *lost*: the writer drops what it holds 
 arrives of rows begun before (no MCB traffic), the slot table holds new rows back and, between
 rows, forgets every frame (counted), and the reader answers the sequencer's outstanding requests
 with zeros (its own side, :class:`~gateware.store.reader.Reader`). The store is whole again
-once the memory is calibrated, the table has forgotten, and the writer waits for a row's first
-word: every row stored from then on is written after the calibration.
+once the memory is calibrated and the table has forgotten: it forgets between rows and holds
+rows back from then on, so the writer has been given no word since, and every row stored after
+is written after the calibration.
 
 Before the first calibration nothing is lost: the writer waits for it, as it always has.
 """
@@ -28,8 +29,6 @@ class Recovery(wiring.Component):
         The write port's ``calib_done``.
     forgotten : In(1)
         The slot table has forgotten every frame since the loss.
-    between_rows : In(1)
-        The writer waits for a row's first word.
     lost : Out(1)
         The memory's contents are lost and the store has not recovered yet; high in the very
         cycle ``calib_done`` falls.
@@ -37,7 +36,6 @@ class Recovery(wiring.Component):
 
     calib_done: In(1)
     forgotten: In(1)
-    between_rows: In(1)
     lost: Out(1)
 
     def elaborate(self, platform):
@@ -52,6 +50,6 @@ class Recovery(wiring.Component):
                     m.next = "LOST"
             with m.State("LOST"):
                 m.d.comb += self.lost.eq(1)
-                with m.If(self.calib_done & self.forgotten & self.between_rows):
+                with m.If(self.calib_done & self.forgotten):
                     m.next = "KEPT"
         return m

@@ -106,7 +106,6 @@ class Store(wiring.Component):
         m.d.comb += [
             recovery.calib_done.eq(self.mcb_write.calib_done),
             recovery.forgotten.eq(slots.forgotten),
-            recovery.between_rows.eq(writer.between_rows),
             slots.lose.eq(recovery.lost),
             writer.discard.eq(recovery.lost),
         ]

@@ -19,11 +19,11 @@ When the row that completes a frame has been written (its commands taken and the
 empty), the writer says so on ``written``: only then may the frame be read through another port.
 
 While ``discard`` is high (the memory lost its calibration: :mod:`gateware.store.recovery`) the
-writer gives the port nothing, empties both banks and drops every word it is given: all of them
-belong to rows begun before the loss, whose frames are forgotten.
+writer is held in reset: it gives the port nothing, both banks are empty, and every word it is
+given is dropped (all belong to rows begun before the loss, whose frames are forgotten).
 """
 
-from amaranth import Module, Signal
+from amaranth import Module, ResetInserter, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
@@ -77,8 +77,6 @@ class Writer(wiring.Component):
         The slot whose completing row (``completes``) is now in memory.
     discard : In(1)
         Drop everything held and given; no MCB traffic.
-    between_rows : Out(1)
-        The next word taken is a row's first.
     mcb : Out(mcb.PortSignature(64))
         MCB port 0, clocked by ``sync``; only the write half is used.
     """
@@ -93,7 +91,6 @@ class Writer(wiring.Component):
             "words": In(stream.Signature(write_word_layout(dmd))),
             "written": Out(stream.Signature(SLOT_BITS)),
             "discard": In(1),
-            "between_rows": Out(1),
             "mcb": Out(mcb.PortSignature(64)),
         })
 
@@ -148,10 +145,8 @@ class Writer(wiring.Component):
         closes = Signal()
         with m.If(self.words.valid & ~f_full & breaks):
             m.d.comb += closes.eq(1)
-        m.d.comb += self.between_rows.eq(~in_row)
-        with m.If(self.words.valid & self.words.ready):
-            m.d.sync += in_row.eq(~word.last)
         with m.If(take):
+            m.d.sync += in_row.eq(~word.last)
             with m.If(word.last & (word.completes | (f_rows == group - 1))):
                 m.d.comb += closes.eq(1)
         for b in range(2):
@@ -202,10 +197,6 @@ class Writer(wiring.Component):
                     m.d.sync += [full[b].eq(0), planes[b].eq(0), rows[b].eq(0), completes[b].eq(0)]
             m.d.sync += drain_bank.eq(~drain_bank)
 
-        def abandon_on_discard():
-            with m.If(discard):
-                m.next = "IDLE"
-
         with m.FSM():
             with m.State("IDLE"):
                 with m.If(d_full):
@@ -219,12 +210,10 @@ class Writer(wiring.Component):
                 with m.Elif(port.calib_done & (settle == 0) & (port.wr_count + d_words <= mcb.FIFO_DEPTH)):
                     m.d.sync += index.eq(0)
                     m.next = "PUSH"
-                abandon_on_discard()
             with m.State("PUSH"):
                 m.d.sync += [pushing.eq(1), index.eq(index + 1)]
                 with m.If(index == d_words - 1):
                     m.next = "COMMAND"
-                abandon_on_discard()
             with m.State("COMMAND"):
                 # the last word was pushed in this cycle's edge at the latest; give the command after
                 with m.If(~pushing & ~port.cmd_full & ~discard):
@@ -234,23 +223,17 @@ class Writer(wiring.Component):
                         m.next = "DONE"
                     with m.Else():
                         m.next = "PLANE"
-                abandon_on_discard()
             with m.State("DONE"):
                 with m.If(~d_completes):
                     release_bank()
                     m.next = "IDLE"
                 with m.Elif((settle == 0) & port.cmd_empty & port.wr_empty):
                     m.next = "WRITTEN"
-                abandon_on_discard()
             with m.State("WRITTEN"):
                 m.d.comb += self.written.valid.eq(~discard)
                 with m.If(self.written.ready & ~discard):
                     release_bank()
                     m.next = "IDLE"
-                abandon_on_discard()
-        # the memory is lost: both banks are forgotten (written last, so this wins)
-        with m.If(discard):
-            m.d.sync += [fill_bank.eq(0), drain_bank.eq(0), pushing.eq(0)]
-            for b in range(2):
-                m.d.sync += [full[b].eq(0), planes[b].eq(0), rows[b].eq(0), completes[b].eq(0)]
-        return m
+        # the memory is lost: everything held is forgotten (the port is kept quiet above, in the
+        # cycle discard rises)
+        return ResetInserter(discard)(m)

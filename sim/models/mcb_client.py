@@ -101,8 +101,8 @@ def reads(ops, write_width, read_width):
     return out
 
 
-def _model():
-    return McbModel(WORDS * 8, widths=WIDTHS)
+def _model(timing=None):
+    return McbModel(WORDS * 8, widths=WIDTHS, timing=timing)
 
 
 def _run(model, port, client, cycles=100000):
@@ -207,7 +207,7 @@ class LossClient:
         return (yield {"cmd_en": 1, "cmd_instr": WRITE, "cmd_bl": len(words) - 1, "cmd_byte_addr": self.address})
 
     def _read(self, words):
-        out = yield {"cmd_en": 1, "cmd_instr": READ, "cmd_bl": words - 1, "cmd_byte_addr": self.address}
+        out = yield _read(self.address, words)
         got = []
         while len(got) < words:
             if out["rd_empty"]:
@@ -225,14 +225,14 @@ class LossClient:
         while not (out["cmd_empty"] and out["wr_empty"]):
             out = yield {}
         # words left in the FIFOs for the loss to take
-        out = yield {"cmd_en": 1, "cmd_instr": READ, "cmd_bl": 1, "cmd_byte_addr": self.address}
+        out = yield _read(self.address, 2)
         for _ in range(3):
             out = yield {"wr_en": 1, "wr_data": self.stale}
         while out["calib_done"]:
             self.before = {name: out[name] for name in FIFO_OUTPUTS}
             out = yield {}
         if self.case == "before_calib":
-            out = yield {"cmd_en": 1, "cmd_instr": READ, "cmd_bl": 0, "cmd_byte_addr": self.address}
+            out = yield _read(self.address)
         while not out["calib_done"]:
             out = yield {}
         self.after = {name: out[name] for name in FIFO_OUTPUTS}
@@ -252,7 +252,7 @@ def python_loss(case, port):
     """(error kind or None, client, model) of :class:`LossClient` ``case`` on ``port`` of the
     Python model with the loss of :data:`LOSS_AT_NS` and :data:`LOSS_NS`."""
     timing = McbTiming(calib_lost_at_s=LOSS_AT_NS * 1e-9, calib_lost_s=LOSS_NS * 1e-9)
-    model = McbModel(WORDS * 8, widths=WIDTHS, timing=timing)
+    model = _model(timing)
     client = LossClient(case, WIDTHS[port], address=port << 16)
     outputs = model.ports[port].outputs
     try:
