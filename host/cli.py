@@ -16,7 +16,7 @@ from spec import schedule
 from spec.facts import DMDS
 from spec.registers import PlaneOrder, ResetMode, TriggerMode
 
-from .client import DEFAULT_PORT, Client, ClientError
+from .client import DEFAULT_PORT, Client, ClientError, period_fault
 
 __all__ = ["main", "describe"]
 
@@ -40,15 +40,35 @@ def _load(path):
     return image
 
 
+def _t_rst(args):
+    """``--t-rst``: cycles, ``measured`` (the projector's longest RST_ACTIVE so far, from its
+    status), or ``None`` (the facts table's)."""
+    if args.t_rst is None:
+        return None
+    if args.t_rst != "measured":
+        return int(args.t_rst)
+    with Client(args.address, args.port, timeout=args.timeout) as client:
+        measured = client.status()["rst_active_cycles_max"]
+    if not measured:
+        raise ClientError("the projector has made no clocking pulse yet, so it has measured no RST_ACTIVE: "
+                          "show a frame first")
+    return measured
+
+
 def _plan(args):
     dmd = DMDS[args.dmd]
     plan = schedule.plan(dmd, args.dclk, depth=args.depth, reset_mode=ResetMode[args.reset_mode],
-                         order=PlaneOrder[args.order], exposure_s=args.exposure, words_per_cycle=args.read_rate)
+                         order=PlaneOrder[args.order], exposure_s=args.exposure, words_per_cycle=args.read_rate,
+                         t_rst_cycles=_t_rst(args))
     trigger = TriggerMode[args.trigger.upper()]
     period = round(args.period * schedule.FABRIC_HZ) if args.period else plan.frame_cycles
     params = dataclasses.replace(plan.params, trigger=trigger,
                                  period=period if trigger == TriggerMode.PERIODIC else plan.params.period)
-    return dmd, dataclasses.replace(plan, params=params)
+    plan = dataclasses.replace(plan, params=params)
+    fault = period_fault(plan)
+    if fault:
+        raise ClientError(fault)
+    return dmd, plan
 
 
 def describe(plan):
@@ -90,6 +110,10 @@ def main(argv=None):
                                 "(python -m host trigger) or the sync input")
     configure.add_argument("--period", type=float, default=0.0,
                            help="periodic trigger: seconds between frames (default: the fastest the plan allows)")
+    configure.add_argument("--t-rst", default=None,
+                           help="RST_ACTIVE time to plan with, in cycles from the pulse, or 'measured': the "
+                                "longest the projector has seen (status rst_active_cycles_max; default: the "
+                                "facts table's 4.54 us)")
     configure.add_argument("--read-rate", type=float, default=1.0,
                            help="the store's read bandwidth in 64-bit words per DCLK cycle (row pacing)")
     configure.add_argument("--dry-run", action="store_true", help="say the rate, send nothing")

@@ -28,10 +28,11 @@ import numpy as np
 
 from spec import records
 from spec.records import RecordType
+from spec.registers import TriggerMode
 
 from . import codec, levels
 
-__all__ = ["Client", "ClientError", "Sent", "DEFAULT_PORT", "path_mtu"]
+__all__ = ["Client", "ClientError", "Sent", "DEFAULT_PORT", "path_mtu", "period_fault"]
 
 DEFAULT_PORT = 5000
 
@@ -57,6 +58,19 @@ _WHY = {
     "store_rows_refused": "the projector's store refused rows (a frame id not newer than its newest, "
                           "or no free slot)",
 }
+
+
+def period_fault(plan):
+    """Why a :func:`spec.schedule.plan` with a periodic trigger cannot keep its period (``None``
+    when it can): a period shorter than the plan's frame period for the bit depth planned. The
+    projector takes such a period (it knows a frame's depth only when the frame comes); each
+    frame then outlasts it, the strobe that comes meanwhile is held or lost, and
+    ``frames_period_short`` counts the frames."""
+    p = plan.params
+    if p.trigger != TriggerMode.PERIODIC or p.period >= plan.frame_cycles:
+        return None
+    return (f"a periodic trigger every {p.period} cycles is shorter than the plan's frame period of "
+            f"{plan.frame_cycles} cycles ({plan.rate_hz:.1f} frames/s): every frame would outlast it")
 
 
 class ClientError(RuntimeError):
@@ -270,7 +284,11 @@ class Client:
 
     def configure(self, plan, dmd):
         """Send the register set of a :func:`spec.schedule.plan` (checked as the
-        projector checks it); the sequencer takes it when no frame is playing."""
+        projector checks it, and a periodic trigger against the plan's frame period:
+        :func:`period_fault`); the sequencer takes it when no frame is playing."""
+        fault = period_fault(plan)
+        if fault:
+            raise ClientError(fault)
         self._send(codec.sequencer_record(plan.params.registers(dmd), self._next(), dmd=dmd,
                                           beats=plan.params.beats))
 

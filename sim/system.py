@@ -95,8 +95,8 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None):
         print(f"faults: {f['mcb_stall_permille']} in 1000 memory commands stall up to {f['mcb_stall_max_ns']} ns "
               f"(seed {f['mcb_stall_seed']})")
     if "dlpc410_rst_extra" in f:
-        print(f"faults: RST_ACTIVE held {f['dlpc410_rst_extra']} cycles longer than the facts table's time "
-              f"(the plan's)")
+        print(f"faults: RST_ACTIVE held {f['dlpc410_rst_extra']} cycles longer than the facts table's time; "
+              f"a first short run measures it (status rst_active_cycles_max) and the run is planned with it")
     t0 = time.monotonic()
     r = xga.run(f"scene-{faults}" if faults else "scene", frames=frames, one_by_one=XGA_ONE_BY_ONE,
                 back_to_back=XGA_BACK_TO_BACK, dclk_hz=dclk_hz, faults=faults)
@@ -114,11 +114,12 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None):
     print(f"trigger pin to the optical change (+ {optical} cycles, pulse to mirror motion, facts "
           f"t_pulse_to_mirror): typical {typical + optical} cycles ({(typical + optical) * ns / 1e3:.2f} us), "
           f"worst {worst + optical} cycles ({(worst + optical) * ns / 1e3:.2f} us)")
-    agree = ("the sequencer waits for RST_ACTIVE and late rows: not compared with the schedule model" if faults
-             else "frame starts equal the schedule model's")
+    agree = ("frame starts equal the schedule model's" if r["compared_with_model"]
+             else "the sequencer waits for late rows: not compared with the schedule model")
     print(f"frame period back to back, measured on the pins: {measured} cycles = {xga.DMD_HZ / measured:.1f} Hz "
           f"({agree}; periods {periods}); schedule model (global reset, MSB "
-          f"first, LSB {r['lsb_cycles']} cycles, rows every {r['row_period']} cycles): {r['period_cycles']} "
+          f"first, LSB {r['lsb_cycles']} cycles, rows every {r['row_period']} cycles, t_rst {r['t_rst_cycles']} "
+          f"cycles{' as measured' if r['t_rst_measured'] else ''}): {r['period_cycles']} "
           f"cycles = {r['rate_hz']:.1f} Hz")
     spans = sorted({f["span_cycles"] for f in shown})
     print(f"first to last pulse of each frame: {spans} cycles, model {r['model_span_cycles']}")
@@ -129,7 +130,8 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None):
           f"triggers {status['triggers']} (held {status['triggers_held']}), overruns {status['trigger_overruns']}, "
           f"frames shown {status['frames_shown']}, pulses late {status['pulses_late']}, row loads that waited "
           f"for the store {status['row_underruns']}, RST_ACTIVE late {status['rst_active_late']}, RST_ACTIVE "
-          f"faults {status['rst_active_faults']}, controller restarts {status['dlpc410_restarts']}")
+          f"faults {status['rst_active_faults']}, longest RST_ACTIVE {status['rst_active_cycles_max']} cycles, "
+          f"controller restarts {status['dlpc410_restarts']}")
     if faults:
         print(f"memory commands stalled: {r['mcb_stalls']}")
     print(f"grey error of the reconstructed images: max {max(f['max_error_lsb'] for f in shown):g} LSB "

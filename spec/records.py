@@ -178,6 +178,8 @@ SYSTEM_STATUS = [
     ("dlpc410_restarts", 32),  # the DLPC410 initialised again mid-run (INIT_ACTIVE high again, ECP2_FINISHED low)
     ("store_calibration_losses", 32),  # the DDR2 lost its calibration: every stored frame forgotten
     ("store_frames_lost", 32),         # frames forgotten (stored, arriving or held) when the DDR2 was lost
+    ("rst_active_cycles_max", 32),     # the longest RST_ACTIVE seen, in dmd cycles from a pulse: the t_rst to plan with
+    ("frames_period_short", 32),       # frames the periodic trigger started whose planes outlast its period
 ]
 
 #: Status reply body (after :data:`HEADER`).
@@ -212,7 +214,11 @@ def register_faults(wire, row_cycles, clear_row_cycles):
 
     ``lsb_keepable``: between two clocking pulses of a block come its reset (``t_rst``), its
     settle time (``t_settle``) and at least a block clear, the shortest way to end a plane
-    (``docs/bounds.md``); a shorter least significant plane cannot be shown at its length."""
+    (``docs/bounds.md``); a shorter least significant plane cannot be shown at its length.
+
+    ``period_keepable``: a periodic trigger's period is at least the least significant plane, the
+    shortest a frame (one plane) can last; frames of more planes that outlast it are counted
+    when they start (``frames_period_short``)."""
     faults = {}
     for f, (_, wire_width) in zip(_registers.FIELDS, SEQUENCER, strict=True):
         if wire_width > f.bits:
@@ -224,8 +230,8 @@ def register_faults(wire, row_cycles, clear_row_cycles):
     faults["stagger_even"] = (wire["stagger"] & 1) != 0
     faults["row_period"] = wire["row_period"] < row_cycles
     faults["lsb_keepable"] = wire["lsb"] < wire["t_rst"] + wire["t_settle"] + clear_row_cycles * row_cycles
-    faults["period_nonzero"] = ((wire["trigger"] == _registers.TriggerMode.PERIODIC.value)
-                                & (wire["period"] == 0))
+    faults["period_keepable"] = ((wire["trigger"] == _registers.TriggerMode.PERIODIC.value)
+                                 & (wire["period"] < wire["lsb"]))
     return faults
 
 

@@ -602,7 +602,7 @@ def _lattice_ok(M, s, G, sep):
 def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetMode.GLOBAL,
          exposure_s=0.0, strict_rst=True, chain=False, words_per_cycle=1.0, source=Source.STORE,
          t_rst_s=None, t_settle_s=None, frame=None, order_table=(7, 6, 5, 4, 3, 2, 1, 0),
-         reload_lead=RELOAD_LEAD, trigger_hold=False):
+         reload_lead=RELOAD_LEAD, trigger_hold=False, t_rst_cycles=None):
     """A parameter set that shows every plane exactly on time, and the rate it reaches.
 
     ``exposure_s`` asks for a least significant plane at least that long (0: the shortest legal
@@ -619,10 +619,15 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     ``reload_lead``: the store's latency to a row's first words, in cycles (see :class:`Params`).
     ``trigger_hold``: a trigger that comes too early is held until every group is ready, rather
     than counted as an overrun.
+    ``t_rst_cycles``: the controller's own RST_ACTIVE as the projector measured it (the status
+    reply's ``rst_active_cycles_max``, from the pulse's decision to the fall: the synchroniser's
+    margin included), taken as ``t_rst`` instead of the facts table's time plus
+    :data:`RST_MARGIN`.
     """
     beats = beats_at(dclk_hz)
     R = row_cycles(dmd, beats)
-    t_rst = even(_cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s) + RST_MARGIN)
+    t_rst = even(t_rst_cycles) if t_rst_cycles is not None else \
+        even(_cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s) + RST_MARGIN)
     t_settle = _cycles(TIMING["t_settle"].value if t_settle_s is None else t_settle_s)
     words = dmd.words_per_row
     # the on-chip source needs no memory bandwidth: one row per row cycle on any bus width

@@ -63,20 +63,21 @@ def same_commands(run, model):
 
 
 def check(p, frames, images, pins, name, *, extra=400, soft=(), sync_pins=(), early_pins=(),
-          offered=None, dmd=DMD, store_words=1):
+          offered=None, dmd=DMD, store_words=1, model=None):
     """Run gateware and model; assert equal commands, counters, and exact light per frame.
     ``frames``: the frames expected on the DMD; ``offered``: what the store offers (default:
-    the same). The rule model logs no no-op rows (a 1080p clear's), the schedule model does."""
+    the same); ``model``: the rule-checking DLPC410 model (default: as planned). The rule model
+    logs no no-op rows (a 1080p clear's), the schedule model does."""
     offered = frames if offered is None else offered
     mframes = model_frames(offered, images, dmd)
     if p.trigger == TriggerMode.SOFTWARE:
         strobes = list(soft)
     else:
         strobes = [t + PIN_TO_STROBE for t in (sync_pins if p.trigger == TriggerMode.SYNC else pins)]
-    model = schedule.simulate(dmd, p, mframes, strobes)
+    dlpc410, model = model, schedule.simulate(dmd, p, mframes, strobes)
     end = max(c[0] for c in model.commands) + extra
     run = run_rig(dmd, p, offered, images, pins=pins, soft=soft, sync_pins=sync_pins,
-                  early_pins=early_pins, cycles=end, name=name, store_words=store_words)
+                  early_pins=early_pins, cycles=end, name=name, store_words=store_words, model=dlpc410)
     assert run.commands == model.decoded()
     assert run.status["late"] == 0 == model.late
     assert run.status["underruns"] == 0
@@ -318,6 +319,26 @@ def test_trigger_modes(mode, test_name):
 
 
 @pytest.mark.verilog
+@pytest.mark.parametrize("short", [True, False])
+def test_periodic_trigger_faster_than_the_frames_is_counted(short, test_name):
+    """A periodic trigger every 2 LSB under frames of 2 planes (3 LSB): every frame started is
+    counted (``period_short``) and the strobes that come while it plays are overruns; at the
+    plan's frame period neither."""
+    plan = fast_plan(depth=2)
+    p = plan.params
+    p.trigger = TriggerMode.PERIODIC
+    ready = next_ready(p, model_frames([(0, 2)], None), [])
+    p.period = 2 * p.lsb if short else plan.frame_cycles
+    strobes = [k * p.period - 1 for k in range(1, (ready + 4 * plan.frame_cycles) // p.period + 1)]
+    model = schedule.simulate(DMD, p, model_frames([(0, 2)], None), strobes, until=strobes[-1] - 4)
+    run = run_rig(DMD, p, [(0, 2)], None, cycles=strobes[-1] - 4, name=test_name)
+    same_commands(run, model)
+    assert run.status["frames"] >= 2
+    assert run.status["period_short"] == (run.status["frames"] if short else 0)
+    assert run.status["overruns"] == model.overruns and (model.overruns > 0) == short
+
+
+@pytest.mark.verilog
 @pytest.mark.parametrize("dmd", [DMD, TEST_DMD4], ids=["two_buses", "four_buses"])
 def test_binary_prng_chain(dmd, test_name):
     """1-bit Bernoulli frames back to back at the bus limit: the patterns the host rebuilds
@@ -424,6 +445,9 @@ def test_rst_active_as_planned_counts_nothing(test_name):
     first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
     run, _model = check(p, [(0, 3)], None, [first], test_name)
     assert run.status["rst_late"] == 0 and run.status["rst_faults"] == 0
+    # the longest RST_ACTIVE, from the decision (the pins show the pulse a cycle later) to the
+    # fall (the cycle after the last high one): the planned t_rst less its two spare cycles
+    assert run.status["rst_longest"] == dlpc410_for(DMD, p).rst_active_cycles + 2 == p.t_rst - 2
 
 
 @pytest.mark.verilog
@@ -443,6 +467,15 @@ def test_rst_active_longer_than_planned(test_name):
     assert len(pulses) == want
     assert run.status["rst_late"] == want and run.status["rst_faults"] == 0
     assert run.status["late"] > 0
+    assert run.status["rst_longest"] == model.rst_active_cycles + 2
+    # planned with the time the projector measured, the same controller keeps every plane on
+    # time: every level exact, commands equal to the schedule model's, nothing late
+    calibrated = fast_plan(depth=3, t_rst_cycles=run.status["rst_longest"]).params
+    same = dlpc410_for(DMD, calibrated)
+    same.rst_active_cycles = model.rst_active_cycles
+    first = next_ready(calibrated, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
+    again, _model = check(calibrated, [(0, 3)], None, [first], f"{test_name}-calibrated", model=same)
+    assert again.status["rst_late"] == 0 and again.status["rst_faults"] == 0
 
 
 @pytest.mark.verilog

@@ -3,6 +3,7 @@ with the reference models: the endpoint's (records, rows, counters) and the stor
 policy (which frames it takes, which rows it refuses); a software trigger shows the newest
 complete frame."""
 
+import dataclasses
 import socket
 import threading
 
@@ -14,6 +15,7 @@ from sim.models.net import Model
 from sim.models.slots import SlotPolicy
 from spec import records
 from spec.facts import TEST_DMD
+from spec.registers import TriggerMode
 
 #: The store's refusals, summed into the status reply's ``store_rows_refused``.
 REFUSALS = ("rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot")
@@ -33,6 +35,7 @@ class FakeProjector:
         self.shown = None
         self.depths = []            # bit depth of each frame the store completed
         self.mode = mode
+        self.status_values = {}     # status fields the test sets
         self.received = []
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._serve, daemon=True)
@@ -62,6 +65,7 @@ class FakeProjector:
                 values = {name: self.model.counters.get(name, 0) for name, _ in records.STATUS_REPLY}
                 values["store_rows_refused"] = sum(self.store.counters[name] for name in REFUSALS)
                 values["shown_frame"] = self.shown or 0
+                values.update(self.status_values)
                 reply = codec.status_reply(sequence, values)
                 if self.mode == "garbled":
                     reply = reply[:20]
@@ -258,5 +262,43 @@ def test_sequencer_record_refuses_what_the_projector_would_drop():
         codec.sequencer_record({**wire, "lsb": 2}, dmd=TEST_DMD)
     with pytest.raises(ValueError, match="order_known"):
         codec.sequencer_record({**wire, "order": 3}, dmd=TEST_DMD)
+    periodic = {**wire, "trigger": TriggerMode.PERIODIC.value}
+    with pytest.raises(ValueError, match="period_keepable"):
+        codec.sequencer_record({**periodic, "period": wire["lsb"] - 2}, dmd=TEST_DMD)
+    codec.sequencer_record({**periodic, "period": wire["lsb"]}, dmd=TEST_DMD)
     head, body, rest = codec.decode(codec.sequencer_record(wire, 9))
     assert head["type"] == records.RecordType.SEQUENCER and body == wire and rest == b""
+
+
+def test_a_periodic_trigger_faster_than_the_plans_frames_is_refused(projector, capsys):
+    """A period the projector would take (at least one plane) but every frame of the planned
+    depth outlasts: ``configure`` refuses it with the plan's frame period, before sending."""
+    from spec import schedule
+    plan = schedule.plan(TEST_DMD, 200e6, depth=6)
+    base = ["--address", "127.0.0.1", "--port", str(projector.port), "configure", "--dmd", "test",
+            "--dclk", "200e6", "--depth", "6", "--trigger", "periodic"]
+    short = (plan.frame_cycles - 2) / schedule.FABRIC_HZ
+    assert cli.main(base + ["--period", repr(short)]) == 1
+    assert f"frame period of {plan.frame_cycles} cycles" in capsys.readouterr().err
+    assert projector.received == []
+    assert cli.main(base + ["--period", repr(plan.frame_cycles / schedule.FABRIC_HZ)]) == 0
+    periodic = dataclasses.replace(plan, params=dataclasses.replace(
+        plan.params, trigger=TriggerMode.PERIODIC, period=plan.frame_cycles - 2))
+    with Client("127.0.0.1", projector.port) as client, pytest.raises(ClientError, match="outlast"):
+        client.configure(periodic, TEST_DMD)
+
+
+def test_configure_plans_with_the_measured_rst_active(projector, capsys):
+    """``--t-rst measured`` plans with the longest RST_ACTIVE the projector reports; before any
+    pulse (0) it says to show a frame first."""
+    from spec import schedule
+    base = ["--address", "127.0.0.1", "--port", str(projector.port), "configure", "--dmd", "test",
+            "--dclk", "200e6", "--t-rst", "measured", "--dry-run"]
+    assert cli.main(base) == 1
+    assert "show a frame first" in capsys.readouterr().err
+    default = schedule.plan(TEST_DMD, 200e6)
+    projector.status_values["rst_active_cycles_max"] = default.params.t_rst + 91
+    assert cli.main(base) == 0
+    longer = schedule.plan(TEST_DMD, 200e6, t_rst_cycles=default.params.t_rst + 91)
+    assert longer.params.t_rst == default.params.t_rst + 92 and longer.params.lsb > default.params.lsb
+    assert f"{longer.rate_hz:.1f} frames/s" in capsys.readouterr().out

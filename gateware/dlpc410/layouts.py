@@ -60,7 +60,9 @@ class Status(data.Struct):
     a bit depth outside 1..8, dropped; ``held`` triggers held until every group was ready;
     ``rst_late`` RST_ACTIVE falls later than planned (the settle counted from the fall);
     ``rst_faults`` RST_ACTIVE missing after a pulse or stuck high; ``restarts`` the controller
-    initialised again mid-run (INIT_ACTIVE high again or ECP2_FINISHED low).
+    initialised again mid-run (INIT_ACTIVE high again or ECP2_FINISHED low); ``rst_longest`` the
+    longest RST_ACTIVE seen, in cycles from the pulse's decision; ``period_short`` frames started
+    by the periodic timer whose planes outlast its period.
     """
     now: TIME_BITS
     frames: COUNTER_BITS
@@ -74,3 +76,5 @@ class Status(data.Struct):
     rst_late: COUNTER_BITS
     rst_faults: COUNTER_BITS
     restarts: COUNTER_BITS
+    rst_longest: COUNTER_BITS
+    period_short: COUNTER_BITS

@@ -93,9 +93,11 @@ class Planner(wiring.Component):
         High while a frame is shown (first pulse to the last group's final dark pulse).
     frames_started, late, bad_frames : Out(COUNTER_BITS)
         Frames started; pulses made after their time; frames dropped for their bit depth.
-    rst_late, rst_faults : Out(COUNTER_BITS)
-        RST_ACTIVE falls later than planned; RST_ACTIVE missing after a pulse or stuck high
-        (:class:`~gateware.dlpc410.reset_watch.ResetWatch`).
+    rst_late, rst_faults, rst_longest : Out(COUNTER_BITS)
+        RST_ACTIVE falls later than planned; RST_ACTIVE missing after a pulse or stuck high; the
+        longest RST_ACTIVE seen (:class:`~gateware.dlpc410.reset_watch.ResetWatch`).
+    depth : Out(4)
+        The bit depth of the frame the first group plays (or is about to).
     """
 
     def __init__(self, dmd, *, beats=1):
@@ -129,6 +131,8 @@ class Planner(wiring.Component):
             "bad_frames": Out(COUNTER_BITS),
             "rst_late": Out(COUNTER_BITS),
             "rst_faults": Out(COUNTER_BITS),
+            "rst_longest": Out(COUNTER_BITS),
+            "depth": Out(4),
         })
 
     def elaborate(self, platform):
@@ -152,6 +156,7 @@ class Planner(wiring.Component):
         rst_any = Signal(TIME_BITS)
         next_slot = Signal(SLOT_BITS)          # the newest frame taken
         next_depth = Signal(4)
+        m.d.comb += self.depth.eq(depth[0])
         active = [Signal(name=f"active{g}") for g in range(G)]
         for g in range(G):
             m.d.comb += active[g].eq(g < self.n_groups)
@@ -159,7 +164,8 @@ class Planner(wiring.Component):
         m.submodules.reset_watch = watch = ResetWatch(dmd)
         m.d.comb += [watch.regs.eq(regs), watch.now.eq(now), watch.rst_active.eq(self.rst_active),
                      watch.pulse.valid.eq(self.pulse.valid), watch.pulse.payload.eq(self.pulse.payload),
-                     self.rst_late.eq(watch.late), self.rst_faults.eq(watch.faults)]
+                     self.rst_late.eq(watch.late), self.rst_faults.eq(watch.faults),
+                     self.rst_longest.eq(watch.longest)]
         # ---- what the bus may do ----
         armed = [Signal(name=f"armed{g}") for g in range(G)]
         for g in range(G):

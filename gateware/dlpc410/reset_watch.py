@@ -13,6 +13,10 @@ this pulse's (a high that lasts is seen again two cycles later), so a short high
 pulse cannot pass for the pulse's own reset and end its wait early. With the loose reading
 (``strict_rst`` low) another group may pulse while RST_ACTIVE is high; the one pin then no
 longer tells when the earlier group's reset ended, and that group falls back on the planned time.
+
+The longest RST_ACTIVE seen with the strict reading (from a pulse's decision to the fall, dated
+as above) is the ``t_rst`` a plan for this controller needs: it is reported, so that the host can
+plan with the controller's own time instead of the facts table's.
 """
 
 from amaranth import Array, Cat, Module, Signal
@@ -64,6 +68,10 @@ class ResetWatch(wiring.Component):
     faults : Out(COUNTER_BITS)
         RST_ACTIVE did not rise after a pulse, or stayed high, ``t_rst + t_settle`` past its
         planned fall.
+    longest : Out(COUNTER_BITS)
+        The longest RST_ACTIVE seen (strict reading), in cycles from the pulse's decision to the
+        fall. It catches up with each new longest by one a cycle, so that it crosses clock
+        domains as a counter does.
     """
 
     def __init__(self, dmd):
@@ -78,6 +86,7 @@ class ResetWatch(wiring.Component):
             "fell": Out(event(data.StructLayout({"groups": groups, "settled": TIME_BITS}))),
             "late": Out(COUNTER_BITS),
             "faults": Out(COUNTER_BITS),
+            "longest": Out(COUNTER_BITS),
         })
 
     def elaborate(self, platform):
@@ -128,4 +137,15 @@ class ResetWatch(wiring.Component):
             m.d.sync += self.late.eq(self.late + 1)
         with m.If(missing | stuck):
             m.d.sync += self.faults.eq(self.faults + 1)
+
+        # the longest reset: with the loose reading another group's pulse may come first, and
+        # the fall no longer dates this pulse's reset
+        pulsed_at, longest = Signal(TIME_BITS), Signal(COUNTER_BITS)
+        with m.If(self.pulse.valid):
+            m.d.sync += pulsed_at.eq(now)
+        length = (fell_at - pulsed_at)[:COUNTER_BITS]
+        with m.If(falls & regs.strict_rst & (length > longest)):
+            m.d.sync += longest.eq(length)
+        with m.If(self.longest < longest):
+            m.d.sync += self.longest.eq(self.longest + 1)
         return m

@@ -34,6 +34,7 @@ from .camera import CameraTrigger
 from .control import FrameControl
 from .init import TRAINING_EDGES, Init
 from .layouts import Status, load_job, ready_load
+from .period_watch import PeriodWatch
 from .planner import Planner
 from .requester import Requester
 from .row_source import RowSource
@@ -147,6 +148,7 @@ class Sequencer(wiring.Component):
         m.submodules.row_source = source = RowSource(dmd, beats=beats, store_words=self._store_words)
         m.submodules.bus = bus = Bus(dmd, beats=beats)
         m.submodules.camera = camera = CameraTrigger()
+        m.submodules.period_watch = period_watch = PeriodWatch()
         m.d.comb += [
             init.ecp2_finished.eq(self.pins.ecp2_finished),
             init.init_active.eq(self.pins.init_active),
@@ -170,7 +172,7 @@ class Sequencer(wiring.Component):
                 m.d.comb += [n_groups.eq((G + 1) // 2), size_log2.eq(1)]
             with m.Case(ResetMode.SINGLE):
                 m.d.comb += n_groups.eq(G)
-        for part in (planner, control, requester, source, bus, camera):
+        for part in (planner, control, requester, source, bus, camera, period_watch):
             m.d.comb += part.regs.eq(regs)
         for part in (planner, control, bus, camera):
             m.d.comb += part.now.eq(now)
@@ -227,6 +229,7 @@ class Sequencer(wiring.Component):
         # ---- outputs and counters ----
         m.d.comb += [
             camera.frame_start.eq(planner.frame_start),
+            period_watch.frame_start.eq(planner.frame_start), period_watch.depth.eq(planner.depth),
             self.camera_out.eq(camera.out),
             self.sync_out.eq(planner.sync_out),
             self.status.frames.eq(planner.frames_started),
@@ -234,6 +237,8 @@ class Sequencer(wiring.Component):
             self.status.rst_late.eq(planner.rst_late),
             self.status.rst_faults.eq(planner.rst_faults),
             self.status.restarts.eq(init.restarts),
+            self.status.rst_longest.eq(planner.rst_longest),
+            self.status.period_short.eq(period_watch.short),
             self.status.bad_frames.eq(planner.bad_frames),
             self.status.triggers.eq(control.triggers),
             self.status.overruns.eq(control.overruns),

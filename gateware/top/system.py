@@ -213,6 +213,8 @@ class Projector(wiring.Component):
                              ("rst_active_late", seq.status.rst_late),
                              ("rst_active_faults", seq.status.rst_faults),
                              ("dlpc410_restarts", seq.status.restarts),
+                             ("rst_active_cycles_max", seq.status.rst_longest),
+                             ("frames_period_short", seq.status.period_short),
                              ("pulses_late", seq.status.late), ("row_underruns", seq.status.underruns),
                              ("frames_bad_depth", seq.status.bad_frames),
                              ("registers_applied", registers.applied)):

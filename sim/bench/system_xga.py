@@ -31,7 +31,7 @@ def run():
 def faulty():
     """The same run with the chips misbehaving (``make sim FAULTS=stalls`` and ``=all``,
     :data:`sim.xga.FAULTS`): every rule checked on the pins as always; the figures say what it
-    cost."""
+    cost. The RST_ACTIVE the projector measured is the plan's ``t_rst`` in ``all``."""
     figures = {}
     for kind in ("stalls", "all"):
         r = xga.run(f"bench-{kind}", frames=XGA_FRAMES, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK,
@@ -45,5 +45,6 @@ def faulty():
             f"sys.xga_faults_{kind}_row_underruns": (status["row_underruns"], "row"),
             f"sys.xga_faults_{kind}_pulses_late": (status["pulses_late"], "pulse"),
             f"sys.xga_faults_{kind}_rst_active_late": (status["rst_active_late"], "pulse"),
+            f"sys.xga_faults_{kind}_t_rst_measured_cycles": (status["rst_active_cycles_max"], "cycle"),
         })
     return figures

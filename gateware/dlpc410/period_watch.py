@@ -1,0 +1,51 @@
+"""A periodic trigger faster than the frames it starts.
+
+With :attr:`~gateware.registers.TriggerMode.PERIODIC`, a frame whose planes alone (``lsb`` times
+``2**depth - 1`` cycles, the least any plan gives them) outlast ``period`` cannot end before the
+next strobe: that strobe is then held or an overrun (``trigger_hold``), and the triggers no
+longer come at the period the user set. The frame is still shown; each such frame is counted,
+so that the status reply says why. (A period shorter than ``lsb`` fits no frame at all: the
+sequencer record is dropped instead, :func:`spec.records.register_faults`.)
+"""
+
+from amaranth import Module, Signal
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+from ..registers import LSB_BITS, Registers, TriggerMode
+from .layouts import COUNTER_BITS
+
+__all__ = ["PeriodWatch"]
+
+
+class PeriodWatch(wiring.Component):
+    """Count frames started by the periodic timer that last longer than its period.
+
+    Members
+    -------
+    regs : In(:class:`~gateware.registers.Registers`)
+        ``trigger``, ``period``, ``lsb``.
+    depth : In(4)
+        Bit depth of the frame the first group plays; it is set at least a plane before that
+        frame's first pulse.
+    frame_start : In(1)
+        A frame's first pulse.
+    short : Out(COUNTER_BITS)
+        Frames started in periodic mode whose planes outlast the period.
+    """
+    regs: In(Registers)
+    depth: In(4)
+    frame_start: In(1)
+    short: Out(COUNTER_BITS)
+
+    def elaborate(self, platform):
+        m = Module()
+        regs = self.regs
+        # two registered stages (a shift, then a compare): the depth and the registers are
+        # steady for a plane or more before the frame's first pulse
+        planes, too_short = Signal(LSB_BITS + 15), Signal()
+        m.d.sync += [planes.eq((regs.lsb << self.depth) - regs.lsb),
+                     too_short.eq((regs.trigger == TriggerMode.PERIODIC) & (regs.period < planes))]
+        with m.If(self.frame_start & too_short):
+            m.d.sync += self.short.eq(self.short + 1)
+        return m
