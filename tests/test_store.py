@@ -112,6 +112,21 @@ class Bench:
             store_stim.check_plane(self.dmd, image, plane, words, what=what)
         store_stim.check_occupancy(self.dmd, image, depth, await self.occupancy(ctx, slot), what=what)
 
+    async def receive(self, ctx, image, frame_id, what=""):
+        """Ask for a frame: it must be ``frame_id``, and read back as ``image``. Its slot."""
+        slot, got, depth = await self.ask(ctx)
+        assert got == frame_id, f"frame {got} given, not {frame_id}"
+        await self.check_frame(ctx, slot, image, depth, what=what or f"frame {frame_id}")
+        return slot
+
+    async def recovered(self, ctx, frames_lost):
+        """Wait (``dmd``) until the store is whole again after the memory's one calibration
+        loss, and check that it counted that loss and ``frames_lost`` frames forgotten."""
+        await ctx.tick("dmd").until(~self.dut.lost)
+        counters = self.counters(ctx)
+        assert counters["calibration_losses"] == 1 and counters["frames_lost"] == frames_lost, counters
+        assert self.model.calib_losses == 1
+
     def counters(self, ctx):
         c = ctx.get(self.dut.counters)
         return {name: int(getattr(c, name)) for name, _ in SlotCounters.as_shape()}
@@ -673,19 +688,77 @@ def test_calibration_loss_forgets_every_frame(test_name):
         assert all(w in (0, v) for w, v in zip(words, want, strict=True)), "only stored words or zeros"
         assert words[-1] == 0 != want[-1], "the loss cut the read short"
         assert ctx.get(dut.lost)
-        await ctx.tick("dmd").until(~dut.lost)
-        counters = bench.counters(ctx)
-        assert counters["calibration_losses"] == 1 and counters["frames_lost"] == 3, counters
+        await bench.recovered(ctx, frames_lost=3)
         phase["recovered"] = True
         # the frame stored after the loss is the one given (not frame 2, lost); the lost one
         # held is handed back without complaint
-        slot4, frame, depth = await bench.ask(ctx)
-        assert frame == 4
-        await bench.check_frame(ctx, slot4, images[4], depth, what="frame 4")
+        await bench.receive(ctx, images[4], 4)
         await bench.release(ctx, slot)
         for _ in range(20):
             await ctx.tick("dmd")
         assert bench.counters(ctx)["bad_releases"] == 0
-        assert bench.model.calib_losses == 1
 
     bench.run([producer, consumer], test_name, deadline=1e-3)
+
+
+@pytest.mark.parametrize("moment", ["words", "command"])
+def test_calibration_loss_mid_burst(moment, test_name):
+    """The memory loses its calibration while the writer is in the middle of a frame's first
+    burst: half its words in the write FIFO and the rest still coming ("words"), or all of them
+    there and the command due in the very cycle of the loss ("command"). The loss is timed on
+    the port's own signals, and the test checks where it landed. From the loss cycle until the
+    memory is back the port is given nothing (the model refuses any traffic while not
+    calibrated, and so does the test) and nothing is written to the memory; the interrupted
+    frame is forgotten and never given (its rows that come after the recovery make an incomplete
+    frame, abandoned for the next one), and the next frame is stored and read back exactly."""
+    bench = Bench(SHORT_DMD)
+    dut, port = bench.dut, bench.dut.mcb_write
+    interrupted, image = (store_stim.random_image(SHORT_DMD, 950 + i) for i in range(2))
+    seen = {}
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        await bench.feed(ctx, interrupted, 1)
+        await bench.feed(ctx, image, 2)
+
+    async def watcher(ctx):
+        # counts the port's edges as its model does (edge n at n / SYNC_HZ), and the words given
+        # since the last command
+        cycle = pushed = 0
+        due = None
+        async for _clk, _rst, wr_en, cmd_en, bl, calib_done in ctx.tick().sample(
+                port.wr_en, port.cmd_en, port.cmd_bl, port.calib_done):
+            cycle += 1
+            pushed = (0 if cmd_en else pushed) + wr_en
+            if due is None and wr_en:
+                # the burst's first word: its words come one per edge, then its command; the
+                # loss lands on the edge chosen, taking that edge's inputs with the rest
+                burst = bl + 1
+                due = cycle + (burst // 2 if moment == "words" else burst - 1)
+                bench.model.lose_calibration((due - 0.5) / SYNC_HZ, 2e-6)
+            elif cycle == due:
+                assert calib_done and not cmd_en
+                seen.update(pushed=pushed, burst=bl + 1, written=len(bench.model.write_log))
+            elif due is not None and cycle > due:
+                # from the loss cycle (sampled at due + 1) until the memory is back: nothing
+                assert calib_done or not (wr_en or cmd_en), f"port traffic while lost, edge {cycle}"
+                if cycle == due + 1:
+                    assert not calib_done, "the loss landed on the edge chosen"
+                elif calib_done:
+                    seen["back"] = len(bench.model.write_log)
+                    return
+
+    async def consumer(ctx):
+        # asked before the loss: the first frame given is the one sent after it
+        await bench.receive(ctx, image, 2)
+        await bench.recovered(ctx, frames_lost=1)
+        counters = bench.counters(ctx)
+        assert counters["frames_complete"] == 1 and counters["frames_abandoned"] == 1, counters
+
+    bench.run([producer, watcher, consumer], test_name)
+    assert seen["burst"] == 2 * 16, "the first burst: 16 rows of 2 words"
+    if moment == "words":
+        assert 0 < seen["pushed"] < seen["burst"], seen
+    else:
+        assert seen["pushed"] == seen["burst"], seen
+    assert seen["written"] == seen["back"] == 0, "nothing of the interrupted frame reached the memory"
