@@ -23,11 +23,13 @@ test: $(STAMP)
 
 # The main job: the system simulation on the default scene (DCLK 400 MHz; DCLK=200 for 200 MHz;
 # FAULTS=stalls|rst|all: the memory stalls at random, the DLPC410 holds RST_ACTIVE longer than
-# planned, or both).
+# planned, or both; VIRTUAL=<seconds>|demo: the virtual projector on a TAP device in a network
+# namespace of its own, which host software in that namespace can talk to; needs root).
 DCLK ?= 400
 FAULTS ?=
+VIRTUAL ?=
 sim: $(STAMP)
-	$(PY) -m flow sim --dclk $(DCLK) $(if $(FAULTS),--faults $(FAULTS))
+	$(PY) -m flow sim --dclk $(DCLK) $(if $(FAULTS),--faults $(FAULTS)) $(if $(VIRTUAL),--virtual $(VIRTUAL))
 
 # The Spartan-6 ISE tree (Verilog, UCF, ISE scripts) and each block's Verilog, in build/spartan6.
 verilog: $(STAMP)

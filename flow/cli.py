@@ -23,6 +23,9 @@ def main(argv=None):
     sim.add_argument("--dclk", type=float, default=400, choices=(200, 400), help="DCLK in MHz (default 400)")
     sim.add_argument("--faults", choices=("stalls", "rst", "all"), default=None,
                      help="memory stalls at random, RST_ACTIVE held longer than planned, or both (sim.xga.FAULTS)")
+    sim.add_argument("--virtual", default=None, metavar="SECONDS|demo",
+                     help="the virtual projector: the small core on a TAP in a network namespace of its own, for "
+                          "that many seconds, or 'demo' (the host CLI talks to it); needs root (sim.virtual)")
     sub.add_parser("waves", help="say where the latest VCD and its GTKWave save file are")
     args = parser.parse_args(argv)
 
@@ -41,6 +44,16 @@ def main(argv=None):
     if args.command == "bench":
         from flow.bench import main as run
         return run(args.only, resources=not args.no_resources)
+    if args.command == "sim" and args.virtual:
+        from sim import virtual
+        if args.virtual != "demo":
+            return virtual.main(float(args.virtual))
+        try:
+            report = virtual.demo()
+        except RuntimeError as error:
+            print(error)
+            return 2
+        return 0 if report.get("max_error_lsb") == 0 else 1
     if args.command == "sim":
         from sim.system import main as run
         return run(frames=args.frames, dclk_hz=args.dclk * 1e6, faults=args.faults)

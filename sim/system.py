@@ -25,7 +25,7 @@ from spec import schedule
 from spec.facts import DMDS
 from spec.registers import PlaneOrder, ResetMode
 
-__all__ = ["main", "run", "plan", "power_up_plan", "PARAMS", "XGA_FRAMES"]
+__all__ = ["main", "run", "core", "plan", "power_up_plan", "PARAMS", "XGA_FRAMES"]
 
 MAC, IP, PORT = 0x02_00_00_00_00_01, 0x0A_00_00_02, 5000
 DMD_NS = 5.0
@@ -57,15 +57,19 @@ def power_up_plan(p):
     return plan(p, exposure_s=3 * plan(p).params.lsb * DMD_NS * 1e-9)
 
 
+def core(p):
+    """The small-geometry core, built as the platform is: disarmed, with power-up registers unlike
+    any run's (the testbench configures and arms it through records)."""
+    dmd = DMDS[p["dmd"]]
+    return Projector(dmd, mac=MAC, ip=IP, port=PORT, regs=power_up_plan(p).params.registers(dmd),
+                     armed=False, mdio_cycles=(40, 10))
+
+
 def run(key="test", **overrides):
     """Build and run the system testbench; returns its report (dict)."""
     report = build_dir("system") / f"{key}.json"
     p = {**PARAMS, **overrides, "report": str(report)}
-    dmd = DMDS[p["dmd"]]
-    # built as the platform is: disarmed, the testbench configures and arms through records
-    core = Projector(dmd, mac=MAC, ip=IP, port=PORT, regs=power_up_plan(p).params.registers(dmd),
-                     armed=False, mdio_cycles=(40, 10))
-    build = cocotb_run.run(core, toplevel="projector", module="sim.tb.system", key=key, params=p)
+    build = cocotb_run.run(core(p), toplevel="projector", module="sim.tb.system", key=key, params=p)
     result = json.loads(report.read_text())
     result["build"] = str(build)
     return result

@@ -105,6 +105,14 @@ class System:
         self.mac = {"good": 0, "bad_fcs": 0}
         self.sequence = 0                # the host's record counter, as host.Client keeps it
         self.replies = []                # UDP payloads of frames on the transmit pins
+        self.tx_frames = []              # every frame on the transmit pins (no FCS)
+
+    @classmethod
+    async def started(cls, dut):
+        """The testbench's system on ``dut`` with the run's parameters, clocks and models running."""
+        system = cls(dut, params())
+        await system.start()
+        return system
 
     async def start(self):
         dut = self.dut
@@ -156,6 +164,7 @@ class System:
                 assert frame[:8] == gmii.PREAMBLE, "preamble or SFD wrong"
                 body = bytes(frame[8:])
                 assert zlib.crc32(body) == 0x2144DF1C, "bad FCS on a transmitted frame"
+                self.tx_frames.append(body[:-4])
                 packet = Ether(body[:-4])
                 if UDP in packet:
                     self.replies.append(bytes(packet[UDP].payload))
@@ -263,10 +272,8 @@ def bad_records(system, picture):
 
 @cocotb.test()
 async def frames_over_gmii_are_shown_exactly(dut):
-    p = params()
-    system = System(dut, p)
-    await system.start()
-    dmd = system.dmd
+    system = await System.started(dut)
+    p, dmd = system.p, system.dmd
     faults = p.get("faults", True)
     count = p["frames"] + (5 if faults else 0)
     if p.get("scene"):

@@ -1,0 +1,54 @@
+"""The virtual projector (:mod:`sim.virtual`): real host software, installed in a fresh virtual
+environment without Amaranth, talks through the operating system's network stack (a namespace
+of its own) to the core's generated Verilog on a TAP device, and the frame it sends is the frame
+the DMD shows. Skipped, with the reason, where the machine does not allow a network namespace and
+a TAP device."""
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from sim import virtual
+
+REASON = virtual.unavailable()
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def host_environment(tmp_path):
+    """A fresh virtual environment with this project installed as a user installs it on a lab PC
+    (``pip install .``: the host library and CLI, numpy its one dependency, from the package
+    index pip is configured with), from a copy of the sources without build products."""
+    src, env = tmp_path / "src", tmp_path / "env"
+    shutil.copytree(ROOT, src, ignore=shutil.ignore_patterns(".git", ".venv", "build", "*.egg-info", "__pycache__",
+                                                              ".*_cache", ".hypothesis"))
+    subprocess.run([sys.executable, "-m", "venv", str(env)], check=True, timeout=300)
+    subprocess.run([str(env / "bin" / "pip"), "install", "--quiet", str(src)], check=True, timeout=600,
+                   cwd=tmp_path)
+    return env / "bin" / "python"
+
+
+@pytest.mark.verilog
+@pytest.mark.skipif(REASON is not None, reason=f"virtual projector: {REASON}")
+def test_installed_host_cli_through_the_kernel_to_the_core(tmp_path):
+    python = host_environment(tmp_path)
+    check = "import sys, host.cli; assert 'amaranth' not in sys.modules; print(host.__file__)"
+    where = subprocess.run([str(python), "-c", check], check=True, capture_output=True, text=True,
+                           cwd=tmp_path).stdout
+    assert where.startswith(str(tmp_path / "env")), where
+    gone = subprocess.run([str(python), "-c", "import amaranth"], capture_output=True, text=True, cwd=tmp_path)
+    assert "ModuleNotFoundError" in gone.stderr
+
+    report = virtual.demo(seconds=600, log=lambda _text: None, python=str(python), cwd=tmp_path)
+    # the kernel ARPed for the projector, then pinged it; the CLI's records all got through
+    assert report["ping_s"] > 0
+    assert "records_status" in report["status_before"]
+    assert "8-bit" in report["send"]
+    # one frame triggered, one shown, exactly the image sent (the camera model on the pins)
+    assert len(report["shown"]) == 1 and report["shown"][0]["whole_levels"]
+    assert report["max_error_lsb"] == 0
+    after = dict(line.split()[:2] for line in report["status_after"].splitlines() if len(line.split()) >= 2)
+    assert after["frames_shown"] == "1" and after["triggers"] == "1"
+    assert report["frames_received"] > 0 and report["frames_sent"] > 0 and report["stopped"] == "file"
