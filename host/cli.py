@@ -12,7 +12,7 @@ import sys
 
 import numpy as np
 
-from spec import schedule
+from spec import plan_search, schedule
 from spec.facts import DMDS
 from spec.registers import PlaneOrder, ResetMode, TriggerMode
 
@@ -57,9 +57,16 @@ def _t_rst(args):
 
 def _plan(args):
     dmd = DMDS[args.dmd]
-    plan = schedule.plan(dmd, args.dclk, depth=args.depth, reset_mode=ResetMode[args.reset_mode],
-                         order=PlaneOrder[args.order], exposure_s=args.exposure, words_per_cycle=args.read_rate,
-                         t_rst_cycles=_t_rst(args))
+    common = dict(depth=args.depth, exposure_s=args.exposure, words_per_cycle=args.read_rate,
+                  t_rst_cycles=_t_rst(args))
+    if args.best:
+        found = plan_search.find(dmd, args.dclk, **common)
+        print(f"plan finder: every reset mode, plane order and hide threshold under TI's rules\n{found.table()}\n"
+              f"fastest: {found.binds}")
+        plan = found.plan
+    else:
+        plan = schedule.plan(dmd, args.dclk, reset_mode=ResetMode[args.reset_mode], order=PlaneOrder[args.order],
+                             **common)
     trigger = TriggerMode[args.trigger.upper()]
     period = round(args.period * schedule.FABRIC_HZ) if args.period else plan.frame_cycles
     params = dataclasses.replace(plan.params, trigger=trigger,
@@ -102,6 +109,10 @@ def main(argv=None):
                            help="DCLK in Hz the projector was built for (default 400e6; 200e6 for the older PROM)")
     configure.add_argument("--depth", type=int, default=8, help="bit-planes per frame, 1..8")
     configure.add_argument("--reset-mode", default="GLOBAL", choices=[m.name for m in ResetMode])
+    configure.add_argument("--best", action="store_true",
+                           help="search every reset mode, plane order and hide threshold for the fastest legal "
+                                "plan (spec.plan_search; about two minutes on the DLP7000) instead of "
+                                "--reset-mode and --order")
     configure.add_argument("--order", default="MSB_FIRST", choices=["MSB_FIRST", "LSB_FIRST"])
     configure.add_argument("--exposure", type=float, default=0.0,
                            help="least significant plane at least this long, seconds (0: shortest)")

@@ -65,7 +65,7 @@ from .registers import PlaneOrder, ResetMode, Source, TriggerMode, group_size
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate", "FABRIC_HZ",
            "beats_at", "row_cycles",
            "plan", "bound", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS", "flush_rows",
-           "RST_MARGIN", "even", "ready_cycle", "reload_bound", "reload_cycles"]
+           "RST_MARGIN", "even", "ready_cycle", "reload_bound", "reload_cycles", "on_time", "frame_period"]
 
 #: The ``dmd`` domain's clock: every cycle count of the model and the sequencer is in its cycles.
 #: DCLK is this (one beat per cycle) or twice this (two beats per cycle: 400 MHz through the
@@ -664,16 +664,14 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
                        strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period,
                        reload_lead=reload_lead, beats=beats, trigger_hold=trigger_hold)
             fr = frame or Frame(0, depth)
-            r = simulate(dmd, p, [replace(fr, ready=0)] * (3 if chain else 1), [ready_cycle(dmd, p, fr)],
-                         max_frames=2)
-            if r.late == 0:
+            if on_time(dmd, p, fr):
                 break
         lsb += max(2, even(lsb // 128))
     else:
         raise ValueError("no feasible schedule found")
     if lsb > lsb_min and binds != "requested exposure":
         binds += " + pulse spacing" if G > 1 else ""
-    frame_cycles = _frame_cycles(dmd, p, fr)
+    frame_cycles = frame_period(dmd, p, fr)
     if G > 1 and not chain and depth > 1:
         # phased PWM: the LSB lattice against spread groups, whichever is faster
         spread = _spread(dmd, replace(p, dark_gap=even(t_rst + t_settle + load_g + slack)), fr,
@@ -743,8 +741,8 @@ def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
         for s in stag[fits]:
             s = int(s)
             q = replace(p, lsb=lsb, stagger=s)
-            if simulate(dmd, q, [replace(fr, ready=0)], [ready_cycle(dmd, q, fr)], max_frames=2).late == 0:
-                cycles = _frame_cycles(dmd, q, fr)
+            if on_time(dmd, q, fr):
+                cycles = frame_period(dmd, q, fr)
                 if cycles < (beat if best is None else best[1]):
                     best = (q, cycles)
                 break
@@ -773,7 +771,14 @@ def ready_cycle(dmd, p, fr):
     return max(st.loaded_at for st in r.groups)
 
 
-def _frame_cycles(dmd, p, fr):
+def on_time(dmd, p, fr):
+    """The frame ``fr`` played under ``p`` (three of them, chained) has no pulse late: every
+    plane is shown at its length."""
+    r = simulate(dmd, p, [replace(fr, ready=0)] * (3 if p.chain else 1), [ready_cycle(dmd, p, fr)], max_frames=2)
+    return r.late == 0
+
+
+def frame_period(dmd, p, fr):
     """Shortest trigger-to-trigger period (triggered) or frame period (chained)."""
     if p.chain:
         r = simulate(dmd, p, [fr] * 4, [ready_cycle(dmd, p, fr)], max_frames=3)
