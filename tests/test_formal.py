@@ -112,9 +112,13 @@ class Through(wiring.Component):
         return m
 
 
+def _sequencer_check(name):
+    return next(check for check in sequencer.sequencer_checks() if check.name == name)
+
+
 def test_sequencer_init_rule(monkeypatch):
     from gateware.dlpc410 import init
-    check, _, _ = sequencer.sequencer_checks()
+    check = _sequencer_check("no command during INIT_ACTIVE")
     assert run(check).status == "proven"
     monkeypatch.setattr(init, "FFSynchronizer", Through)
     with pytest.raises(FormalFailure) as failure:
@@ -125,7 +129,7 @@ def test_sequencer_init_rule(monkeypatch):
 def test_sequencer_rst_active_rule():
     """Proven; and not vacuous: claimed one cycle sooner than the synchroniser allows, it fails
     (a pulse is reached with RST_ACTIVE rising just before it)."""
-    _, check, _ = sequencer.sequencer_checks()
+    check = _sequencer_check("no clocking pulse while RST_ACTIVE is high")
     assert run(check).status == "proven"
     with pytest.raises(FormalFailure) as failure:
         run(dataclasses.replace(check, block="Sequencer-rst-one-cycle", induction=None,
@@ -136,9 +140,35 @@ def test_sequencer_rst_active_rule():
 def test_sequencer_settle_rule():
     """Checked to the suite's depth (a pulse comes at step 15, the loads after it from step 23);
     and not vacuous: claimed one cycle longer after a pulse than the sequencer waits, it fails."""
-    _, _, check = sequencer.sequencer_checks()
+    check = _sequencer_check("no load within the settle time after a pulse and after RST_ACTIVE fell")
     assert run(check, depth=check.quick).status == "checked"
     with pytest.raises(FormalFailure) as failure:
         run(dataclasses.replace(check, block="Sequencer-settle-one-more", build=lambda: sequencer.settle_top(extra=1)),
             depth=check.quick)
     assert "a load sooner than t_rst + t_settle after a pulse" in failure.value.result.failed
+
+
+@pytest.mark.parametrize("dmd", [sequencer.DMD, sequencer.DMD_1080P_CLEAR], ids=["one-row-clear", "1080p-clear"])
+def test_sequencer_clear_rule(dmd):
+    """Proven; and not vacuous: claimed one no-op row cycle longer than the DMD takes, it fails (a
+    clear of block 0 at step 12, a second clear right after it at step 14; on the 1080p clear a
+    row load right after the two no-op rows, at step 18)."""
+    name = "no clear overlapping a row load" + (", 1080p clear" if dmd.clear_row_cycles > 1 else "")
+    check = _sequencer_check(name)
+    assert run(check).status == "proven"
+    with pytest.raises(FormalFailure) as failure:
+        run(dataclasses.replace(check, block="Sequencer-clear-one-more", induction=None,
+                                build=lambda: sequencer.clear_top(dmd, extra=1)), depth=20)
+    assert failure.value.result.failed == ["a row load, clear or pulse of the block within a clear's no-op rows"]
+
+
+def test_sequencer_phased_settle_rule():
+    """Checked to the suite's depth (a group's first pulse at step 22); and not vacuous: claimed
+    one cycle longer after a pulse than the sequencer waits, it fails (a quad pulse at step 22, a
+    clear of one of its blocks at step 30), which also shows the claim holds to step 29."""
+    check = _sequencer_check("no load of a pulsed group within its settle time, phased modes")
+    assert run(check, depth=check.quick).status == "checked"
+    with pytest.raises(FormalFailure) as failure:
+        run(dataclasses.replace(check, block="Sequencer-phased-settle-one-more",
+                                build=lambda: sequencer.phased_settle_top(extra=1)), depth=31)
+    assert failure.value.result.failed == ["a load sooner than t_rst + t_settle after a pulse"]
