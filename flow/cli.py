@@ -23,6 +23,9 @@ def main(argv=None):
     sim.add_argument("--dclk", type=float, default=400, choices=(200, 400), help="DCLK in MHz (default 400)")
     sim.add_argument("--faults", choices=("stalls", "rst", "all"), default=None,
                      help="memory stalls at random, RST_ACTIVE held longer than planned, or both (sim.xga.FAULTS)")
+    sim.add_argument("--window", type=int, default=None, metavar="K",
+                     help="also dump every signal of the core from 10 us before one-by-one trigger K (1 to 3) "
+                          "to just after its frame's first pulse, with a GTKWave save file grouped by block")
     sim.add_argument("--virtual", default=None, metavar="SECONDS|demo",
                      help="the virtual projector: the small core on a TAP in a network namespace of its own, for "
                           "that many seconds, or 'demo' (the host CLI talks to it); needs root (sim.virtual)")
@@ -56,7 +59,7 @@ def main(argv=None):
         return 0 if report.get("max_error_lsb") == 0 else 1
     if args.command == "sim":
         from sim.system import main as run
-        return run(frames=args.frames, dclk_hz=args.dclk * 1e6, faults=args.faults)
+        return run(frames=args.frames, dclk_hz=args.dclk * 1e6, faults=args.faults, window=args.window)
     if args.command == "waves":
         from sim.harness.waves import main as run
         return run()

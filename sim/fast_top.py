@@ -11,7 +11,9 @@ Simulation only. Around :class:`gateware.top.system.Projector` it places the Ver
   does (the offline replay cross-checks them);
 * two ``trace_recorder.v`` write the DLPC410 pins (with the trigger, sync and camera pins) and the
   GMII transmit pins to files, only on cycles where something happens, for the rule-checking
-  model and the camera model (:mod:`sim.models.trace`) after the run.
+  model and the camera model (:mod:`sim.models.trace`) after the run;
+* with ``window``, ``wave_window.v`` dumps every signal of the design while ``wave_dump`` is high
+  (a build with tracing: :data:`WINDOW_SOURCES`).
 
 Clocks come from the testbench: ``clk`` (125 MHz) and ``dmd_clk`` (200 MHz); resets are made
 inside. The GMII receive and transmit domains run on ``clk`` here: every edge costs the simulator
@@ -34,13 +36,16 @@ from sim.models.dlpc410_replay import Replay
 from sim.models.mcb import McbTiming
 
 __all__ = ["FastSystem", "ResponderBench", "dlpc410_side", "power_on_reset", "pin_layout", "SOURCES", "PLUSARGS",
-           "read_rate", "INGEST_BYTES_PER_S"]
+           "WINDOW_SOURCES", "read_rate", "INGEST_BYTES_PER_S"]
 
 #: The Verilog models the top instantiates.
 SOURCES = [ROOT / "sim" / "hdl" / name for name in
            ("gmii_replay.v", "mcb_model.v", "dlpc410_responder.v", "trace_recorder.v")]
-#: Plusargs naming the files: GMII replay in, DLPC410 pin trace and GMII transmit trace out.
-PLUSARGS = {"replay": "GMII_REPLAY", "pins": "DLPC_TRACE", "tx": "GMII_TX_TRACE"}
+#: The wave window's model and its DPI function (a Verilator build with tracing).
+WINDOW_SOURCES = [ROOT / "sim" / "hdl" / name for name in ("wave_window.v", "wave_window.cpp")]
+#: Plusargs naming the files: GMII replay in, DLPC410 pin trace, GMII transmit trace and the
+#: wave window's dump out.
+PLUSARGS = {"replay": "GMII_REPLAY", "pins": "DLPC_TRACE", "tx": "GMII_TX_TRACE", "window": "WAVE_WINDOW"}
 
 #: ECP2_FINISHED rises on this cycle (the DLPC410 model's default).
 ECP2_CYCLES = 4
@@ -175,6 +180,9 @@ class FastSystem(wiring.Component):
         DDR2 timing (default :class:`sim.models.mcb.McbTiming`, the Python model's).
     beats : int
         DCLK cycles per ``dmd`` cycle (2: DCLK 400 MHz).
+    window : bool
+        Adds the wave window (``wave_dump``, ``sync_out``); build with :data:`WINDOW_SOURCES`
+        and tracing.
 
     Members
     -------
@@ -191,10 +199,14 @@ class FastSystem(wiring.Component):
         The memory ports' rule-break codes (``mcb_model.v``), 4 bits per port; 0 = none.
     mcb_stalls : Out(32)
         Commands the memory model stalled at random (plusargs; none by default).
+    wave_dump : In(1); sync_out : Out(1)
+        With ``window``: every signal is dumped while ``wave_dump`` is high (once, to the file
+        of plusarg ``PLUSARGS["window"]``); the core's sync out, for the testbench to close the
+        window after a frame's first pulse.
     """
 
     def __init__(self, dmd, registers, *, mac, ip, port, clocks, init_cycles=200, init_grace_cycles=4,
-                 memory_words=1 << 21, timing=None, beats=1):
+                 memory_words=1 << 21, timing=None, beats=1, window=False):
         self._dmd, self._beats = dmd, beats
         self._registers = registers
         self._addresses = dict(mac=mac, ip=ip, port=port)
@@ -202,6 +214,7 @@ class FastSystem(wiring.Component):
         self._init = (init_cycles, init_grace_cycles)
         self._memory_words = memory_words
         self._timing = timing or McbTiming()
+        self._window = window
         super().__init__({
             "clk": In(1),
             "dmd_clk": In(1),
@@ -211,6 +224,7 @@ class FastSystem(wiring.Component):
             "flush": In(1),
             "mcb_fault": Out(8),
             "mcb_stalls": Out(32),
+            **({"wave_dump": In(1), "sync_out": Out(1)} if window else {}),
         })
 
     def _memory(self, m, core):
@@ -283,4 +297,7 @@ class FastSystem(wiring.Component):
             "trace_recorder", p_WIDTH=len(tx.as_value()), p_PLUSARG=PLUSARGS["tx"],
             i_clk=ClockSignal("gmii_tx"), i_rst=ResetSignal("gmii_tx"), i_value=tx.as_value(), i_always_record=tx.en,
             i_flush=self.flush)
+        if self._window:
+            m.submodules.wave_window = Instance("wave_window", i_dump=self.wave_dump)
+            m.d.comb += self.sync_out.eq(core.sync_out)
         return m

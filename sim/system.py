@@ -21,6 +21,7 @@ from gateware.top.system import Projector
 from sim import xga
 from sim.harness import cocotb_run
 from sim.harness.paths import build_dir
+from sim.harness.waves import declared
 from spec import schedule
 from spec.facts import DMDS
 from spec.registers import PlaneOrder, ResetMode
@@ -82,10 +83,12 @@ def latency(shown):
     return latencies[len(latencies) // 2], latencies[-1]
 
 
-def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None):
+def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=None):
     """``make sim``: the full-XGA run of :mod:`sim.xga` on the default scene; prints the figures.
     ``faults`` (``make sim FAULTS=stalls|rst|all``): the same run with the chips misbehaving
-    (:data:`sim.xga.FAULTS`)."""
+    (:data:`sim.xga.FAULTS`). ``window`` (``make sim WINDOW=<k>``): every signal of the core is
+    dumped from shortly before one-by-one trigger ``k`` to just after its frame's first clocking
+    pulse, with a save file of its own."""
     frames = frames or XGA_FRAMES
     dmd = xga.DMD
     print(f"make sim: the projector's core (generated Verilog, Verilator) on the default scene, "
@@ -102,8 +105,9 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None):
         print(f"faults: RST_ACTIVE held {f['dlpc410_rst_extra']} cycles longer than the facts table's time; "
               f"a first short run measures it (status rst_active_cycles_max) and the run is planned with it")
     t0 = time.monotonic()
-    r = xga.run(f"scene-{faults}" if faults else "scene", frames=frames, one_by_one=XGA_ONE_BY_ONE,
-                back_to_back=XGA_BACK_TO_BACK, dclk_hz=dclk_hz, faults=faults)
+    key = "-".join(["scene", *([faults] if faults else []), *([f"window{window}"] if window else [])])
+    r = xga.run(key, frames=frames, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK, dclk_hz=dclk_hz,
+                faults=faults, window=window)
     shown, status = r["frames"], r["status"]
     ns = 1e9 / xga.DMD_HZ
     typical, worst = latency(shown)
@@ -152,6 +156,8 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None):
     print(f"waves: {vcd} (DLPC410 pins, trigger, sync and camera outputs of the first frame triggered, "
           f"written from the pin trace; the full design is not dumped at XGA)\n"
           f"  GTKWave save file: {save} (opens on the trigger; markers A trigger, B first pulse, C last pulse)")
+    if window:
+        print_window(r["window"], window)
     exact = all(f["max_error_lsb"] == 0 for f in shown) and len(shown) == XGA_ONE_BY_ONE + XGA_BACK_TO_BACK
     return 0 if exact else 1
 
@@ -170,6 +176,54 @@ SAVE_GROUPS = {
                                 "dlpc__blkad[3:0]", "dlpc__din_a[31:0]", "dlpc__din_b[31:0]",
                                 "dlpc__rst_active", "dlpc__init_active", "dlpc__arstz"],
 }
+
+
+#: The core's blocks in the whole-core dump (``make sim WINDOW=<k>``): the scopes, under the core,
+#: whose own signals each group of the save file shows.
+WINDOW_GROUPS = {
+    "MAC: GMII receive": ["ethernet.rx.mac"],
+    "MAC: GMII transmit": ["ethernet.tx.mac"],
+    "network stack": [f"ethernet.endpoint.stack{block}" for block in ("", ".eth", ".ipv4", ".udp", ".buffer")],
+    "protocol: parser, rows, serialiser": ["ethernet.endpoint.parser", "ethernet.endpoint.rows", "serialiser"],
+    "store: writer": ["store.writer"],
+    "store: slot table": ["store.slots.table"],
+    "store: reader": ["store.reader"],
+    "sequencer: control (broker, trigger, control)": ["broker", "sequencer.trigger", "sequencer.control"],
+    "sequencer: planner": ["sequencer.planner"],
+    "sequencer: bus": ["sequencer.bus"],
+}
+#: The core's pins the last group shows: DLPC410, trigger, sync and camera.
+WINDOW_PINS = [name.split("[")[0] for group in ("sequencer: trigger and sync", "sequencer: DLPC410 pins")
+               for name in SAVE_GROUPS[group]]
+
+
+def window_groups(vcd, core="fast_system.core"):
+    """:data:`WINDOW_GROUPS` with the signals ``vcd`` declares (names under ``core``; Amaranth's
+    anonymous ``$`` signals left out), then the core's DLPC410 pins; groups the dump lacks are
+    left out."""
+    scopes = declared(vcd)
+
+    def own(scope):
+        return [f"{scope}.{name}" if scope else name for name in scopes.get(".".join(filter(None, (core, scope))), [])
+                if "$" not in name]
+    groups = {group: [name for scope in where for name in own(scope)] for group, where in WINDOW_GROUPS.items()}
+    groups["DLPC410 pins, trigger, sync and camera"] = [name for name in own("") if name.split("[")[0] in WINDOW_PINS]
+    return {group: names for group, names in groups.items() if names}
+
+
+def print_window(w, k):
+    """Writes the whole-core dump's save file and says where both are."""
+    vcd = Path(w["path"])
+    start, end = w["span_ps"]
+    markers = w["markers"]
+    save = write_save_file(vcd, window_groups(vcd), "fast_system.core", view=(start, end), markers=markers)
+    print(f"whole core dumped (every signal, VCD): {vcd}, {vcd.stat().st_size / 2**20:.0f} MiB, "
+          f"{start / 1e6:.3f} to {end / 1e6:.3f} us ({(end - start) / 1e6:.1f} us of simulated time): from "
+          f"{xga.WINDOW_LEAD_US} us before trigger {k} to {xga.WINDOW_AFTER_US} us after its frame's first "
+          f"clocking pulse\n"
+          f"  GTKWave save file: {save} (grouped by block, buses in hex; opens on the window; markers "
+          + ", ".join(f"{chr(ord('A') + i)} {name} {t / 1e6:.3f} us" for i, (name, t) in enumerate(markers.items()))
+          + ")")
 
 
 #: The pin trace's fields by what they are, for the XGA run's save file.

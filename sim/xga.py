@@ -19,6 +19,10 @@ RST_ACTIVE is measured first, in a short run, and the run is planned with it (as
 with ``rst_active_cycles_max``); memory stalls make the frame starts differ from the schedule
 model's (the sequencer waits for late rows), so they are then reported, not compared.
 
+With ``window`` (a one-by-one trigger ``k``), every signal of the design is dumped for a bounded
+window: from :data:`WINDOW_LEAD_US` before trigger ``k`` to :data:`WINDOW_AFTER_US` after its
+frame's first clocking pulse (:mod:`sim.tb.system_fast`), from a build with tracing of its own.
+
 Timing: DCLK 400 MHz (two beats per 200 MHz ``dmd`` cycle) by default, or 200 MHz; RST_ACTIVE and
 settle from the facts table (no scaling); only the DLPC410's initialisation (220 ms) is shortened,
 to ``INIT_CYCLES``. The schedule comes from :func:`spec.schedule.plan` with the read bandwidth
@@ -35,7 +39,7 @@ from scapy.layers.l2 import Ether
 from scapy.packet import Raw
 
 from host import codec
-from sim.fast_top import PLUSARGS, SOURCES, FastSystem, pin_layout, read_rate
+from sim.fast_top import PLUSARGS, SOURCES, WINDOW_SOURCES, FastSystem, pin_layout, read_rate
 from sim.harness import cocotb_run
 from sim.harness.paths import build_dir
 from sim.models import bitplane, gmii, trace
@@ -68,6 +72,10 @@ FAULTS = {"stalls": _STALLS, "rst": _RST, "all": {**_STALLS, **_RST}}
 #: to this many after its last pulse; its save file opens on this many cycles from the trigger.
 WAVE_WINDOW = (1000, 2000)
 WAVE_VIEW = 3000
+#: The dump of every signal (``window``) opens this long before the trigger (which comes that
+#: much later) and closes this long after the frame's first clocking pulse: the idle core dumps
+#: about 1.5 MB a microsecond (status counters of a thousand bits change every cycle).
+WINDOW_LEAD_US, WINDOW_AFTER_US = 10, 5
 
 
 def plan(dclk_hz=DCLK_HZ, t_rst_cycles=None):
@@ -88,10 +96,10 @@ def calibrate(key, dclk_hz=DCLK_HZ, faults=None, log=print):
     return r["status"]["rst_active_cycles_max"]
 
 
-def top(the_plan):
+def top(the_plan, window=False):
     return FastSystem(DMD, the_plan.params.registers(DMD), mac=MAC, ip=IP_ADDR, port=PORT,
                       clocks={"sync": SYNC_HZ, "dmd": DMD_HZ}, init_cycles=INIT_CYCLES,
-                      init_grace_cycles=INIT_GRACE, beats=the_plan.params.beats)
+                      init_grace_cycles=INIT_GRACE, beats=the_plan.params.beats, window=window)
 
 
 def _datagrams(payloads, port=PORT):
@@ -135,7 +143,7 @@ def _status(tx_trace):
 
 
 def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, faults=None, log=print,
-        calibrated=True):
+        calibrated=True, window=None):
     """Build and run the XGA system simulation on ``frames`` frames of the default scene, stored
     as a sequence; ``one_by_one`` frames triggered each when the sequencer is ready, then
     ``back_to_back`` frames triggered faster than they can be shown. Returns the report (dict).
@@ -144,7 +152,10 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
     the images' errors are in the report. ``faults``: a key of :data:`FAULTS`, the chips
     misbehave; when the controller's RST_ACTIVE is not the facts table's, the run is planned
     with the time the projector measured in a first short run (:func:`calibrate`), unless
-    ``calibrated`` is false."""
+    ``calibrated`` is false. ``window``: dumps every signal around one-by-one trigger ``window``
+    (1 to ``one_by_one``); the report's ``window`` says where, its span and its markers."""
+    if window is not None and not 1 <= window <= one_by_one:
+        raise ValueError(f"window: a trigger from 1 to {one_by_one}, not {window}")
     t_rst_cycles = None
     if calibrated and "dlpc410_rst_extra" in FAULTS.get(faults, {}):
         t_rst_cycles = calibrate(key, dclk_hz, faults, log)
@@ -165,16 +176,20 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
          # a frame's first plane is loaded about 155 us after its last byte (the stack forwards the
          # last datagram once its FCS is checked, then the plane is read from DDR2)
          "settle_us": 250,
-         "margin_us": 20, "reply_us": 30, "progress_us": 2000, "report": str(report_path)}
+         "margin_us": 20, "reply_us": 30, "progress_us": 2000, "report": str(report_path),
+         "window": window and {"trigger": window, "lead_us": WINDOW_LEAD_US, "after_us": WINDOW_AFTER_US}}
     plusargs = [f"+{PLUSARGS['replay']}={p['replay']}", f"+{PLUSARGS['pins']}={files['pins']}",
                 f"+{PLUSARGS['tx']}={files['tx']}"]
     if faults:
         plusargs += [f"+{name}={value}" for name, value in FAULTS[faults].items()]
+    if window:
+        plusargs.append(f"+{PLUSARGS['window']}={directory / 'window.vcd'}")
     t_build = time.monotonic()
-    build = cocotb_run.run(top(the_plan), toplevel=TOPLEVEL, module="sim.tb.system_fast",
-                           key=f"dlp7000-{the_plan.params.beats}beats",
-                           params=p, extra_sources=SOURCES, plusargs=plusargs, waves=False,
-                           top_signals_only=True)
+    # the window's build traces: a key of its own, so that the other runs stay untraced
+    build = cocotb_run.run(top(the_plan, bool(window)), toplevel=TOPLEVEL, module="sim.tb.system_fast",
+                           key=f"dlp7000-{the_plan.params.beats}beats" + ("-window" if window else ""),
+                           params=p, extra_sources=SOURCES + (WINDOW_SOURCES if window else []), plusargs=plusargs,
+                           waves=False, traced=bool(window), top_signals_only=True)
     stimulus = json.loads(report_path.read_text())
     sim_wall = stimulus["wall_s"]
     log(f"simulation done: build and run {time.monotonic() - t_build:.0f} s, of which the run {sim_wall:.0f} s; "
@@ -182,7 +197,24 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
     report = analyse(the_plan, images, stimulus, files, one_by_one=one_by_one, back_to_back=back_to_back,
                      build=build, faults=faults)
     report["t_rst_cycles"], report["t_rst_measured"] = the_plan.params.t_rst, t_rst_cycles is not None
+    if window:
+        report["window"] = _window(directory / "window.vcd", stimulus, report, window)
     return report
+
+
+def _window(path, stimulus, report, k):
+    """The dump of every signal: its path, size, span and markers (ps of simulated time, as in
+    the dump): trigger ``k`` and its frame's first clocking pulse."""
+    frame = report["frames"][k - 1]
+    # a pin trace cycle is the dmd edge that sampled the pins; trigger k's edge is known
+    edge_ns = stimulus["trigger_edges_ns"][k - 1]
+
+    def ps(ns):
+        return round(ns * 1e3)
+    first_pulse_ns = edge_ns + (frame["start_cycle"] - frame["trigger_cycle"]) * 1e9 / DMD_HZ
+    w = stimulus["window"]
+    return {"path": str(path), "bytes": path.stat().st_size, "span_ps": (ps(w["open_ns"]), ps(w["close_ns"])),
+            "markers": {"trigger": ps(stimulus["triggers_ns"][k - 1]), "first pulse": ps(first_pulse_ns)}}
 
 
 def _frames_shown(pins, layout, pulses):
@@ -254,7 +286,7 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
         waves = trace.write_vcd(Path(files["pins"]).with_suffix(".vcd"), pins, layout,
                                 start=start, end=frames[0][1] + WAVE_WINDOW[1], ns_per_cycle=1e9 / DMD_HZ)
     sends = stimulus["sends"]
-    first_frame = sends[1]
+    first_frame = next(s for s in sends if s["what"].startswith("frame 1/"))
     return {
         "frames": shown,
         "dclk_hz": DMD_HZ * p.beats,

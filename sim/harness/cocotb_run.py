@@ -5,9 +5,11 @@ parameter set (``build/cocotb/<toplevel>-<key>/``, safe under pytest-xdist: see 
 runs the cocotb module in a directory of its own and fails the calling pytest test if any cocotb
 test failed or none ran. Parameters reach the testbench as JSON in the ``DUT_PARAMS`` environment
 variable (read it with :func:`params`). ``WAVES=1`` in the environment records a VCD of the run
-in its run directory.
+in its run directory. ``traced=True`` builds with tracing but dumps nothing from the start: the
+design opens and closes its own dump (``sim/hdl/wave_window.v``).
 """
 
+import contextlib
 import fcntl
 import functools
 import hashlib
@@ -70,7 +72,7 @@ def _tokens(text):
 
 
 def run(component, *, toplevel, module, key, params=None, testcase=None, waves=None,
-        extra_sources=(), plusargs=(), timeout_s=None, top_signals_only=True, run_dir=None):
+        extra_sources=(), plusargs=(), timeout_s=None, top_signals_only=True, run_dir=None, traced=False):
     """Build ``component`` and run the cocotb tests in ``module`` against it.
 
     Parameters
@@ -86,6 +88,13 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
         Names the parameter set; one build directory per key.
     params : dict
         JSON-able parameters handed to the testbench.
+    extra_sources : list of path
+        Verilog models and Verilator control files; C++ files (DPI functions) too, which go to
+        Verilator's command line (the runner takes only Verilog and control files as sources).
+    traced : bool
+        Build with tracing (Verilator ``--trace``) but run without dumping from the start, for a
+        design that opens and closes its own dump. Give it a ``key`` of its own: the build is
+        slower to run than an untraced one.
     top_signals_only : bool
         Make only the top module's signals visible to the testbench, not every signal of the
         design (cocotb's default). Verilator must then re-evaluate only the logic that depends on
@@ -116,14 +125,15 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
         files["public.vlt"] = f'`verilator_config\npublic_flat_rw -module "{toplevel}" -var "*"\n'
     sources = [build / name for name in sorted(files, key=lambda n: not n.endswith(".vlt"))]
     # the runner takes the last source for the top's language: the control file goes first
-    sources += [Path(p) for p in extra_sources]
-    stamp = _stamp(toplevel, files, extra_sources, waves, top_signals_only)
+    sources += [Path(p) for p in extra_sources if Path(p).suffix != ".cpp"]
+    cpp = [str(p) for p in extra_sources if Path(p).suffix == ".cpp"]
+    stamp = _stamp(toplevel, files, extra_sources, waves or traced, top_signals_only)
 
     with _lock(build.parent / f"{build.name}.lock") as lock:
         if not _built(build, toplevel, stamp):
             lock.exclusive()
             if not _built(build, toplevel, stamp):
-                _build(build, toplevel, files, sources, waves, top_signals_only)
+                _build(build, toplevel, files, sources, waves or traced, top_signals_only, cpp)
                 (build / "stamp").write_text(stamp)
             lock.shared()
         directory = Path(run_dir) if run_dir is not None else \
@@ -163,7 +173,7 @@ def _built(build, toplevel, stamp):
     return (build / toplevel).exists() and stamp_file.exists() and stamp_file.read_text() == stamp
 
 
-def _build(build, toplevel, files, sources, waves, top_signals_only):
+def _build(build, toplevel, files, sources, waves, top_signals_only, cpp=()):
     from cocotb_tools.runner import get_runner
 
     for name, text in files.items():
@@ -174,15 +184,16 @@ def _build(build, toplevel, files, sources, waves, top_signals_only):
     runner = get_runner("verilator")
     if top_signals_only:
         _drop_public_flat_rw(runner)
-    runner.build(
-        sources=sources,
-        hdl_toplevel=toplevel,
-        build_dir=build,
-        build_args=VERILATOR_ARGS,
-        waves=waves,
-        timescale=("1ns", "1ps"),
-        log_file=build / "build.log",
-    )
+    with _waves_env(waves):
+        runner.build(
+            sources=sources,
+            hdl_toplevel=toplevel,
+            build_dir=build,
+            build_args=[*VERILATOR_ARGS, *cpp],
+            waves=waves,
+            timescale=("1ns", "1ps"),
+            log_file=build / "build.log",
+        )
 
 
 def _test(build, directory, *, toplevel, module, params, testcase, waves, plusargs, timeout_s):
@@ -200,18 +211,19 @@ def _test(build, directory, *, toplevel, module, params, testcase, waves, plusar
     results.unlink(missing_ok=True)
     runner = get_runner("verilator")
     try:
-        runner.test(
-            test_module=module,
-            hdl_toplevel=toplevel,
-            hdl_toplevel_lang="verilog",
-            build_dir=build,
-            test_dir=directory,
-            testcase=testcase,
-            extra_env=env,
-            waves=waves,
-            results_xml=str(results),
-            plusargs=list(plusargs),
-        )
+        with _waves_env(waves):
+            runner.test(
+                test_module=module,
+                hdl_toplevel=toplevel,
+                hdl_toplevel_lang="verilog",
+                build_dir=build,
+                test_dir=directory,
+                testcase=testcase,
+                extra_env=env,
+                waves=waves,
+                results_xml=str(results),
+                plusargs=list(plusargs),
+            )
     except SystemExit as exc:
         # under pytest the runner exits on failure; report it as the test's failure, with counts
         if not results.exists():
@@ -221,6 +233,21 @@ def _test(build, directory, *, toplevel, module, params, testcase, waves, plusar
     assert tests > 0, f"cocotb ran no test from {module}"
     assert failed == 0, f"{failed} of {tests} cocotb tests failed in {module} (see {directory})"
     return True
+
+
+@contextlib.contextmanager
+def _waves_env(waves):
+    """``WAVES`` in the environment as :func:`run` decided: the runner lets the variable override
+    its ``waves`` argument, and a traced build is made with waves whatever ``WAVES`` says."""
+    before = os.environ.get("WAVES")
+    os.environ["WAVES"] = "1" if waves else "0"
+    try:
+        yield
+    finally:
+        if before is None:
+            del os.environ["WAVES"]
+        else:
+            os.environ["WAVES"] = before
 
 
 def _run_name():

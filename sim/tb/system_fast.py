@@ -12,6 +12,11 @@ loaded, at a different phase of the trigger against the clock; then ``back_to_ba
 come faster than frames can be shown (every ``fast_period_cycles``): each is held until the
 sequencer is ready. At the end a status query is sent and the reply is recorded on the transmit
 pins.
+
+With ``window`` (``{"trigger": k, "lead_us": .., "after_us": ..}``), every signal is dumped
+from ``lead_us`` before one-by-one trigger ``k`` (which comes that much later) to ``after_us``
+after sync out rises at its frame's first pulse. (The frame's last GMII byte is milliseconds
+earlier: frames are all sent first, and a frame sent just before its trigger is not shown.)
 """
 
 import json
@@ -32,7 +37,7 @@ class Run:
     def __init__(self, dut, p):
         self.dut, self.p = dut, p
         self.wall0 = time.monotonic()
-        self.events = {"sends": [], "triggers_ns": [], "wall": {}}
+        self.events = {"sends": [], "triggers_ns": [], "trigger_edges_ns": [], "wall": {}}
 
     def now_ns(self):
         return cocotb.utils.get_sim_time("ns")
@@ -70,12 +75,28 @@ class Run:
         """A trigger pulse, ``phase_ps`` after a ``dmd`` rising edge (the pin is asynchronous)."""
         dut = self.dut
         await RisingEdge(dut.dmd_clk)
+        # the edge after this one samples the pin (phase_ps is under a cycle)
+        self.events["trigger_edges_ns"].append(self.now_ns() + DMD_NS)
         if phase_ps:
             await Timer(phase_ps, "ps")
         self.events["triggers_ns"].append(self.now_ns())
         dut.trigger_in.value = 1
         await Timer(40, "ns")
         dut.trigger_in.value = 0
+
+    async def window_open(self, lead_us):
+        """Opens the wave window, then waits ``lead_us``."""
+        self.dut.wave_dump.value = 1
+        self.events["window"] = {"open_ns": self.now_ns()}
+        await Timer(lead_us, "us")
+
+    async def window_close(self, after_us):
+        """Closes the wave window ``after_us`` after sync out rises (the frame's first pulse)."""
+        await RisingEdge(self.dut.sync_out)
+        await Timer(after_us, "us")
+        self.dut.wave_dump.value = 0
+        self.events["window"]["close_ns"] = self.now_ns()
+        self.log("wave window closed")
 
     async def mark(self, at_ns, name):
         """Note the wall time when simulated time reaches ``at_ns``."""
@@ -100,12 +121,18 @@ async def stream_frames(dut):
     cocotb.start_soon(run.progress(p["progress_us"]))
     period_ns = p["period_cycles"] * DMD_NS
     frames = p["frames"]
+    window = p.get("window")
+    if window:
+        dut.wave_dump.value = 0
     await run.send(p["replays"][0], "sequence of stored frames (control record)")
     for index in range(frames):
         await run.send(p["replays"][index + 1], f"frame {index + 1}/{frames}")
     await Timer(p["settle_us"], "us")
     shown = 0
     for index in range(p["one_by_one"]):
+        if window and index == window["trigger"] - 1:
+            await run.window_open(window["lead_us"])
+            cocotb.start_soon(run.window_close(window["after_us"]))
         # a different phase of the trigger against DCLK each time: latency has a spread
         await run.trigger((index * 1300) % int(DMD_NS * 1000))
         if index == 0:
