@@ -34,6 +34,7 @@ import numpy as np
 
 from sim.harness import cocotb_run
 from sim.harness.paths import build_dir
+from sim.models.net import ones_sum
 
 __all__ = ["unavailable", "Namespace", "serve", "demo", "PROJECTOR", "HOST_ADDRESS"]
 
@@ -163,10 +164,7 @@ def ping(address, timeout=10.0):
     sock = socket.socket(socket.AF_INET, socket.SOCK_RAW, socket.IPPROTO_ICMP)
     sock.settimeout(timeout)
     ident, payload = os.getpid() & 0xFFFF, b"dmd projector ping"
-    header = struct.pack("!BBHHH", 8, 0, 0, ident, 1)
-    total = sum(struct.unpack(f"!{(len(header + payload)) // 2}H", header + payload))
-    total = (total & 0xFFFF) + (total >> 16)
-    checksum = ~((total & 0xFFFF) + (total >> 16)) & 0xFFFF
+    checksum = ~ones_sum(struct.pack("!BBHHH", 8, 0, 0, ident, 1) + payload) & 0xFFFF
     t0 = time.monotonic()
     sock.sendto(struct.pack("!BBHHH", 8, 0, checksum, ident, 1) + payload, (address, 0))
     while True:

@@ -140,10 +140,8 @@ class ResetWatch(wiring.Component):
 
         # the longest reset: with the loose reading another group's pulse may come first, and
         # the fall no longer dates this pulse's reset
-        pulsed_at, longest = Signal(TIME_BITS), Signal(COUNTER_BITS)
-        with m.If(self.pulse.valid):
-            m.d.sync += pulsed_at.eq(now)
-        length = (fell_at - pulsed_at)[:COUNTER_BITS]
+        longest = Signal(COUNTER_BITS)
+        length = (fell_at - planned_fall + regs.t_rst)[:COUNTER_BITS]   # from the last pulse
         with m.If(falls & regs.strict_rst & (length > longest)):
             m.d.sync += longest.eq(length)
         with m.If(self.longest < longest):

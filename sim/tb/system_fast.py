@@ -16,7 +16,7 @@ pins.
 With ``window`` (``{"trigger": k, "lead_us": .., "after_us": ..}``), every signal is dumped
 from ``lead_us`` before one-by-one trigger ``k`` (which comes that much later) to ``after_us``
 after sync out rises at its frame's first pulse. (The frame's last GMII byte is milliseconds
-earlier: frames are all sent first, and a frame sent just before its trigger is not shown.)
+earlier: frames are all sent first, and a window reaching back to it would be gigabytes.)
 """
 
 import json
