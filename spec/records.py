@@ -32,7 +32,7 @@ from .wire import size
 MAGIC = 0x444D
 #: Protocol version this tree speaks; records with any other version are dropped and counted.
 #: ``magic`` and ``version`` keep their places in every version, so that a projector can tell.
-VERSION = 3
+VERSION = 4
 #: IPv4 and UDP headers around a record: a record fills an MTU less these.
 UDP_IP_OVERHEAD = 28
 #: Largest record: a UDP payload inside a 9000-byte IP MTU (9000 - 20 IPv4 - 8 UDP).
@@ -61,8 +61,14 @@ HEADER = [
 
 #: Image record body (after :data:`HEADER`), followed by its pixel bytes: the rest of the
 #: datagram, consecutive pixels of the frame (row by row, left to right) from ``offset``.
+#: A whole frame carries every row (``carried`` 0, ``base`` unused). A delta frame carries only
+#: the rows that differ from ``base``, a whole frame the projector holds; it takes every other row,
+#: and its bit depth, from that frame. Every record of one frame has the same ``base`` and
+#: ``carried``.
 IMAGE = [
     ("frame", 16),       # frame id (serial-number order: see frame_newer)
+    ("base", 16),        # a delta: the whole frame whose rows it keeps where it carries none
+    ("carried", 16),     # a delta: how many distinct rows it carries (1..rows); 0: a whole frame
     ("offset", 24),      # position of the first pixel carried: row * columns + column
 ]
 
@@ -171,7 +177,7 @@ SYSTEM_STATUS = [
     ("store_frames_complete", 32),   # frames whose every row arrived
     ("store_frames_replaced", 32),   # complete, replaced unshown by a newer one
     ("store_frames_abandoned", 32),  # incomplete, abandoned for a newer frame (a lost record)
-    ("store_rows_refused", 32),      # rows the store refused (outside, stale, shown, duplicate, no slot)
+    ("store_rows_refused", 32),      # rows the store refused (outside, stale, shown, duplicate, no slot, no base)
     ("triggers_held", 32),     # triggers that came too early, held and obeyed once every group was ready
     ("rst_active_late", 32),   # RST_ACTIVE fell later than planned: the settle counted from its fall
     ("rst_active_faults", 32), # RST_ACTIVE did not rise after a pulse, or stayed high far too long
@@ -180,6 +186,7 @@ SYSTEM_STATUS = [
     ("store_frames_lost", 32),         # frames forgotten (stored, arriving or held) when the DDR2 was lost
     ("rst_active_cycles_max", 32),     # the longest RST_ACTIVE seen, in dmd cycles from a pulse: the t_rst to plan with
     ("frames_period_short", 32),       # frames the periodic trigger started whose planes outlast its period
+    ("store_rows_no_base", 32),        # rows of a delta refused: its base is not a whole frame the store holds
 ]
 
 #: Status reply body (after :data:`HEADER`).
