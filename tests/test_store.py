@@ -47,9 +47,9 @@ class Bench:
             await ctx.tick()
             quiet = quiet + 1 if port.outputs["calib_done"] and port.idle() else 0
 
-    async def feed(self, ctx, image, frame_id, rows=None, idle=0.0):
-        await stream_feed(ctx, self.dut.pixels, store_stim.frame_beats(image, frame_id, rows=rows),
-                          idle=idle)
+    async def feed(self, ctx, image, frame_id, rows=None, idle=0.0, base=0, carried=0):
+        await stream_feed(ctx, self.dut.pixels, store_stim.frame_beats(image, frame_id, rows=rows, base=base,
+                                                                        carried=carried), idle=idle)
 
     async def feed_sequence(self, ctx, images, order):
         """Sequence mode of ``len(images)`` frames at depth 1, then the frames in ``order``."""
@@ -602,8 +602,9 @@ def test_random_events_against_policy_model(seed, test_name):
     bench.run([producer, consumer], test_name, deadline=3e-3)
     assert checked["events"] == len(events)
     exercised = {name for name, value in policy.counters.items() if value}
-    # (a lost memory: test_calibration_loss_forgets_every_frame)
-    assert exercised >= set(policy.counters) - {"bad_releases", "calibration_losses", "frames_lost"}, policy.counters
+    # (a lost memory: test_calibration_loss_forgets_every_frame; deltas: test_delta_frames)
+    assert exercised >= set(policy.counters) - {"bad_releases", "calibration_losses", "frames_lost",
+                                                "rows_no_base"}, policy.counters
 
 
 def test_mode_change_keeps_the_shown_frame(test_name):
@@ -652,6 +653,96 @@ def test_mode_change_keeps_the_shown_frame(test_name):
         await bench.check_frame(ctx, held, images[0], depth, what="sequence frame 0")
 
     bench.run([producer, consumer], test_name)
+
+
+def test_delta_frames(test_name):
+    """Delta frames: a frame of only the rows that changed shows its base's words in every other
+    row, at its base's bit depth; the base is kept while a delta uses it and freed after; a delta
+    of a base not held (gone, never sent, or itself a delta) is refused row by row, and one that
+    claims more rows than the frame as outside. After each step the counters equal the reference
+    model's (sim.models.slots), and every frame shown reads back as numpy composes it."""
+    from sim.models.slots import SlotPolicy
+
+    dmd = SHORT_DMD
+    rows = dmd.rows
+    bench = Bench(dmd, slots=4)
+    dut = bench.dut
+    policy = SlotPolicy(rows, 4)
+    rng = np.random.default_rng(5)
+    key = store_stim.random_image(dmd, 11)
+    changed = [store_stim.random_image(dmd, 12 + k) for k in range(3)]
+    carried = [[2, 3, 4, 17], [0, 9, 23], [5]]
+    key2 = store_stim.random_image(dmd, 20)
+
+    def composed(k):
+        image = key.copy()
+        image[carried[k]] = changed[k][carried[k]]
+        return image
+
+    async def send(ctx, image, frame, record, depth=3, base=0, n=0):
+        for row in record:
+            policy.row(frame, row, depth, base=base, carried=n)
+        await bench.feed(ctx, image, frame, rows=record, base=base, carried=n)
+        await bench.settle(ctx)
+        assert bench.counters(ctx) == policy.counters, f"after frame {frame}"
+
+    async def show(ctx, frame, image):
+        want = policy.ask()
+        assert want == frame
+        slot, got, depth = await bench.ask(ctx)
+        assert (got, depth) == (frame, policy.depth(frame)) == (frame, 3)
+        for plane in store_stim.stored_planes(depth):
+            words = await bench.read(ctx, slot, plane)
+            store_stim.check_plane(dmd, image, plane, words, what=f"frame {frame}")
+        # the occupancy: at least the composed frame's (a block wrongly empty would be cleared)
+        keep = sum(1 << p for p in store_stim.stored_planes(depth))
+        got_occ = np.array(await bench.occupancy(ctx, slot), dtype=np.uint8)
+        need = bitplane.occupancy(image, dmd.rows_per_block) & keep
+        assert np.array_equal(got_occ & need, need), (frame, got_occ, need)
+        return slot
+
+    async def release(ctx, slot, frame):
+        policy.release(frame)
+        await bench.release(ctx, slot)
+        for _ in range(20):
+            await ctx.tick("dmd")
+
+    async def testbench(ctx):
+        ctx.set(dut.bit_depth, 3)
+        await send(ctx, key, 1, range(rows))
+        held = await show(ctx, 1, key)
+        ctx.set(dut.bit_depth, 8)              # a delta keeps its base's depth
+        for k, frame in enumerate((2, 3)):
+            order = list(rng.permutation(carried[k]))
+            await send(ctx, changed[k], frame, order, depth=8, base=1, n=len(carried[k]))
+            slot = await show(ctx, frame, composed(k))
+            await release(ctx, held, 1 if k == 0 else 2)     # the key: kept, a delta uses it
+            held = slot
+        assert sorted(policy.in_state("KEPT")) == [1]
+        # refused: a delta of a delta, of a frame never sent, and one claiming too many rows
+        await send(ctx, changed[2], 4, carried[2], base=3, n=1)
+        await send(ctx, changed[2], 5, carried[2], base=77, n=1)
+        await send(ctx, changed[2], 6, carried[2], base=1, n=rows + 1)
+        # a third delta of the key, while the second is shown
+        await send(ctx, changed[2], 7, carried[2], depth=8, base=1, n=1)
+        image = key.copy()
+        image[carried[2]] = changed[2][carried[2]]
+        slot = await show(ctx, 7, image)
+        await release(ctx, held, 3)
+        held = slot
+        # a new whole frame; once no delta of the first key is held, that key is freed
+        ctx.set(dut.bit_depth, 3)
+        await send(ctx, key2, 8, range(rows))
+        slot = await show(ctx, 8, key2)
+        await release(ctx, held, 7)
+        assert policy.in_state("KEPT") == []
+        await send(ctx, changed[0], 9, carried[0], base=1, n=len(carried[0]))
+        assert bench.counters(ctx) == policy.counters
+        counted = policy.counters
+        assert counted["rows_no_base"] == 2 * len(carried[2]) + len(carried[0]), counted
+        assert counted["rows_outside"] == len(carried[2]) and counted["frames_complete"] == 5, counted
+
+    bench.run([testbench], test_name, deadline=3e-3)
 
 
 def test_calibration_loss_forgets_every_frame(test_name):

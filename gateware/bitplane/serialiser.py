@@ -21,7 +21,7 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
 
-from ..protocol.layouts import pixel_layout, position_fields
+from ..protocol.layouts import copy_tag, pixel_layout, position_fields
 
 __all__ = ["Serialiser", "word_layout", "row_flags_layout", "PLANES"]
 
@@ -135,7 +135,7 @@ class Serialiser(wiring.Component):
                 m.d.sync += [
                     held_valid.eq(1),
                     plane.eq(0),
-                    held_tag.frame.eq(beat.frame),
+                    *copy_tag(held_tag, beat),
                     held_tag.row.eq(beat.row),
                     held_tag.word.eq(word_pos),
                     held_tag.block.eq(block),
@@ -148,7 +148,7 @@ class Serialiser(wiring.Component):
                     m.d.sync += [
                         flags_valid.eq(1),
                         flags.planes.eq(row_so_far),
-                        flags.frame.eq(beat.frame),
+                        *copy_tag(flags, beat),
                         flags.row.eq(beat.row),
                         flags.block.eq(block),
                     ]
@@ -164,7 +164,7 @@ class Serialiser(wiring.Component):
 
         m.d.comb += [
             self.words.valid.eq(held_valid),
-            self.words.payload.frame.eq(held_tag.frame),
+            *copy_tag(self.words.payload, held_tag),
             self.words.payload.row.eq(held_tag.row),
             self.words.payload.word.eq(held_tag.word),
             self.words.payload.block.eq(held_tag.block),

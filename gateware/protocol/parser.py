@@ -10,7 +10,7 @@ leaves whole on :attr:`Parser.registers`, a status query asks
 consumed and counted under its cause and has no other effect.
 """
 
-from amaranth import Cat, Module, Signal
+from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -177,6 +177,9 @@ class Parser(wiring.Component):
         # one past the image record's last pixel
         until = Signal.like(self.pieces.payload.until)
         m.d.comb += until.eq(image.offset + (length - _IMAGE_END))
+        # a delta's row count beyond the frame is kept as rows + 1, for the store to refuse
+        carried = Signal.like(self.pieces.payload.carried)
+        m.d.comb += carried.eq(Mux(image.carried > dmd.rows, dmd.rows + 1, image.carried))
 
         cause = self._cause(m, header, image, control, sequencer, length, needed)
         causes = self._CAUSES
@@ -230,6 +233,8 @@ class Parser(wiring.Component):
                     self.pieces.valid.eq(self.datagrams.valid),
                     self.pieces.payload.data.eq(beat.data),
                     self.pieces.payload.frame.eq(image.frame),
+                    self.pieces.payload.base.eq(image.base),
+                    self.pieces.payload.carried.eq(carried),
                     self.pieces.payload.position.eq(position),
                     self.pieces.payload.until.eq(until),
                     self.pieces.payload.first.eq(first),

@@ -26,7 +26,7 @@ from spec import records
 
 from ..queue import Queue
 from ..wire import layout
-from .layouts import piece_layout, pixel_layout
+from .layouts import TAG, copy_tag, piece_layout, pixel_layout, tag_fields
 
 __all__ = ["RowAssembler"]
 
@@ -71,7 +71,8 @@ class RowAssembler(wiring.Component):
         m = Module()
         columns = self._dmd.columns
         column_bits = exact_log2(columns)
-        announced_layout = data.StructLayout({"buffer": 1, "row": ceil_log2(self._dmd.rows), "frame": 16})
+        announced_layout = data.StructLayout({"buffer": 1, "row": ceil_log2(self._dmd.rows),
+                                              **tag_fields(self._dmd, 16)})
         m.submodules.memory = memory = Memory(shape=8, depth=2 * columns, init=[])
         write, read = memory.write_port(), memory.read_port()
         m.submodules.announced = announced = Queue(announced_layout, depth=2)
@@ -92,10 +93,11 @@ class RowAssembler(wiring.Component):
         beat = self.pieces.payload
         column, row = beat.position[:column_bits], beat.position[column_bits:]
         buffer = row[0]
-        frame = Signal(16)
+        tag = Signal(data.StructLayout(tag_fields(self._dmd, 16)))    # the frame being written
         following = Signal.like(beat.position)        # the position that continues the row
         valid = Signal()                              # the row being written began at column 0
-        continuing = valid & (beat.frame == frame) & (beat.position == following)
+        same_frame = Cat(beat[name] for name in TAG) == tag.as_value()
+        continuing = valid & same_frame & (beat.position == following)
         starts = column == 0
         keep = starts | continuing
         # the row's end comes in this record: it goes on (at a row start, or at the first
@@ -111,10 +113,10 @@ class RowAssembler(wiring.Component):
             announced.w_stream.valid.eq(taken & announce),
             announced.w_stream.payload.buffer.eq(buffer),
             announced.w_stream.payload.row.eq(row),
-            announced.w_stream.payload.frame.eq(beat.frame),
+            *copy_tag(announced.w_stream.payload, beat),
         ]
         with m.If(taken):
-            m.d.sync += [frame.eq(beat.frame), following.eq(beat.position + 1), valid.eq(keep)]
+            m.d.sync += [*copy_tag(tag, beat), following.eq(beat.position + 1), valid.eq(keep)]
             with m.If(keep):
                 m.d.sync += fill[buffer].eq(column + 1)
             with m.If(beat.first & ~continuing):
@@ -131,9 +133,9 @@ class RowAssembler(wiring.Component):
         active = Signal()
         buffer = Signal()
         row = Signal.like(head.payload.row)
-        frame = Signal(16)
+        tag = Signal(data.StructLayout(tag_fields(self._dmd, 16)))
         column = Signal(range(columns))
-        out_column, out_row, out_frame = Signal.like(column), Signal.like(row), Signal(16)
+        out_column, out_row, out_tag = Signal.like(column), Signal.like(row), Signal.like(tag)
         advance = ~out.valid | out.ready
         readable = active & (column < fill[buffer])
         issue = advance & readable
@@ -144,19 +146,19 @@ class RowAssembler(wiring.Component):
             out.payload.pixels[0].eq(read.data),
             out.payload.column.eq(out_column),
             out.payload.row.eq(out_row),
-            out.payload.frame.eq(out_frame),
+            *copy_tag(out.payload, out_tag),
             head.ready.eq(~active | finishing),
         ]
         with m.If(advance):
             m.d.sync += out.valid.eq(readable)
         with m.If(issue):
-            m.d.sync += [out_column.eq(column), out_row.eq(row), out_frame.eq(frame), column.eq(column + 1)]
+            m.d.sync += [out_column.eq(column), out_row.eq(row), out_tag.eq(tag), column.eq(column + 1)]
         with m.If(finishing):
             m.d.sync += active.eq(0)
         with m.If(head.valid & head.ready):
             m.d.sync += [active.eq(1), buffer.eq(head.payload.buffer), row.eq(head.payload.row),
-                         frame.eq(head.payload.frame), column.eq(0)]
-        self._count(m, out_frame)
+                         *copy_tag(tag, head.payload), column.eq(0)]
+        self._count(m, out_tag.frame)
         return finishing, buffer
 
     def _count(self, m, out_frame):

@@ -3,7 +3,10 @@
 A :class:`~gateware.store.layouts.PlaneRequest` names a slot, a plane and a run of rows; the
 rows of a plane are one contiguous run of memory (:mod:`gateware.store.addresses`), so the
 reader cuts it into read commands of up to 64 port words and gives them through MCB port 1,
-clocked by ``dmd``. The port is 64 or 128 bits wide: a 128-bit port word is two plane words, the
+clocked by ``dmd``. A slot holding a delta frame shows some rows from its base's slot: the
+reader looks each row up in the row map (``sources``, one row a cycle) and reads each run of
+rows from one slot as one contiguous run; a whole frame's request is one run, found from its
+first row's lookup. The port is 64 or 128 bits wide: a 128-bit port word is two plane words, the
 first in its low bits, and the reader hands it on as it is, so that a sequencer taking two words
 a transfer gets them as fast as the memory gives them. The words go through a FIFO to the
 sequencer, in order, requests one after another.
@@ -31,7 +34,8 @@ from amaranth.lib.wiring import In, Out
 
 from . import mcb
 from .addresses import WORD_BYTES, AddressMap
-from .layouts import PlaneRequest
+from .layouts import SLOT_BITS, PlaneRequest
+from .slot_maps import RowSourceSignature
 
 __all__ = ["Reader"]
 
@@ -65,6 +69,8 @@ class Reader(wiring.Component):
         Requests dropped because they do not fit the frame.
     store_lost : In(1)
         The store has lost its contents and not recovered yet (answer with zeros).
+    sources : Out(RowSourceSignature(dmd))
+        The row map: which slot each row of a slot shows, and whether the slot holds a delta.
     """
 
     def __init__(self, dmd, *, slots=16, fifo_depth=256, domain="dmd", width=128):
@@ -81,6 +87,7 @@ class Reader(wiring.Component):
             "mcb": Out(mcb.PortSignature(width)),
             "bad_requests": Out(16),
             "store_lost": In(1),
+            "sources": Out(RowSourceSignature(dmd)),
         })
 
     def elaborate(self, platform):
@@ -136,24 +143,60 @@ class Reader(wiring.Component):
             port.wr_en.eq(0),
         ]
 
+        # the run of rows being gathered: rows from one slot, contiguous in memory
+        slot, plane = Signal(SLOT_BITS), Signal(3)
+        row = Signal(range(dmd.rows + 1))        # the row whose lookup is on ``sources`` now
+        left = Signal(range(dmd.rows + 1))       # rows of the request from ``row`` on
+        run_source, run_first = Signal(SLOT_BITS), Signal(range(dmd.rows))
+        run_rows = Signal(range(dmd.rows + 1))
+        src = self.sources
+        m.d.comb += [src.slot.eq(slot), src.row.eq(row)]
+
         with m.FSM():
             with m.State("IDLE"):
                 # (answering zeros: one request at a time)
                 m.d.comb += self.requests.ready.eq(~zero | (owed == 0))
+                m.d.comb += [src.slot.eq(request.slot), src.row.eq(request.first_row)]
                 with m.If(self.requests.valid):
                     fits = ((request.slot < self._slots) & (request.row_count != 0)
                             & (request.first_row + request.row_count <= dmd.rows))
                     with m.If(fits):
                         m.d.comb += accepted.eq(1)
-                        m.d.sync += [
-                            address.eq(self._map.address(request.slot, request.plane, request.first_row)),
-                            remaining.eq(request.row_count * port_words_per_row),
-                        ]
-                        m.next = "ISSUE"
+                        m.d.sync += [slot.eq(request.slot), plane.eq(request.plane), row.eq(request.first_row),
+                                     left.eq(request.row_count), run_rows.eq(0)]
+                        m.next = "GATHER"
                         with m.If(lost | zero):
                             m.next = "IDLE"            # answered as zeros
                     with m.Else():
                         m.d.sync += self.bad_requests.eq(self.bad_requests + 1)
+            with m.State("LOOK"):
+                m.next = "GATHER"                      # ``row`` is looked up
+                with m.If(lost):
+                    m.next = "IDLE"
+            with m.State("GATHER"):
+                whole = ~src.delta
+                joins = (run_rows == 0) | (src.source == run_source)
+                with m.If(lost):
+                    m.next = "IDLE"
+                with m.Elif(joins):
+                    with m.If(run_rows == 0):
+                        m.d.sync += [run_source.eq(src.source), run_first.eq(row)]
+                    taken = Mux(whole, left, 1)        # a whole frame's request is one run
+                    m.d.sync += [run_rows.eq(run_rows + taken), left.eq(left - taken), row.eq(row + taken)]
+                    m.d.comb += src.row.eq(row + 1)
+                    with m.If(left == taken):
+                        m.next = "PREPARE"
+                with m.Else():
+                    m.next = "PREPARE"                 # ``row`` starts the next run
+            with m.State("PREPARE"):
+                m.d.sync += [
+                    address.eq(self._map.address(run_source, plane, run_first)),
+                    remaining.eq(run_rows * port_words_per_row),
+                    run_rows.eq(0),
+                ]
+                m.next = "ISSUE"
+                with m.If(lost):
+                    m.next = "IDLE"
             with m.State("ISSUE"):
                 with m.If(lost):
                     m.next = "IDLE"                    # the rest of the request is answered as zeros
@@ -163,6 +206,8 @@ class Reader(wiring.Component):
                                  remaining.eq(remaining - burst)]
                     with m.If(remaining == burst):
                         m.next = "IDLE"
+                        with m.If(left != 0):
+                            m.next = "LOOK"
         if self._domain != "sync":
             return DomainRenamer({"sync": self._domain})(m)
         return m

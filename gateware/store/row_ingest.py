@@ -2,16 +2,17 @@
 dropped whole and counted (``sync`` domain).
 
 At a row's first word the ingest asks the slot table where the row goes
-(:class:`~gateware.store.slot_table.Placement`). A slot taken for a new frame first has its row
-bitmap and occupancy map cleared (one row per cycle), then the row's bit in the bitmap is read: a
-row that arrived before is refused. An accepted row's words of the stored planes go to the writer
+(:class:`~gateware.store.slot_table.Placement`). A slot taken for a new frame first has its maps
+set up (one row per cycle): no row arrived, each row shown from the slot itself, or for a delta
+frame from its base, whose occupancy map it starts from. Then the row's entry is read: a row that
+arrived before is refused. An accepted row's words of the stored planes go to the writer
 with the slot (so a row can only ever be written inside the slot chosen here, whatever its header
 said); with the row's last word come its row flags, which set the row's bit in the bitmap and its
-block's planes in the occupancy map. The row that completes the frame is marked for the writer and
-reported to the table.
+block's planes in the occupancy map. The row that completes the frame (every row, or for a delta the
+rows it says it carries) is marked for the writer and reported to the table.
 """
 
-from amaranth import Array, Cat, Const, Module, Signal
+from amaranth import Array, Cat, Const, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
@@ -19,7 +20,7 @@ from amaranth.utils import ceil_log2
 from gateware.bitplane.serialiser import row_flags_layout, word_layout
 
 from .addresses import PLANES
-from .layouts import BLOCK_BITS, COUNTER_BITS, SLOT_BITS
+from .layouts import BLOCK_BITS, COUNTER_BITS, SLOT_BITS, OccupancySignature
 from .slot_maps import RowLookupSignature, map_write_layout
 from .slot_table import Placement, PlacementSignature, opening_layout
 from .writer import write_word_layout
@@ -37,6 +38,7 @@ class IngestCounters(data.Struct):
     rows_shown: COUNTER_BITS
     rows_duplicate: COUNTER_BITS
     rows_no_slot: COUNTER_BITS
+    rows_no_base: COUNTER_BITS
 
 
 #: The placements that refuse a row, and the counter each one counts.
@@ -45,6 +47,7 @@ _REFUSALS = {
     Placement.SHOWN: "rows_shown",
     Placement.DUPLICATE: "rows_duplicate",
     Placement.NO_SLOT: "rows_no_slot",
+    Placement.NO_BASE: "rows_no_base",
 }
 
 
@@ -79,6 +82,8 @@ class RowIngest(wiring.Component):
         Clearing and setting the row bitmap and the occupancy map.
     bitmap : Out(RowLookupSignature(dmd))
         Whether a row arrived before.
+    base_occupancy : Out(OccupancySignature())
+        The occupancy map of a delta's base, copied when the delta's slot is set up.
     counters : Out(IngestCounters)
     """
 
@@ -94,19 +99,24 @@ class RowIngest(wiring.Component):
             "completed": Out(stream.Signature(SLOT_BITS, always_ready=True)),
             "map_writes": Out(stream.Signature(map_write_layout(dmd), always_ready=True)),
             "bitmap": Out(RowLookupSignature(dmd)),
+            "base_occupancy": Out(OccupancySignature()),
             "counters": Out(IngestCounters),
         })
 
     def elaborate(self, platform):
         m = Module()
         dmd, count = self._dmd, self.counters
-        received = Array(Signal(range(dmd.rows + 1), name=f"received{s}") for s in range(self._slots))
+        missing = Array(Signal(range(dmd.rows + 1), name=f"missing{s}") for s in range(self._slots))
         head = self.words.payload
         flags = self.rows.payload
         place = self.placement
         is_last = (head.plane == PLANES - 1) & (head.word == dmd.words_per_row - 1)
         cur_slot = Signal(SLOT_BITS)
         cur_depth = Signal(4)
+        delta = Signal()                        # the frame being set up is a delta ...
+        base = Signal(SLOT_BITS)                # ... of the frame in this slot,
+        base_depth = Signal(4)                  # at its bit depth
+        needed = Signal.like(missing[0])        # rows that complete it
         clear_index = Signal(ceil_log2(dmd.rows))
         depth_in = Signal(4)
         m.d.comb += depth_in.eq(self.bit_depth)
@@ -116,17 +126,24 @@ class RowIngest(wiring.Component):
         m.d.comb += [
             stored_mask.eq(Const(0xFF00, 2 * PLANES) >> cur_depth),
             place.frame.eq(head.frame),
+            place.base.eq(head.base),
+            place.delta.eq(head.carried != 0),
             self.bitmap.slot.eq(cur_slot),
             self.bitmap.row.eq(head.row),
             self.opened.payload.slot.eq(cur_slot),
             self.opened.payload.frame.eq(head.frame),
-            self.opened.payload.depth.eq(depth_in),
+            self.opened.payload.depth.eq(Mux(delta, base_depth, depth_in)),
+            self.opened.payload.delta.eq(delta),
+            self.opened.payload.base.eq(base),
             self.completed.payload.eq(cur_slot),
             self.map_writes.payload.slot.eq(cur_slot),
+            self.base_occupancy.slot.eq(place.base_slot),   # block 0, read as the slot is taken
         ]
 
         def take(*, abandon=False):
-            m.d.sync += [cur_slot.eq(place.slot), clear_index.eq(0)]
+            m.d.sync += [cur_slot.eq(place.slot), clear_index.eq(0), delta.eq(head.carried != 0),
+                         base.eq(place.base_slot), base_depth.eq(place.base_depth),
+                         needed.eq(Mux(head.carried != 0, head.carried, dmd.rows))]
             if abandon:
                 m.d.sync += count.frames_abandoned.eq(count.frames_abandoned + 1)
             m.next = "CLEAR"
@@ -143,14 +160,14 @@ class RowIngest(wiring.Component):
             self.store.payload.row.eq(head.row),
             self.store.payload.word.eq(head.word),
             self.store.payload.last.eq(is_last),
-            self.store.payload.completes.eq(received[cur_slot] == dmd.rows - 1),
+            self.store.payload.completes.eq(missing[cur_slot] == 1),
         ]
 
         with m.FSM(name="ingest") as ingest:
             m.d.comb += place.between_rows.eq(ingest.ongoing("ROW_START"))
             with m.State("ROW_START"):
                 with m.If(self.words.valid & (place.verdict != Placement.HOLD)):
-                    with m.If(head.row >= dmd.rows):
+                    with m.If((head.row >= dmd.rows) | (head.carried > dmd.rows)):
                         refuse(count.rows_outside)
                     with m.Elif(place.verdict == Placement.JOIN):
                         m.d.sync += [cur_slot.eq(place.slot), cur_depth.eq(place.depth)]
@@ -165,16 +182,24 @@ class RowIngest(wiring.Component):
                     # WAIT: a slot frees when the frame being written becomes ready
 
             with m.State("CLEAR"):
+                # the base's occupancy of block i is read while block i - 1 is written
                 m.d.comb += [
+                    self.base_occupancy.slot.eq(base),
+                    self.base_occupancy.block.eq(clear_index[:BLOCK_BITS] + 1),
                     self.map_writes.valid.eq(1),
                     self.map_writes.payload.row.eq(clear_index),
+                    self.map_writes.payload.source.eq(Mux(delta, base, cur_slot)),
                     self.map_writes.payload.block.eq(clear_index[:BLOCK_BITS]),
-                    self.map_writes.payload.planes.eq(Cat((clear_index < 2**BLOCK_BITS) for _ in range(PLANES))),
+                    self.map_writes.payload.occupancy_mask.eq(
+                        Cat((clear_index < 2**BLOCK_BITS) for _ in range(PLANES))),
+                    self.map_writes.payload.occupancy.eq(Mux(delta, self.base_occupancy.planes, 0)),
+                    self.map_writes.payload.opening.eq(clear_index == 0),
+                    self.map_writes.payload.delta.eq(delta),
                 ]
                 m.d.sync += clear_index.eq(clear_index + 1)
                 with m.If(clear_index == dmd.rows - 1):
                     m.d.comb += self.opened.valid.eq(1)
-                    m.d.sync += [received[cur_slot].eq(0), cur_depth.eq(depth_in)]
+                    m.d.sync += [missing[cur_slot].eq(needed), cur_depth.eq(Mux(delta, base_depth, depth_in))]
                     m.next = "LOOKUP"
 
             with m.State("LOOKUP"):
@@ -206,12 +231,14 @@ class RowIngest(wiring.Component):
                         m.d.comb += [
                             self.map_writes.valid.eq(1),
                             self.map_writes.payload.row.eq(head.row),
+                            self.map_writes.payload.stored.eq(1),
+                            self.map_writes.payload.source.eq(cur_slot),
                             self.map_writes.payload.block.eq(flags.block),
-                            self.map_writes.payload.planes.eq(flags.planes & stored_mask),
-                            self.map_writes.payload.set.eq(1),
+                            self.map_writes.payload.occupancy_mask.eq(flags.planes & stored_mask),
+                            self.map_writes.payload.occupancy.eq(~0),
                         ]
-                        m.d.sync += received[cur_slot].eq(received[cur_slot] + 1)
-                        with m.If(received[cur_slot] == dmd.rows - 1):
+                        m.d.sync += missing[cur_slot].eq(missing[cur_slot] - 1)
+                        with m.If(missing[cur_slot] == 1):
                             m.d.comb += self.completed.valid.eq(1)
                             m.d.sync += count.frames_complete.eq(count.frames_complete + 1)
                         m.next = "ROW_START"

@@ -1,13 +1,18 @@
-"""The frame slots' two maps: which rows of each slot have arrived, and the occupancy map.
+"""The frame slots' maps: where each row of each slot comes from, and the occupancy map.
 
-Row bitmap: one bit per slot and row, set when the row is stored; read back (one cycle later) to
-refuse a row that arrived before. Occupancy map: per slot and DMD block, 8 bits, plane ``k`` has
-a bit set somewhere in the block. Both are written in ``sync`` through one stream of writes; the
-occupancy map has a second read port in ``dmd`` for the sequencer, safe because a slot reaches
-the sequencer only after it is complete (see :mod:`gateware.store.layouts`).
+Row map: per slot and row, whether the row arrived in that slot (``stored``) and the slot whose
+words the row shows (``source``): the slot itself for a whole frame and for a row a delta frame
+carries, the delta's base for a row it does not. Read back in ``sync`` (one cycle later) to
+refuse a row that arrived before, and in ``dmd`` by the plane reader, with the slot's kind
+(whole or delta). Occupancy map: per slot and DMD block, 8 bits, plane ``k`` has a bit set
+somewhere in the block (a delta starts from its base's, a superset of what its rows from the
+base hold: a block it says has bits is loaded, never wrongly cleared). Every map is written in
+``sync`` through one stream of writes; the ``dmd`` read ports are safe because a slot reaches
+the sequencer only after it is complete, and a base is never written while a delta uses it (see
+:mod:`gateware.store.layouts`).
 """
 
-from amaranth import Cat, Module, Mux
+from amaranth import Cat, Module
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
@@ -16,30 +21,42 @@ from amaranth.utils import ceil_log2
 from .addresses import PLANES
 from .layouts import BLOCK_BITS, SLOT_BITS, OccupancySignature
 
-__all__ = ["SlotMaps", "RowLookupSignature", "map_write_layout"]
+__all__ = ["SlotMaps", "RowLookupSignature", "RowSourceSignature", "map_write_layout", "row_entry_layout"]
+
+#: One entry of the row map.
+row_entry_layout = data.StructLayout({"stored": 1, "source": SLOT_BITS})
 
 
 def map_write_layout(dmd):
-    """One write to both maps of slot ``slot``: bit ``row`` of the row bitmap and the bits
-    ``planes`` of block ``block`` of the occupancy map all become ``set``."""
+    """One write to the maps of slot ``slot``: row ``row``'s entry becomes ``stored`` and
+    ``source``; the bits ``occupancy_mask`` of block ``block``'s occupancy take the values of
+    ``occupancy``; with ``opening``, the slot's kind becomes ``delta``."""
     return data.StructLayout({
         "slot": SLOT_BITS,
         "row": ceil_log2(dmd.rows),
+        "stored": 1,
+        "source": SLOT_BITS,
         "block": BLOCK_BITS,
-        "planes": PLANES,
-        "set": 1,
+        "occupancy_mask": PLANES,
+        "occupancy": PLANES,
+        "opening": 1,
+        "delta": 1,
     })
 
 
 class RowLookupSignature(wiring.Signature):
-    """Read port of the row bitmap, seen from its user (``sync``).
+    """A read port of the row map, seen from its user.
 
     Members
     -------
     slot, row : Out
         Which row of which slot to look up.
     stored : In(1)
-        One cycle later: that row is stored.
+        One cycle later: that row arrived in that slot.
+    source : In(SLOT_BITS)
+        One cycle later: the slot whose words that row shows.
+    delta : In(1)
+        One cycle later: the slot holds a delta frame (some rows show its base's words).
     """
 
     def __init__(self, dmd):
@@ -48,14 +65,20 @@ class RowLookupSignature(wiring.Signature):
             "slot": Out(SLOT_BITS),
             "row": Out(self._row_bits),
             "stored": In(1),
+            "source": In(SLOT_BITS),
+            "delta": In(1),
         })
 
     def __eq__(self, other):
         return isinstance(other, RowLookupSignature) and other._row_bits == self._row_bits
 
 
+#: The plane reader's port: the same lookup.
+RowSourceSignature = RowLookupSignature
+
+
 class SlotMaps(wiring.Component):
-    """Row bitmap and occupancy map of the frame slots.
+    """Row map and occupancy map of the frame slots.
 
     Parameters
     ----------
@@ -66,9 +89,13 @@ class SlotMaps(wiring.Component):
     Members
     -------
     writes : In(stream.Signature(map_write_layout(dmd), always_ready=True))
-        Writes to both maps, one per cycle (``sync``).
+        Writes to the maps, one per cycle (``sync``).
     bitmap : In(RowLookupSignature(dmd))
-        Row bitmap read port (``sync``).
+        Row map read port (``sync``).
+    base_occupancy : In(OccupancySignature())
+        Occupancy read port (``sync``): a delta's map starts as its base's.
+    sources : In(RowSourceSignature(dmd))
+        Row map read port (``dmd``) for the plane reader.
     occupancy : In(OccupancySignature())
         Occupancy map read port (``dmd``).
     """
@@ -78,6 +105,8 @@ class SlotMaps(wiring.Component):
         super().__init__({
             "writes": In(stream.Signature(map_write_layout(dmd), always_ready=True)),
             "bitmap": In(RowLookupSignature(dmd)),
+            "base_occupancy": In(OccupancySignature()),
+            "sources": In(RowSourceSignature(dmd)),
             "occupancy": In(OccupancySignature()),
         })
 
@@ -86,25 +115,36 @@ class SlotMaps(wiring.Component):
         row_bits = ceil_log2(self._dmd.rows)
         write = self.writes.payload
 
-        m.submodules.bitmap = bitmap = Memory(shape=1, depth=self._slots << row_bits, init=[])
-        bitmap_w = bitmap.write_port()
-        bitmap_r = bitmap.read_port()
+        m.submodules.rows = rows = Memory(shape=row_entry_layout, depth=self._slots << row_bits, init=[])
+        m.submodules.kinds = kinds = Memory(shape=1, depth=self._slots, init=[])
+        rows_w, kinds_w = rows.write_port(), kinds.write_port()
         m.d.comb += [
-            bitmap_w.addr.eq(Cat(write.row, write.slot)),
-            bitmap_w.data.eq(write.set),
-            bitmap_w.en.eq(self.writes.valid),
-            bitmap_r.addr.eq(Cat(self.bitmap.row, self.bitmap.slot)),
-            self.bitmap.stored.eq(bitmap_r.data),
+            rows_w.addr.eq(Cat(write.row, write.slot)),
+            rows_w.data.stored.eq(write.stored),
+            rows_w.data.source.eq(write.source),
+            rows_w.en.eq(self.writes.valid),
+            kinds_w.addr.eq(write.slot),
+            kinds_w.data.eq(write.delta),
+            kinds_w.en.eq(self.writes.valid & write.opening),
         ]
+        for port, domain in ((self.bitmap, "sync"), (self.sources, "dmd")):
+            rows_r, kinds_r = rows.read_port(domain=domain), kinds.read_port(domain=domain)
+            m.d.comb += [
+                rows_r.addr.eq(Cat(port.row, port.slot)),
+                kinds_r.addr.eq(port.slot),
+                port.stored.eq(rows_r.data.stored),
+                port.source.eq(rows_r.data.source),
+                port.delta.eq(kinds_r.data),
+            ]
 
         m.submodules.occupancy = occ = Memory(shape=PLANES, depth=self._slots << BLOCK_BITS, init=[])
         occ_w = occ.write_port(granularity=1)
-        occ_r = occ.read_port(domain="dmd")
         m.d.comb += [
             occ_w.addr.eq(Cat(write.block, write.slot)),
-            occ_w.data.eq(Mux(write.set, ~0, 0)),
-            occ_w.en.eq(Mux(self.writes.valid, write.planes, 0)),
-            occ_r.addr.eq(Cat(self.occupancy.block, self.occupancy.slot)),
-            self.occupancy.planes.eq(occ_r.data),
+            occ_w.data.eq(write.occupancy),
+            occ_w.en.eq(Cat(self.writes.valid & bit for bit in write.occupancy_mask)),
         ]
+        for port, domain in ((self.base_occupancy, "sync"), (self.occupancy, "dmd")):
+            occ_r = occ.read_port(domain=domain)
+            m.d.comb += [occ_r.addr.eq(Cat(port.block, port.slot)), port.planes.eq(occ_r.data)]
         return m

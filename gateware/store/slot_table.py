@@ -11,9 +11,14 @@ A memory that lost its calibration (``lose``, :mod:`gateware.store.recovery`) ho
 back and, between rows, makes the table forget every frame before any other event: each slot
 not shown is freed, and each shown one is marked stale (its words are gone) so that it is freed,
 not put back in a sequence, when the sequencer hands it back. Both are counted as frames lost.
+
+Delta frames: a frame that carries only some rows names a whole frame as its base; its first row
+is placed only if that base is held (being written, complete, shown or kept) and not stale, else
+refused (``NO_BASE``). A slot that would be freed while a delta held uses it as its base is KEPT
+instead (its words stay, it is never given out) and freed once no delta uses it.
 """
 
-from amaranth import Array, Module, Signal
+from amaranth import Array, Cat, Module, Mux, Signal
 from amaranth.lib import data, enum, stream, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -28,6 +33,7 @@ class SlotState(enum.Enum, shape=3):
     WRITING = 2
     READY = 3
     SHOWN = 4
+    KEPT = 5          # no longer showable; its words stay while a delta frame uses them
 
 
 class Placement(enum.Enum, shape=4):
@@ -42,6 +48,7 @@ class Placement(enum.Enum, shape=4):
     SHOWN = 6         # refused: the frame of a slot being shown
     DUPLICATE = 7     # refused: the frame's slot is complete (sequence)
     NO_SLOT = 8       # refused: the sequencer holds every other slot
+    NO_BASE = 9       # refused: a delta whose base is not a whole frame held
 
 
 class PlacementSignature(wiring.Signature):
@@ -51,6 +58,8 @@ class PlacementSignature(wiring.Signature):
     -------
     frame : Out(frame_bits)
         Frame id of the row to place.
+    delta, base : Out(1), Out(frame_bits)
+        The frame is a delta of frame ``base``.
     between_rows : Out(1)
         The ingest waits for a row's first word: a change of mode may be applied.
     verdict : In(Placement)
@@ -59,16 +68,22 @@ class PlacementSignature(wiring.Signature):
         The slot for ``JOIN``, ``TAKE`` and ``ABANDON``.
     depth : In(4)
         The bit depth of the frame in that slot (for ``JOIN``).
+    base_slot, base_depth : In(SLOT_BITS), In(4)
+        A delta's base: its slot and bit depth (for ``TAKE`` and ``ABANDON``).
     """
 
     def __init__(self, frame_bits):
         self._frame_bits = frame_bits
         super().__init__({
             "frame": Out(frame_bits),
+            "delta": Out(1),
+            "base": Out(frame_bits),
             "between_rows": Out(1),
             "verdict": In(Placement),
             "slot": In(SLOT_BITS),
             "depth": In(4),
+            "base_slot": In(SLOT_BITS),
+            "base_depth": In(4),
         })
 
     def __eq__(self, other):
@@ -76,8 +91,9 @@ class PlacementSignature(wiring.Signature):
 
 
 def opening_layout(frame_bits):
-    """A slot taken for a new frame: from now on it receives frame ``frame`` at ``depth`` bits."""
-    return data.StructLayout({"slot": SLOT_BITS, "frame": frame_bits, "depth": 4})
+    """A slot taken for a new frame: from now on it receives frame ``frame`` at ``depth`` bits,
+    a delta of the frame in slot ``base`` with ``delta``."""
+    return data.StructLayout({"slot": SLOT_BITS, "frame": frame_bits, "depth": 4, "delta": 1, "base": SLOT_BITS})
 
 
 class TableCounters(data.Struct):
@@ -145,7 +161,7 @@ class SlotTable(wiring.Component):
         n_slots = self._slots
         count = self.counters
         t = _Registers(n_slots, self._frame_bits)
-        state, frame_id, depth, in_sequence = t.state, t.frame_id, t.depth, t.in_sequence
+        state, frame_id, depth, in_sequence, stale = t.state, t.frame_id, t.depth, t.in_sequence, t.stale
 
         # -- mode
         seq_len = Signal(5)          # the mode in force
@@ -155,7 +171,6 @@ class SlotTable(wiring.Component):
             m.d.comb += wanted_len.eq(n_slots)
         mode_pending = Signal()
         sequence = Signal()
-        stale = Array(Signal(name=f"stale{s}") for s in range(n_slots))
         m.d.comb += [mode_pending.eq(wanted_len != seq_len), sequence.eq(seq_len != 0)]
 
         self._place(m, t, seq_len, mode_pending, sequence)
@@ -168,6 +183,8 @@ class SlotTable(wiring.Component):
                 frame_id[opening.slot].eq(opening.frame),
                 depth[opening.slot].eq(opening.depth),
                 in_sequence[opening.slot].eq(sequence),
+                t.delta[opening.slot].eq(opening.delta),
+                t.base[opening.slot].eq(opening.base),
             ]
             with m.If(~sequence):
                 m.d.sync += [t.recv_active.eq(1), t.recv_slot.eq(opening.slot), t.recv_frame.eq(opening.frame),
@@ -198,6 +215,20 @@ class SlotTable(wiring.Component):
             self.answers.payload.sequence.eq(sequence),
         ]
 
+        # -- a base no delta uses any more is freed (housekeeping below never changes a KEPT slot
+        # but to FREE)
+        used = [Signal(name=f"used{s}") for s in range(n_slots)]
+        for s in range(n_slots):
+            m.d.comb += used[s].eq(Cat((state[d] != SlotState.FREE) & t.delta[d] & (t.base[d] == s) & ~stale[d]
+                                       for d in range(n_slots) if d != s).any())
+            with m.If((state[s] == SlotState.KEPT) & ~used[s]):
+                m.d.sync += state[s].eq(SlotState.FREE)
+        used = Array(used)
+
+        def retire(s):
+            """Slot ``s`` is neither shown nor showable: kept while a delta uses it, else free."""
+            return state[s].eq(Mux(used[s], SlotState.KEPT, SlotState.FREE))
+
         # -- housekeeping: one event per cycle. An answer offered and not taken (the answer FIFO
         # full) stays offered, unchanged: nothing else happens until it is taken.
         offered = Signal()
@@ -219,7 +250,7 @@ class SlotTable(wiring.Component):
             m.d.sync += [seq_len.eq(wanted_len), play.eq(0), t.recv_active.eq(0), t.last_valid.eq(0)]
             for s in range(n_slots):
                 with m.If(state[s] != SlotState.SHOWN):
-                    m.d.sync += state[s].eq(SlotState.FREE)
+                    m.d.sync += retire(s)
                 m.d.sync += in_sequence[s].eq(0)
         with m.Elif(self.written.valid & ~offered):
             m.d.comb += self.written.ready.eq(1)
@@ -230,8 +261,7 @@ class SlotTable(wiring.Component):
                 for s in range(n_slots):
                     with m.If((state[s] == SlotState.READY) & ~in_sequence[s] & ~in_sequence[done]
                               & (done != s)):
-                        m.d.sync += [state[s].eq(SlotState.FREE),
-                                     count.frames_replaced.eq(count.frames_replaced + 1)]
+                        m.d.sync += [retire(s), count.frames_replaced.eq(count.frames_replaced + 1)]
         with m.Elif(self.releases.valid):
             m.d.comb += self.releases.ready.eq(1)
             m.d.sync += stale[released].eq(0)
@@ -239,8 +269,10 @@ class SlotTable(wiring.Component):
                 m.d.sync += count.bad_releases.eq(count.bad_releases + 1)
             with m.Elif(in_sequence[released] & sequence & ~stale[released]):
                 m.d.sync += state[released].eq(SlotState.READY)
-            with m.Else():
+            with m.Elif(stale[released]):
                 m.d.sync += state[released].eq(SlotState.FREE)
+            with m.Else():
+                m.d.sync += retire(released)
         with m.Elif(self.asks.valid & can_answer & ~self.lose):
             m.d.comb += self.answers.valid.eq(1)
             with m.If(self.answers.ready):
@@ -261,6 +293,12 @@ class SlotTable(wiring.Component):
         writing_found, _ = _first_of(m, n_slots, lambda s: state[s] == SlotState.WRITING)
         shown_match, _ = _first_of(m, n_slots,
                                    lambda s: (state[s] == SlotState.SHOWN) & (t.frame_id[s] == place.frame))
+        base_found, base_slot = _first_of(
+            m, n_slots, lambda s: ((state[s] == SlotState.WRITING) | (state[s] == SlotState.READY)
+                                   | (state[s] == SlotState.SHOWN) | (state[s] == SlotState.KEPT))
+            & ~t.delta[s] & ~t.stale[s] & (t.frame_id[s] == place.base))
+        no_base = place.delta & ~base_found
+        m.d.comb += [place.base_slot.eq(base_slot), place.base_depth.eq(t.depth[base_slot])]
         newer = Signal()
         diff = Signal(frame_bits)
         m.d.comb += [diff.eq(place.frame - t.last_frame), newer.eq((diff != 0) & ~diff[frame_bits - 1])]
@@ -277,6 +315,8 @@ class SlotTable(wiring.Component):
         with m.Elif(sequence):
             with m.If(place.frame >= seq_len):
                 verdict(Placement.STALE)
+            with m.Elif((state[seq_slot] == SlotState.FREE) & no_base):
+                verdict(Placement.NO_BASE)
             with m.Elif(state[seq_slot] == SlotState.FREE):
                 verdict(Placement.TAKE, seq_slot)
             with m.Elif(state[seq_slot] == SlotState.RECEIVING):
@@ -288,7 +328,9 @@ class SlotTable(wiring.Component):
         with m.Elif(t.recv_active & (place.frame == t.recv_frame)):
             verdict(Placement.JOIN, t.recv_slot)
         with m.Elif(~t.last_valid | newer):
-            with m.If(t.recv_active):
+            with m.If(no_base):
+                verdict(Placement.NO_BASE)
+            with m.Elif(t.recv_active):
                 verdict(Placement.ABANDON, t.recv_slot)
             with m.Elif(free_found):
                 verdict(Placement.TAKE, free_slot)
@@ -311,6 +353,9 @@ class _Registers:
         self.frame_id = Array(Signal(frame_bits, name=f"frame_id{s}") for s in range(slots))
         self.depth = Array(Signal(4, name=f"depth{s}") for s in range(slots))
         self.in_sequence = Array(Signal(name=f"in_sequence{s}") for s in range(slots))
+        self.stale = Array(Signal(name=f"stale{s}") for s in range(slots))
+        self.delta = Array(Signal(name=f"delta{s}") for s in range(slots))
+        self.base = Array(Signal(SLOT_BITS, name=f"base{s}") for s in range(slots))
         self.recv_active = Signal()
         self.recv_slot = Signal(SLOT_BITS)
         self.recv_frame = Signal(frame_bits)

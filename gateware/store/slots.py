@@ -8,7 +8,8 @@ ever be written inside the slot chosen here, whatever its header said.
 Slot life
 ---------
 ``FREE -> RECEIVING -> WRITING -> READY -> SHOWN -> FREE`` (streaming) or ``-> READY`` again
-(sequence). A slot is RECEIVING while rows arrive (a row bitmap says which), WRITING once every
+(sequence); a whole frame that a delta frame held uses as its base goes to KEPT instead of FREE
+and stays there until no delta uses it. A slot is RECEIVING while rows arrive (a row bitmap says which), WRITING once every
 row has arrived until the writer reports the last row in memory, READY (complete) until the
 sequencer is given it, SHOWN until the sequencer releases it. Only RECEIVING slots are written,
 so a READY or SHOWN frame never changes (no tearing).
@@ -23,6 +24,13 @@ slots: one receiving, one ready, one shown.
 Sequence mode (``sequence_length`` = N > 0): frame id f < N goes to slot f; once all N are
 complete they are given to the sequencer in order 0, 1, .., N-1, 0, .. and a released slot stays
 in the sequence. Changing ``sequence_length`` frees every slot that is not shown.
+
+Delta frames
+------------
+A delta frame carries only some rows (``carried`` of them) and names a whole frame held as its
+base; it is complete once those rows have arrived, takes its bit depth from the base, and shows
+the base's words in every other row (the row map says, per row, which slot the plane reader reads).
+A delta whose base is not held is refused row by row (``rows_no_base``).
 
 Occupancy
 ---------
@@ -57,6 +65,7 @@ class SlotCounters(data.Struct):
     rows_shown: COUNTER_BITS          # frame id of a slot being shown: refused
     rows_duplicate: COUNTER_BITS      # row already received (overlapping records): refused
     rows_no_slot: COUNTER_BITS        # no slot free (the sequencer holds too many): refused
+    rows_no_base: COUNTER_BITS        # a delta frame whose base is not a whole frame held: refused
     bad_releases: COUNTER_BITS        # release of a slot that was not shown
     calibration_losses: COUNTER_BITS  # the memory lost its calibration: every frame forgotten
     frames_lost: COUNTER_BITS         # frames (held or not) forgotten when the memory was lost
@@ -91,8 +100,9 @@ class FrameSlots(wiring.Component):
         (``sync``).
     ask, frames, release
         The crossing's (``dmd``): asks, answers and releases of the sequencer.
-    occupancy
-        The maps' occupancy read port (``dmd``).
+    occupancy, sources
+        The maps' read ports (``dmd``): occupancy for the sequencer, where each row comes from
+        for the plane reader.
     """
 
     #: The ports each part gives the whole.
@@ -100,7 +110,7 @@ class FrameSlots(wiring.Component):
         "ingest": ("words", "rows", "store", "bit_depth"),
         "table": ("written", "sequence_length", "lose", "forgotten"),
         "crossing": ("ask", "frames", "release"),
-        "maps": ("occupancy",),
+        "maps": ("occupancy", "sources"),
     }
 
     #: The parts that count events, each some of the counters.
@@ -133,6 +143,7 @@ class FrameSlots(wiring.Component):
         wiring.connect(m, ingest.completed, table.completed)
         wiring.connect(m, ingest.map_writes, maps.writes)
         wiring.connect(m, ingest.bitmap, maps.bitmap)
+        wiring.connect(m, ingest.base_occupancy, maps.base_occupancy)
         wiring.connect(m, crossing.asks, table.asks)
         wiring.connect(m, crossing.releases, table.releases)
         wiring.connect(m, table.answers, crossing.answers)

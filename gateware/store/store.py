@@ -75,7 +75,7 @@ class Store(wiring.Component):
         self._writer = Writer(dmd, slots=slots)
         self._reader = Reader(dmd, slots=slots, fifo_depth=fifo_depth, width=read_width)
         super().__init__({
-            **members(self._slots, exclude=("store", "written", "lose", "forgotten")),
+            **members(self._slots, exclude=("store", "written", "lose", "forgotten", "sources")),
             **members(self._reader, self._READER_PORTS),
             "planes": Out(stream.Signature(64 * self._plane_words)),
             "mcb_write": self._writer.signature.members["mcb"],
@@ -101,6 +101,7 @@ class Store(wiring.Component):
         wiring.connect(m, writer.written, slots.written)
         wiring.connect(m, writer.mcb, wiring.flipped(self.mcb_write))
         wiring.connect(m, reader.mcb, wiring.flipped(self.mcb_read))
+        wiring.connect(m, reader.sources, slots.sources)
 
         m.submodules.recovery = recovery = Recovery()
         m.d.comb += [

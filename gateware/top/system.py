@@ -233,7 +233,8 @@ class Projector(wiring.Component):
             status.store_calibration_losses.eq(store_counts.calibration_losses),
             status.store_frames_lost.eq(store_counts.frames_lost),
             status.store_rows_refused.eq(sum(store_counts[name] for name in (
-                "rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot"))),
+                "rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot", "rows_no_base"))),
+            status.store_rows_no_base.eq(store_counts.rows_no_base),
         ]
         # dlpc410_state: bit 0 INIT_ACTIVE, 1 RST_ACTIVE, 2 ECP2_FINISHED, 3 DDR2 calibrated,
         # 4 Ethernet link up, 5-6 link speed (2 = 1000 Mb/s)

@@ -9,13 +9,14 @@ import numpy as np
 from . import bitplane
 
 
-def pixel_beats(image, lanes, frame=0, row_order=None):
-    """Input transfers for ``image``, rows in ``row_order`` (default top to bottom)."""
+def pixel_beats(image, lanes, frame=0, row_order=None, base=0, carried=0):
+    """Input transfers for ``image``, rows in ``row_order`` (default top to bottom), tagged as
+    frame ``frame`` (a delta of ``base`` carrying ``carried`` rows when that is nonzero)."""
     rows, cols = image.shape
     for row in (range(rows) if row_order is None else row_order):
         for col in range(0, cols, lanes):
             yield {"pixels": [int(p) for p in image[row, col:col + lanes]],
-                   "column": col, "row": int(row), "frame": frame}
+                   "column": col, "row": int(row), "frame": frame, "base": base, "carried": carried}
 
 
 def assemble(dmd, words, row_flags):

@@ -25,9 +25,11 @@ def stored_planes(depth):
     return list(range(PLANES - depth, PLANES))
 
 
-def frame_beats(image, frame_id, lanes=8, rows=None):
-    """Pixel transfers of ``image`` tagged ``frame_id``; ``rows`` the row order (default all)."""
-    return list(serialiser_stim.pixel_beats(image, lanes, frame=frame_id, row_order=rows))
+def frame_beats(image, frame_id, lanes=8, rows=None, base=0, carried=0):
+    """Pixel transfers of ``image`` tagged ``frame_id`` (a delta of ``base`` carrying ``carried``
+    rows when that is nonzero); ``rows`` the row order (default all)."""
+    return list(serialiser_stim.pixel_beats(image, lanes, frame=frame_id, row_order=rows, base=base,
+                                            carried=carried))
 
 
 def random_image(dmd, seed):
