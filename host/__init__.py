@@ -5,9 +5,10 @@ is generated from; the testbenches feed the gateware with this very encoder. Pla
 numpy: no HDL toolchain.
 """
 
-from .client import Client, ClientError
+from .client import Client, ClientError, Sent
 from .codec import (
                       ProtocolError,
+                      changed_rows,
                       control_record,
                       decode,
                       image_record,
@@ -19,6 +20,6 @@ from .codec import (
 )
 from .levels import Quantised, quantise
 
-__all__ = ["Client", "ClientError", "ProtocolError", "Quantised", "control_record", "decode", "image_record",
-           "image_records", "pixels_per_record", "quantise", "sequence_records", "sequencer_record",
+__all__ = ["Client", "ClientError", "ProtocolError", "Quantised", "Sent", "changed_rows", "control_record", "decode",
+           "image_record", "image_records", "pixels_per_record", "quantise", "sequence_records", "sequencer_record",
            "status_query"]

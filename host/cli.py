@@ -3,8 +3,9 @@
 
 ``send`` sizes records to the path MTU (``--mtu`` to say it), continues after the newest frame id
 the projector has (``--frame`` to choose), sends each frame at the smallest bit depth that shows it
-within ``--tolerance`` LSB (``--depth`` to fix it) and checks in a status reply that the projector
-took every record (``--no-check`` not to)."""
+within ``--tolerance`` LSB (``--depth`` to fix it), with ``--delta`` sends a scene's images as delta
+frames of the last whole frame where few rows changed, and checks in a status reply that the
+projector took every record (``--no-check`` not to)."""
 
 import argparse
 import dataclasses
@@ -16,7 +17,7 @@ from spec import plan_search, schedule
 from spec.facts import DMDS
 from spec.registers import PlaneOrder, ResetMode, TriggerMode
 
-from .client import DEFAULT_PORT, Client, ClientError, period_fault
+from .client import DEFAULT_PORT, DELTA_ROWS, Client, ClientError, period_fault
 
 __all__ = ["main", "describe"]
 
@@ -102,6 +103,10 @@ def main(argv=None):
                       "that shows each frame within --tolerance)")
     send.add_argument("--tolerance", type=float, default=0.5, help="largest rounding error, 8-bit LSB")
     send.add_argument("--rate", type=float, default=100e6, help="pacing in bytes per second")
+    send.add_argument("--delta", type=float, default=0.0, metavar="FRACTION",
+                      help="send an image as a delta frame (only its changed rows) of the last whole frame "
+                           f"sent when at most this fraction of its rows changed (e.g. {DELTA_ROWS}); "
+                           "default 0: whole frames")
     send.add_argument("--no-check", action="store_true", help="do not check the status after each frame")
     configure = sub.add_parser("configure", help="plan a schedule, say the rate it reaches, send it")
     configure.add_argument("--dmd", default="dlp7000", choices=sorted(DMDS))
@@ -144,10 +149,14 @@ def main(argv=None):
                     mtu=getattr(args, "mtu", None), check=not getattr(args, "no_check", False)) as client:
             if args.command == "send":
                 images = [_load(path) for path in args.images]
-                sent = client.send_sequence(images, args.frame, depth=args.depth, tolerance=args.tolerance)
+                sent = client.send_sequence(images, args.frame, depth=args.depth, tolerance=args.tolerance,
+                                            delta=args.delta)
                 for path, frame in zip(args.images, sent, strict=True):
+                    kind = f", delta of frame {frame.base} carrying {frame.rows} rows" if frame.delta else ""
+                    if frame.refused:
+                        kind = f", whole: its delta was refused ({frame.refused})"
                     print(f"frame {frame.frame}: {path}, {frame.depth}-bit, {frame.records} records, "
-                          f"rounding error {frame.error_lsb:.3g} LSB")
+                          f"rounding error {frame.error_lsb:.3g} LSB{kind}")
                 print(f"sent {len(images)} frame(s) in {sum(f.records for f in sent)} records "
                       f"of at most {client.limit} bytes (MTU {client.mtu})")
             elif args.command == "configure":

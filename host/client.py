@@ -4,8 +4,8 @@ What it does for the user:
 
 * **Record size.** Records must travel unfragmented (the projector drops fragments). The client
   sends with the don't-fragment flag, takes the path MTU the operating system knows for the
-  projector (or the ``mtu`` it is given) and sizes image records to fill it: 1,462 pixels a
-  record on an ordinary 1,500-byte MTU, 8,962 on a jumbo path. A record that does not fit (the
+  projector (or the ``mtu`` it is given) and sizes image records to fill it: 1,458 pixels a
+  record on an ordinary 1,500-byte MTU, 8,958 on a jumbo path. A record that does not fit (the
   path turned out narrower, or ``mtu`` was too large) raises :class:`ClientError` saying so.
 * **Frame ids.** Before its first frame the client reads a status reply and continues after the
   newest frame id the projector has handed on, so a restarted sender is never refused as old
@@ -13,16 +13,21 @@ What it does for the user:
 * **Bit depth.** Each frame goes at the smallest bit depth that shows it within a tolerance,
   rounded to the nearest level (:mod:`host.levels`); a control record sets the depth when it
   changes. The rounding error is reported.
+* **Delta frames.** Asked to (``delta``), it sends an image as a delta frame of the key frame,
+  the last whole frame it sent: only the rows that differ from it once rounded to the key's bit
+  depth (a delta shows at its base's depth). An image that changed in more rows than asked, or
+  that the key's depth does not show within the tolerance, goes whole and becomes the key.
 * **Checks.** With ``check`` (the default), after each frame a status reply must show every
   record taken and every row handed on; otherwise :class:`ClientError` says what the projector
-  counted instead (fragments, overflow, refused rows, ...).
+  counted instead (fragments, overflow, refused rows, ...). A delta the projector refused because
+  it no longer holds the key frame is sent again as a whole frame.
 """
 
+import dataclasses
 import errno
 import socket
 import sys
 import time
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -32,9 +37,12 @@ from spec.registers import TriggerMode
 
 from . import codec, levels
 
-__all__ = ["Client", "ClientError", "Sent", "DEFAULT_PORT", "path_mtu", "period_fault"]
+__all__ = ["Client", "ClientError", "Sent", "DEFAULT_PORT", "DELTA_ROWS", "path_mtu", "period_fault"]
 
 DEFAULT_PORT = 5000
+#: A starting point for ``delta``: a delta then sends at most half a whole frame's pixels; an
+#: image that changed more goes whole and becomes a fresh key, likely closer to the images after it.
+DELTA_ROWS = 0.5
 
 # Linux socket options (Python's socket module does not name them): the don't-fragment policy
 # and the path MTU of a connected socket.
@@ -56,7 +64,9 @@ _WHY = {
     "drop_app_length": "records were malformed",
     "rows_incomplete": "records were lost or reordered on the way, so rows they split were dropped",
     "store_rows_refused": "the projector's store refused rows (a frame id not newer than its newest, "
-                          "or no free slot)",
+                          "no free slot, or a delta without its base)",
+    "store_rows_no_base": "the projector no longer holds the whole frame a delta is based on "
+                          "(send a whole frame: later deltas can use it)",
 }
 
 
@@ -74,16 +84,36 @@ def period_fault(plan):
 
 
 class ClientError(RuntimeError):
-    """The projector did not answer, refused or lost what was sent, or cannot be reached as asked."""
+    """The projector did not answer, refused or lost what was sent, or cannot be reached as asked.
+
+    Attributes
+    ----------
+    counters : dict
+        For a frame the projector did not take: how much each counter that says why grew.
+    """
+
+    def __init__(self, message, counters=None):
+        super().__init__(message)
+        self.counters = counters or {}
 
 
-@dataclass
+@dataclasses.dataclass
 class Sent:
-    """One frame sent: its id, bit depth, records, and the rounding error left (8-bit LSB)."""
+    """One frame sent: its id, bit depth, records, the rounding error left (8-bit LSB), the rows
+    it carried and, for a delta frame, its base (the key frame's id; None for a whole frame).
+    ``refused``: why the projector refused the delta this whole frame was sent in place of (None
+    when it refused none)."""
     frame: int
     depth: int
     records: int
     error_lsb: float
+    rows: int
+    base: int | None = None
+    refused: str | None = None
+
+    @property
+    def delta(self):
+        return self.base is not None
 
 
 def path_mtu(sock):
@@ -145,6 +175,7 @@ class Client:
         self._depth = None         # the bit depth this client last set
         self._next_frame = None    # the frame id to send next (known after the first status)
         self._last = None          # the last status reply read
+        self._key = None           # the last whole frame sent, (id, Quantised): the base of deltas
 
     def close(self):
         self._sock.close()
@@ -202,7 +233,7 @@ class Client:
             self._next_frame = (self.status()["newest_frame"] + 1) & 0xFFFF
         return self._next_frame
 
-    def send_image(self, image, frame=None, *, depth=None, tolerance=0.5):
+    def send_image(self, image, frame=None, *, depth=None, tolerance=0.5, delta=0.0):
         """Send one image as a frame.
 
         Parameters
@@ -214,10 +245,20 @@ class Client:
             than its newest is refused by it (and, with ``check``, raises).
         depth : int, optional
             Bit depth; default the smallest within ``tolerance`` (8-bit LSB) of every target.
+        delta : float
+            0 (the default): a whole frame. Otherwise a delta frame of the key frame (the last
+            whole frame sent), carrying only the rows that differ from it, when they are at most
+            this fraction of the rows (e.g. :data:`DELTA_ROWS`) and the key's bit depth shows the
+            image (within ``tolerance``, or no worse than its own depth; with ``depth``, only a
+            key of that depth); else a whole frame, which becomes the key. A delta carries a row
+            at least: an image equal to the key goes as a delta of its first row.
 
         Returns
         -------
         Sent
+            With ``check``, a delta the projector refused for want of its base
+            (``store_rows_no_base``) is sent again as a whole frame with the next id: that
+            frame's, saying why in ``refused``.
         """
         frame = self.next_frame() if frame is None else frame & 0xFFFF
         image = np.asarray(image)
@@ -227,23 +268,58 @@ class Client:
         if before is not None:
             self._fits(image, before)
         shown = levels.quantise(image, depth, tolerance=tolerance)
-        if shown.depth != self._depth:
+        keyed = self._against_key(image, shown, depth is not None, tolerance, delta)
+        base, rows = None, None
+        if keyed is not None:
+            shown, rows = keyed
+            base = self._key[0]
+        elif shown.depth != self._depth:
+            # a delta takes its depth from its base: only a whole frame needs the control record
             self.control(bit_depth=shown.depth)
             self._depth = shown.depth
-        encoded = codec.image_records(shown.data, frame, sequence=self.sequence, limit=self.limit)
+        encoded = codec.image_records(shown.data, frame, sequence=self.sequence, limit=self.limit,
+                                      base=base, rows=rows)
         self.sequence = (self.sequence + len(encoded)) & codec.SEQUENCE_MASK
         self.send_records(encoded)
         self._next_frame = (frame + 1) & 0xFFFF
+        carried = image.shape[0] if rows is None else len(rows)
         if self.check:
-            self._verify(before, len(encoded), image.shape[0], frame)
-        return Sent(frame=frame, depth=shown.depth, records=len(encoded), error_lsb=shown.error_lsb)
+            try:
+                self._verify(before, len(encoded), carried, frame)
+            except ClientError as error:
+                if base is None or not error.counters.get("store_rows_no_base"):
+                    raise
+                self._key = None
+                whole = self.send_image(image, depth=depth, tolerance=tolerance, delta=delta)
+                return dataclasses.replace(whole, refused=str(error))
+        if base is None:
+            self._key = (frame, shown)
+        return Sent(frame=frame, depth=shown.depth, records=len(encoded), error_lsb=shown.error_lsb,
+                    rows=carried, base=base)
+
+    def _against_key(self, image, shown, fixed, tolerance, delta):
+        """The image as a delta of the key frame, ``(Quantised at the key's depth, rows to carry)``;
+        None when it is due as a whole frame. ``shown``: the image at its own depth (``fixed``:
+        the depth the caller asked for)."""
+        if not delta or self._key is None:
+            return None
+        key = self._key[1]
+        if fixed and shown.depth != key.depth:
+            return None
+        at_key = shown if shown.depth == key.depth else levels.quantise(image, key.depth)
+        # the delta shows at the key's depth: only if that shows the image as its own depth would
+        if at_key.error_lsb > max(tolerance, shown.error_lsb):
+            return None
+        # rows compared as sent: the bytes of equal levels are equal
+        rows = codec.changed_rows(at_key.data, key.data)
+        if len(rows) > delta * image.shape[0]:
+            return None
+        return at_key, rows if len(rows) else np.array([0])
 
     def send_sequence(self, images, first_frame=None, **kwargs):
         """Several images as consecutive frames; returns a :class:`Sent` for each."""
-        out = []
-        for i, image in enumerate(images):
-            out.append(self.send_image(image, None if first_frame is None else first_frame + i, **kwargs))
-        return out
+        # ids after the first from next_frame: they count on past a delta sent again whole
+        return [self.send_image(image, first_frame if i == 0 else None, **kwargs) for i, image in enumerate(images)]
 
     @staticmethod
     def _fits(image, status):
@@ -254,9 +330,9 @@ class Client:
 
     def _verify(self, before, sent, rows, frame):
         """Wait (at most ``timeout``) until a status reply shows ``sent`` more image records and
-        ``rows`` more rows handed on than ``before``, none refused by the store; else raise with
-        the counters that say why. (A frame's first row is the one a stale id gets refused, long
-        before its last row is handed on.)"""
+        ``rows`` more rows handed on than ``before`` (the rows the frame carried: a delta's own),
+        none refused by the store; else raise with the counters that say why. (A frame's first
+        row is the one a stale id gets refused, long before its last row is handed on.)"""
         deadline = time.monotonic() + self.timeout
         while True:
             after = self.status()
@@ -272,7 +348,7 @@ class Client:
             "no counter says why (the records did not reach the projector)"
         raise ClientError(f"frame {frame}: the projector took {took} of {sent} records and handed on {handed} "
                           f"of {rows} rows; {why}. Its newest frame id is {after['newest_frame']}, "
-                          f"it shows frame {after['shown_frame']}")
+                          f"it shows frame {after['shown_frame']}", grew)
 
     # -- settings and status -----------------------------------------------------------------
 

@@ -6,9 +6,9 @@ from spec import records, wire
 from spec.records import Action, RecordType
 from spec.schedule import row_cycles
 
-__all__ = ["ProtocolError", "header", "image_record", "image_records", "sequence_records", "pixels_per_record",
-           "control_record", "sequencer_record", "status_query", "status_reply", "decode", "SEQUENCE_MASK",
-           "DEFAULT_LIMIT"]
+__all__ = ["ProtocolError", "header", "image_record", "image_records", "changed_rows", "sequence_records",
+           "pixels_per_record", "control_record", "sequencer_record", "status_query", "status_reply", "decode",
+           "SEQUENCE_MASK", "DEFAULT_LIMIT"]
 
 #: Record sequence numbers wrap at this mask.
 SEQUENCE_MASK = (1 << dict(records.HEADER)["sequence"]) - 1
@@ -26,31 +26,70 @@ def header(record_type, sequence):
 
 
 def pixels_per_record(limit=DEFAULT_LIMIT):
-    """Pixels an image record of at most ``limit`` bytes carries: 1,462 in a 1500-byte MTU,
-    8,962 in a 9,000-byte one."""
+    """Pixels an image record of at most ``limit`` bytes carries: 1,458 in a 1500-byte MTU,
+    8,958 in a 9,000-byte one."""
     pixels = limit - records.IMAGE_HEADER
     if pixels < 1:
         raise ValueError(f"a {limit}-byte record has no room for pixels")
     return pixels
 
 
-def image_record(frame, offset, pixels, sequence=0):
-    """One image record: ``pixels`` (bytes) of frame ``frame`` from position ``offset``."""
-    body = wire.pack(records.IMAGE, {"frame": frame & 0xFFFF, "offset": offset})
+def image_record(frame, offset, pixels, sequence=0, *, base=0, carried=0):
+    """One image record: ``pixels`` (bytes) of frame ``frame`` from position ``offset``; a record
+    of a delta frame names its ``base`` and the rows the delta ``carried`` (0: a whole frame)."""
+    body = wire.pack(records.IMAGE, {"frame": frame & 0xFFFF, "base": base & 0xFFFF, "carried": carried,
+                                     "offset": offset})
     return header(RecordType.IMAGE, sequence) + body + bytes(pixels)
 
 
-def image_records(image, frame, *, sequence=0, limit=DEFAULT_LIMIT, pixels=None):
+def changed_rows(image, reference):
+    """Indices of the rows in which two images (same shape) differ: what a delta of ``reference``
+    must carry to show ``image``."""
+    image, reference = np.asarray(image), np.asarray(reference)
+    if image.shape != reference.shape:
+        raise ValueError(f"images of shapes {image.shape} and {reference.shape} have no rows in common")
+    return np.flatnonzero((image != reference).any(axis=1))
+
+
+def _runs(rows):
+    """Sorted distinct row indices -> ``(first, end)`` of each run of consecutive rows."""
+    cuts = np.flatnonzero(np.diff(rows) != 1) + 1
+    return [(int(run[0]), int(run[-1]) + 1) for run in np.split(rows, cuts)]
+
+
+def image_records(image, frame, *, sequence=0, limit=DEFAULT_LIMIT, pixels=None, base=None, rows=None):
     """An 8-bit image (``uint8`` array, rows x columns) -> its image records: its pixels row by
     row, each record as many as fit ``limit`` bytes (or ``pixels``), so that rows split across
-    records anywhere. Sequence numbers count up from ``sequence``."""
+    records anywhere. Sequence numbers count up from ``sequence``.
+
+    Parameters
+    ----------
+    base : int, optional
+        Send a delta frame of whole frame ``base`` (which the projector holds): only ``rows``.
+    rows : array_like of int, optional
+        With ``base``: the rows the delta carries (any order, repeats ignored; at least one).
+        Each run of consecutive rows goes as consecutive records, cut as a whole frame's are;
+        the projector takes every other row from ``base``.
+    """
     image = np.asarray(image)
     if image.dtype != np.uint8 or image.ndim != 2:
         raise ValueError(f"need a 2-D uint8 image, got {image.dtype} with shape {image.shape}")
+    if (base is None) != (rows is None):
+        raise ValueError("a delta frame needs both its base and its rows")
+    height, columns = image.shape
+    if rows is None:
+        runs, carried, base = [(0, height)], 0, 0      # a whole frame: one run of every row
+    else:
+        rows = np.unique(np.asarray(rows, dtype=np.int64))
+        if not rows.size or rows[0] < 0 or rows[-1] >= height:
+            raise ValueError(f"a delta carries 1 to {height} rows of the image, got {rows.tolist()}")
+        runs, carried = _runs(rows), rows.size
     flat = np.ascontiguousarray(image).reshape(-1).tobytes()
     step = pixels or pixels_per_record(limit)
-    return [image_record(frame, offset, flat[offset:offset + step], sequence + i)
-            for i, offset in enumerate(range(0, len(flat), step))]
+    spans = [(offset, min(offset + step, end * columns))
+             for first, end in runs for offset in range(first * columns, end * columns, step)]
+    return [image_record(frame, start, flat[start:stop], sequence + i, base=base, carried=carried)
+            for i, (start, stop) in enumerate(spans)]
 
 
 def sequence_records(images, first_frame=0, *, sequence=0, limit=DEFAULT_LIMIT):

@@ -1,7 +1,7 @@
 """The host client and CLI against an in-process UDP server on 127.0.0.1 that plays projector
 with the reference models: the endpoint's (records, rows, counters) and the store's frame-slot
-policy (which frames it takes, which rows it refuses); a software trigger shows the newest
-complete frame."""
+policy (which frames it takes, which rows it refuses, which whole frame a delta frame takes its
+other rows from); a software trigger shows the newest complete frame."""
 
 import dataclasses
 import socket
@@ -13,12 +13,13 @@ import pytest
 from host import Client, ClientError, cli, codec, levels
 from sim.models.net import Model
 from sim.models.slots import SlotPolicy
-from spec import records
+from spec import records, wire
 from spec.facts import TEST_DMD
 from spec.registers import TriggerMode
 
 #: The store's refusals, summed into the status reply's ``store_rows_refused``.
-REFUSALS = ("rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot")
+REFUSALS = ("rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot", "rows_no_base")
+SHAPE = (TEST_DMD.rows, TEST_DMD.columns)
 
 
 class FakeProjector:
@@ -34,6 +35,8 @@ class FakeProjector:
         self.store = SlotPolicy(TEST_DMD.rows, slots=4)
         self.shown = None
         self.depths = []            # bit depth of each frame the store completed
+        self.kinds = {}             # frame id -> (base, carried) of its image records
+        self.stored = {}            # (frame id, row) -> the row's bytes the store took
         self.mode = mode
         self.status_values = {}     # status fields the test sets
         self.received = []
@@ -49,10 +52,16 @@ class FakeProjector:
                 continue
             self.received.append(raw)
             replies_before, rows_before = len(self.model.replies), len(self.model.rows)
-            self.model.record(raw)
-            for frame, row, _data in self.model.rows[rows_before:]:
+            if self.model.record(raw) == "image":
+                body = wire.unpack(records.IMAGE, raw[wire.size(records.HEADER):])
+                self.kinds[body["frame"]] = (body["base"], body["carried"])
+            for frame, row, data in self.model.rows[rows_before:]:
                 complete = self.store.counters["frames_complete"]
-                self.store.row(frame, row, self.model.config["bit_depth"])
+                base, carried = self.kinds[frame]
+                # a whole frame's row is the policy's row(frame, row, depth) with base and carried at their defaults
+                delta = {"base": base, "carried": carried} if carried else {}
+                if self.store.row(frame, row, self.model.config["bit_depth"], **delta):
+                    self.stored[frame, row] = data
                 if self.store.counters["frames_complete"] > complete:
                     self.depths.append(self.store.frames[frame]["depth"])
             if self.model.triggers and self.store.can_answer():
@@ -63,13 +72,21 @@ class FakeProjector:
             if len(self.model.replies) > replies_before and self.mode != "silent":
                 sequence = self.model.replies[-1][1]["sequence"]
                 values = {name: self.model.counters.get(name, 0) for name, _ in records.STATUS_REPLY}
-                values["store_rows_refused"] = sum(self.store.counters[name] for name in REFUSALS)
+                values["store_rows_refused"] = sum(self.store.counters.get(name, 0) for name in REFUSALS)
+                values["store_rows_no_base"] = self.store.counters.get("rows_no_base", 0)
                 values["shown_frame"] = self.shown or 0
                 values.update(self.status_values)
                 reply = codec.status_reply(sequence, values)
                 if self.mode == "garbled":
                     reply = reply[:20]
                 self.sock.sendto(reply, sender)
+
+    def image(self, frame):
+        """The image frame ``frame`` shows: its own rows, and its base's where a delta carries none."""
+        base, carried = self.kinds[frame]
+        rows = [self.stored[frame if (frame, row) in self.stored or not carried else base, row]
+                for row in range(TEST_DMD.rows)]
+        return np.frombuffer(b"".join(rows), np.uint8).reshape(SHAPE)
 
     def close(self):
         self._stop.set()
@@ -90,7 +107,7 @@ def test_send_image_and_status(projector):
         sent = client.send_image(image, frame=3)
         client.control(armed=1, software_trigger=True)
         status = client.status()
-    # 12,288 pixels in records of 1,462 (a 1500-byte MTU): 9 records, rows split between them
+    # 12,288 pixels in records of 1,458 (a 1500-byte MTU): 9 records, rows split between them
     assert (sent.frame, sent.depth, sent.records, sent.error_lsb) == (3, 8, 9, 0.0)
     assert status["records_image"] == 9 and status["records_control"] == 2   # the depth, then arming
     assert status["rows"] == TEST_DMD.rows and status["sequence_gaps"] == 0 and status["rows_incomplete"] == 0
@@ -110,16 +127,16 @@ def test_records_fill_the_path_mtu(projector):
     with Client("127.0.0.1", projector.port, mtu=2000) as client:
         client.send_image(image)
     sizes = [len(raw) for raw in projector.received if raw[3] == records.RecordType.IMAGE]
-    # 12,288 pixels: 8,962 + 3,326 in jumbo records, 6 x 1,962 + 516 in records for a 2,000-byte MTU,
-    # each with its 10-byte header
-    assert sizes == [8972, 3336] + [1972] * 6 + [526]
+    # 12,288 pixels: 8,958 + 3,330 in jumbo records, 6 x 1,958 + 540 in records for a 2,000-byte MTU,
+    # each with its 14-byte header
+    assert sizes == [8972, 3344] + [1972] * 6 + [554]
 
 
 def test_a_record_too_large_for_the_path_is_a_clear_error(projector):
     """The don't-fragment flag is set: a record larger than the path allows is refused by the
     system, and the client says what to do."""
     with Client("127.0.0.1", projector.port, check=False) as client:
-        with pytest.raises(ClientError, match="a 65600-byte record does not fit the path .* give mtu="):
+        with pytest.raises(ClientError, match="a 65604-byte record does not fit the path .* give mtu="):
             client.send_records([codec.image_record(1, 0, bytes(65590))])
 
 
@@ -156,6 +173,70 @@ def test_depth_per_frame_and_rounding(projector):
     # the dim target at depth 4 is level 1 (17 LSB), not black
     rows = {row: data for _tag, row, data in projector.model.rows[-2 * TEST_DMD.rows:-TEST_DMD.rows]}
     assert rows[15][15] >> 4 == 1 == levels.levels(15, 4)
+
+
+def _target(row, column, level=255, background=None):
+    """An 8 x 8 target at ``row``, ``column`` on a background (default: black)."""
+    image = np.zeros(SHAPE, np.uint8) if background is None else background.copy()
+    image[row:row + 8, column:column + 8] = level
+    return image
+
+
+def test_a_scene_streams_as_deltas_of_its_key_frame(projector):
+    """With ``delta``, each image goes as a delta frame of the last whole frame (the key) when at
+    most that fraction of its rows changed and the key's depth shows it; else whole, as the new
+    key. The projector shows each frame as sent: a delta's rows, its key's elsewhere, at the key's
+    depth."""
+    noise = np.where(np.random.default_rng(4).random(SHAPE) < 0.5, 255, 0).astype(np.uint8)
+    band = np.zeros(SHAPE, np.uint8)
+    band[20:28] = 36                              # 36 LSB: depth 3 shows it, within half an LSB
+    steps = [   # image; then what goes: the index of its base (None: whole), rows carried, depth
+        (_target(10, 10), None, 96, 1),           # the first frame is whole: the key
+        (_target(10, 14), 0, 8, 1),               # the target moves: its 8 rows
+        (_target(13, 14), 0, 11, 1),              # rows 10 to 20 differ from the key's
+        (_target(10, 10), 0, 1, 1),               # the key again: a delta carries a row at least
+        (noise, None, 96, 1),                     # more than half the rows changed: whole
+        (_target(40, 40, 103, noise), None, 96, 8),   # a grey target needs depth 8: whole
+        (_target(44, 40, 103, noise), 5, 8, 8),       # 4 rows down: rows 40 to 43 and 48 to 51
+        (_target(40, 40, 255, noise), 5, 8, 8),       # white on white: depth 1 would do, the key's 8 shows it
+        (band, None, 96, 3),
+        (np.where(band, 85, 0).astype(np.uint8), None, 96, 2),  # 85 needs depth 2; depth 3 shows it 12 LSB off
+    ]
+    with Client("127.0.0.1", projector.port) as client:
+        client.control(armed=1)
+        sent = []
+        for image, *_ in steps:
+            sent.append(client.send_image(image, delta=0.5))
+            client.control(software_trigger=True)
+            assert client.status()["shown_frame"] == sent[-1].frame
+            assert (projector.image(sent[-1].frame) == levels.quantise(image, sent[-1].depth).data).all()
+        status = client.status()
+    frames = [s.frame for s in sent]
+    assert [(None if s.base is None else frames.index(s.base), s.rows, s.depth) for s in sent] == \
+        [tuple(step[1:]) for step in steps]
+    assert [projector.kinds[s.frame] for s in sent] == [(s.base or 0, s.rows if s.delta else 0) for s in sent]
+    assert projector.depths == [s.depth for s in sent]
+    assert status["rows"] == sum(s.rows for s in sent) and status["store_rows_refused"] == 0
+    assert [s.error_lsb for s in sent] == [0.0] * 8 + [pytest.approx(255 * 1 / 7 - 36), 0.0]
+
+
+def test_a_delta_whose_base_is_gone_goes_whole(projector):
+    """Another sender's whole frame replaces the delta that kept the key frame: the projector no
+    longer holds it and refuses the next delta of it (``store_rows_no_base``); the client sends
+    that image again as a whole frame, the new key, and says why."""
+    with Client("127.0.0.1", projector.port) as first, Client("127.0.0.1", projector.port) as other:
+        key = first.send_image(_target(10, 10), delta=0.5)
+        moved = first.send_image(_target(10, 14), delta=0.5)
+        intruder = other.send_image(np.full(SHAPE, 255, np.uint8))
+        again = first.send_image(_target(10, 18), frame=intruder.frame + 1, delta=0.5)
+        after = first.send_image(_target(10, 22), delta=0.5)
+    assert moved.base == key.frame and not intruder.delta
+    assert (again.delta, again.frame, again.rows) == (False, intruder.frame + 2, TEST_DMD.rows)
+    assert again.refused.startswith(f"frame {intruder.frame + 1}: the projector took ")
+    assert ("store_rows_no_base +8: the projector no longer holds the whole frame a delta is based on "
+            "(send a whole frame") in again.refused
+    assert (after.base, after.rows) == (again.frame, 8)
+    assert projector.store.counters["rows_no_base"] == 8
 
 
 def test_an_image_of_another_size_is_refused(projector):
@@ -204,6 +285,18 @@ def test_cli_send_and_status(projector, tmp_path, capsys):
     assert "records_image" in capsys.readouterr().out
     assert cli.main(base + ["send", str(tmp_path / "missing.npy")]) == 1
     assert "error: cannot read" in capsys.readouterr().err
+
+
+def test_cli_send_deltas(projector, tmp_path, capsys):
+    paths = [tmp_path / f"scene{i}.npy" for i in range(3)]
+    for path, image in zip(paths, [_target(10, 10), _target(10, 14), np.full(SHAPE, 255, np.uint8)], strict=True):
+        np.save(path, image)
+    base = ["--address", "127.0.0.1", "--port", str(projector.port)]
+    assert cli.main(base + ["send", "--delta", "0.5", "--frame", "7"] + [str(p) for p in paths]) == 0
+    out = capsys.readouterr().out
+    assert f"frame 7: {paths[0]}, 1-bit, 2 records, rounding error 0 LSB\n" in out
+    assert f"frame 8: {paths[1]}, 1-bit, 1 records, rounding error 0 LSB, delta of frame 7 carrying 8 rows" in out
+    assert f"frame 9: {paths[2]}, 1-bit, 2 records, rounding error 0 LSB\n" in out
 
 
 def test_cli_reports_unreachable(capsys):

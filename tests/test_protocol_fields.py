@@ -1,5 +1,7 @@
 """The protocol's field tables: host encoder and gateware layouts agree, records round-trip."""
 
+import itertools
+
 import numpy as np
 import pytest
 from amaranth import C, Const
@@ -38,10 +40,10 @@ def test_gateware_view_reads_host_bytes(table):
     assert isinstance(layout(table), data.StructLayout)
 
 
-@pytest.mark.parametrize("mtu, pixels", [(1500, 1462), (9000, 8962)])
+@pytest.mark.parametrize("mtu, pixels", [(1500, 1458), (9000, 8958)])
 def test_record_sizes_fill_the_mtu(mtu, pixels):
-    """A record fills the MTU less the IPv4 and UDP headers; its own header is 10 bytes."""
-    assert records.IMAGE_HEADER == 10
+    """A record fills the MTU less the IPv4 and UDP headers; its own header is 14 bytes."""
+    assert records.IMAGE_HEADER == 14
     assert records.record_limit(mtu) == mtu - 28
     assert codec.pixels_per_record(records.record_limit(mtu)) == pixels
     assert len(codec.image_records(np.zeros((16, 1024), np.uint8), 0, limit=records.record_limit(mtu))[0]) == \
@@ -60,6 +62,52 @@ def test_image_records_round_trip(mtu):
         assert body["frame"] == 5 and len(record) <= records.record_limit(mtu)
         rebuilt[body["offset"]:body["offset"] + len(pixels)] = pixels
     assert bytes(rebuilt) == image.tobytes()
+
+
+@pytest.mark.parametrize("pixels", [100, 1024, codec.pixels_per_record(records.record_limit(1500))])
+def test_delta_records_carry_the_changed_rows(pixels):
+    """A delta frame's records carry exactly the rows that differ from its base, each run of
+    consecutive rows in consecutive records (rows split as a whole frame's), every record naming
+    the base and the count of distinct rows; pasted over the base they give the new image."""
+    rng = np.random.default_rng(7)
+    old = rng.integers(0, 256, (768, 1024), dtype=np.uint8)
+    changed = sorted({0, 1, 2, 767, *rng.choice(np.arange(3, 767), 40, replace=False).tolist()})
+    new = old.copy()
+    new[changed, rng.integers(0, 1024, len(changed))] ^= rng.integers(1, 256, len(changed), dtype=np.uint8)
+    rows = codec.changed_rows(new, old)
+    assert rows.tolist() == np.nonzero((new != old).any(axis=1))[0].tolist() == changed
+    encoded = codec.image_records(new, frame=9, base=4, rows=rows[::-1], sequence=254, pixels=pixels)
+    rebuilt, carried, end = old.reshape(-1).copy(), set(), None
+    for i, record in enumerate(encoded):
+        head, body, data = codec.decode(record)
+        assert head["sequence"] == (254 + i) % 256 and (body["frame"], body["base"], body["carried"]) == (9, 4, 44)
+        assert len(data) <= pixels
+        first, last = body["offset"] // 1024, (body["offset"] + len(data) - 1) // 1024
+        # a record continues the previous one, or starts a run: a row no record before carried
+        assert body["offset"] == end or (body["offset"] % 1024 == 0 and first - 1 not in carried)
+        rebuilt[body["offset"]:body["offset"] + len(data)] = np.frombuffer(data, np.uint8)
+        carried |= set(range(first, last + 1))
+        end = body["offset"] + len(data)
+    assert sorted(carried) == changed and (rebuilt.reshape(new.shape) == new).all()
+    runs = [len(list(run)) for _, run in itertools.groupby(enumerate(changed), lambda r: r[1] - r[0])]
+    assert len(encoded) == sum(-(-n * 1024 // pixels) for n in runs)
+
+
+def test_whole_frame_records_name_no_base():
+    bodies = [codec.decode(record)[1] for record in codec.image_records(np.ones((4, 8), np.uint8), 3, pixels=5)]
+    assert [(b["frame"], b["base"], b["carried"]) for b in bodies] == [(3, 0, 0)] * 7
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"base": 2}, "both its base and its rows"),
+    ({"rows": [1]}, "both its base and its rows"),
+    ({"base": 2, "rows": []}, "1 to 4 rows"),
+    ({"base": 2, "rows": [4]}, "1 to 4 rows"),
+    ({"base": 2, "rows": [-1]}, "1 to 4 rows"),
+])
+def test_bad_delta(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        codec.image_records(np.zeros((4, 8), np.uint8), 3, **kwargs)
 
 
 def test_frame_ids_in_serial_number_order():

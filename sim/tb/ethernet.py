@@ -184,7 +184,7 @@ def image_frames(picture, frame, rows_per_record, rows, *, pixels=None):
 
 @cocotb.test()
 async def good_traffic_back_to_back(dut):
-    """Image records of 1 and 3 rows and of 1,462 pixels (a 1500-byte MTU's, rows split), ICMP
+    """Image records of 1 and 3 rows and of 1,458 pixels (a 1500-byte MTU's, rows split), ICMP
     echoes of random size, ARP, status queries and 9,018-byte frames for another port, back to
     back at the minimum gap: 64 to 9,018 bytes on the line. Every row arrives intact, every reply
     is right, nothing is dropped for room."""
