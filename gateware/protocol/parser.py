@@ -179,7 +179,8 @@ class Parser(wiring.Component):
         m.d.comb += until.eq(image.offset + (length - _IMAGE_END))
         # a delta's row count beyond the frame is kept as rows + 1, for the store to refuse
         carried = Signal.like(self.pieces.payload.carried)
-        m.d.comb += carried.eq(Mux(image.carried > dmd.rows, dmd.rows + 1, image.carried))
+        rows = self._dmd.rows
+        m.d.comb += carried.eq(Mux(image.carried > rows, rows + 1, image.carried))
 
         cause = self._cause(m, header, image, control, sequencer, length, needed)
         causes = self._CAUSES
