@@ -93,7 +93,8 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=None):
     dmd = xga.DMD
     print(f"make sim: the projector's core (generated Verilog, Verilator) on the default scene, "
           f"{dmd.columns}x{dmd.rows} 8-bit ({dmd.name}) at DCLK {dclk_hz / 1e6:g} MHz, {frames} frames "
-          f"sent over GMII from a replay file and stored as a sequence, {XGA_ONE_BY_ONE} triggered one by "
+          f"sent over GMII from a replay file (the first whole, the others as deltas of it) and stored as a "
+          f"sequence, {XGA_ONE_BY_ONE} triggered one by "
           f"one, then {XGA_BACK_TO_BACK} back to back; Verilog MCB model on both memory ports; DLPC410 pins "
           f"recorded and checked afterwards by the rule-checking DLPC410 model and the camera model; TI "
           f"timing (only INIT_ACTIVE shortened)")
@@ -140,6 +141,12 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=None):
           f"for the store {status['row_underruns']}, RST_ACTIVE late {status['rst_active_late']}, RST_ACTIVE "
           f"faults {status['rst_active_faults']}, longest RST_ACTIVE {status['rst_active_cycles_max']} cycles, "
           f"controller restarts {status['dlpc410_restarts']}")
+    scene = r["scene"]
+    if scene["deltas"]:
+        print(f"scene over GigE, measured on the GMII pins at line rate (every frame complete in the store, none "
+              f"dropped): the first frame whole, {scene['whole_frames_per_s']:.1f} frames/s; the next "
+              f"{scene['deltas']} as deltas of it (rows carried {scene['delta_rows']} of {xga.DMD.rows}), "
+              f"{scene['delta_frames_per_s']:.0f} frames/s")
     if faults:
         print(f"memory commands stalled: {r['mcb_stalls']}")
     print(f"grey error of the reconstructed images: max {max(f['max_error_lsb'] for f in shown):g} LSB "

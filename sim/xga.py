@@ -112,14 +112,18 @@ def _datagrams(payloads, port=PORT):
 def _replay_files(directory, images):
     """GMII replay files: a control record that makes the store keep the frames as a sequence,
     then one per frame (its image records, then the first record again addressed to another UDP
-    port, which the stack must drop and count), and one with a status query."""
+    port, which the stack must drop and count), and one with a status query. The first frame
+    goes whole; each later one, as a user streams a moving target, goes as a delta of it: only
+    the rows in which it differs from the first."""
     files, sequence, datagrams = [], 0, 0
     setup = directory / "sequence.bin"
     gmii.replay_file(setup, _datagrams([codec.control_record(sequence, sequence_length=len(images))]))
     sequence, datagrams = 1, 1
     files.append(str(setup))
     for index, image in enumerate(images):
-        payloads = codec.image_records(image, frame=index, sequence=sequence)
+        delta = {} if index == 0 else {"base": 0, "rows": codec.changed_rows(image, images[0]) if
+                                        (image != images[0]).any() else [0]}
+        payloads = codec.image_records(image, frame=index, sequence=sequence, **delta)
         sequence += len(payloads)
         stray = _datagrams(payloads[:1], port=PORT + 1)
         datagrams += len(payloads) + len(stray)
@@ -287,6 +291,7 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
                                 start=start, end=frames[0][1] + WAVE_WINDOW[1], ns_per_cycle=1e9 / DMD_HZ)
     sends = stimulus["sends"]
     first_frame = next(s for s in sends if s["what"].startswith("frame 1/"))
+    scene = _scene_rate(images, sends, status)
     return {
         "frames": shown,
         "dclk_hz": DMD_HZ * p.beats,
@@ -303,6 +308,7 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
         "mcb_stalls": stimulus["mcb_stalls"],
         "status": status,
         "sends": sends,
+        "scene": scene,
         "dmd_cycles": stimulus["sim_ns"] / (1e9 / DMD_HZ),
         "sim_wall_s": stimulus["wall_s"],
         "xga_frame_sim_wall_s": stimulus["wall"]["first_frame_last_pulse"] - first_frame["wall_start"],
@@ -316,6 +322,24 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
         "check_wall_s": time.monotonic() - t0,
         "build": str(build) if build else None,
     }
+
+
+def _scene_rate(images, sends, status):
+    """Frames a second over GigE, measured on the GMII pins: the whole first frame's records (and
+    the stray datagram after them) from its first byte to its last, and the deltas' from the
+    first delta's first byte to the last one's last byte, replayed at line rate; each counts only
+    if the store completed every frame with nothing dropped (the status reply)."""
+    dropped = {name: status[name] for name in ("drop_overflow", "mac_rx_dropped", "rows_incomplete",
+                                              "store_rows_refused") if status[name]}
+    assert not dropped and status["store_frames_complete"] == len(images), (dropped, status["store_frames_complete"])
+    frames = [s for s in sends if s["what"].startswith("frame ")]
+    whole_s = (frames[0]["end_ns"] - frames[0]["start_ns"]) * 1e-9
+    deltas = frames[1:]
+    delta_s = (deltas[-1]["end_ns"] - deltas[0]["start_ns"]) * 1e-9 if deltas else None
+    return {"whole_frames_per_s": 1 / whole_s,
+            "delta_frames_per_s": len(deltas) / delta_s if deltas else None,
+            "deltas": len(deltas),
+            "delta_rows": [int(len(codec.changed_rows(image, images[0]))) for image in images[1:]]}
 
 
 def _model_span(the_plan):

@@ -13,17 +13,20 @@ def test_system_small_geometry():
     n = system.PARAMS["frames"]
     # the scene streamed, then: a trigger burst (frame n), a new register set (frame n + 1), a
     # frame with a lost record (never shown: frame n + 1 again), a whole frame after it; the
-    # DDR2 lost while it plays again (not checked: cut), then it shown dark, and a new frame
-    assert [f["index"] for f in frames] == [*range(n), n, n + 1, n + 1, n + 3, n + 3, n + 4]
-    assert [f["dark"] for f in frames] == [False] * (n + 4) + [True, False]
+    # DDR2 lost while it plays again (not checked: cut), then it shown dark, and a new frame; a
+    # key frame, two deltas of it, and the second again (a delta whose base is gone is refused)
+    assert [f["index"] for f in frames] == [*range(n), n, n + 1, n + 1, n + 3, n + 3, n + 4,
+                                            n + 5, n + 6, n + 7, n + 7]
+    assert [f["dark"] for f in frames] == [False] * (n + 4) + [True] + [False] * 5
     assert all(f["max_error_lsb"] == 0 for f in frames)
     # a trigger becomes a clocking pulse within a few cycles
     assert all(f["latency_cycles"] <= 8 for f in frames)
     status = report["status"]      # the testbench checked every counter; the headline ones here
     assert status["triggers"] == status["frames_shown"] == len(frames) + 1       # the frame cut
     assert status["store_calibration_losses"] == 1
-    # the frame shown last, by its id, and the newest id handed on (the frame after the lost record)
-    assert status["shown_frame"] == frames[-1]["index"] == status["newest_frame"]
+    assert status["store_rows_no_base"] == report["rows_no_base"] > 0
+    # the frame shown last, by its id, and the newest id handed on (the delta refused after it)
+    assert status["shown_frame"] == frames[-1]["index"] == status["newest_frame"] - 1
     # the lost record's neighbours: the row the record before it began, the row the one after it ends
     assert status["rows_incomplete"] == 2
     assert status["trigger_overruns"] == 3 and status["registers_applied"] == 2

@@ -157,7 +157,7 @@ class Reader(wiring.Component):
                 # (answering zeros: one request at a time)
                 m.d.comb += self.requests.ready.eq(~zero | (owed == 0))
                 m.d.comb += [src.slot.eq(request.slot), src.row.eq(request.first_row)]
-                with m.If(self.requests.valid):
+                with m.If(self.requests.valid & self.requests.ready):      # (not while answering zeros)
                     fits = ((request.slot < self._slots) & (request.row_count != 0)
                             & (request.first_row + request.row_count <= dmd.rows))
                     with m.If(fits):

@@ -9,10 +9,10 @@ Slot life
 ---------
 ``FREE -> RECEIVING -> WRITING -> READY -> SHOWN -> FREE`` (streaming) or ``-> READY`` again
 (sequence); a whole frame that a delta frame held uses as its base goes to KEPT instead of FREE
-and stays there until no delta uses it. A slot is RECEIVING while rows arrive (a row bitmap says which), WRITING once every
-row has arrived until the writer reports the last row in memory, READY (complete) until the
-sequencer is given it, SHOWN until the sequencer releases it. Only RECEIVING slots are written,
-so a READY or SHOWN frame never changes (no tearing).
+and stays there until no delta uses it. A slot is RECEIVING while rows arrive (the row map says
+which), WRITING once every row has arrived until the writer reports the last row in memory,
+READY (complete) until the sequencer is given it, SHOWN until the sequencer releases it. Only
+RECEIVING slots are written, so a READY, SHOWN or KEPT frame never changes (no tearing).
 
 Streaming mode (``sequence_length`` = 0): one frame receives at a time. A row of a frame id
 newer (serial-number order) than the last one started begins a new frame; a receiving frame it

@@ -24,6 +24,9 @@ def run():
         "sys.xga_trigger_latency_cycles": (typical, "cycle"),
         "sys.xga_trigger_latency_cycles_worst": (worst, "cycle"),
         "sys.xga_gray_error_lsb_max": (max(f["max_error_lsb"] for f in r["frames"]), "LSB"),
+        # the default scene over GigE: the first frame whole, the others as deltas of it (rows changed)
+        "eth.scene_frames_per_s": (r["scene"]["delta_frames_per_s"], "frame/s"),
+        "eth.scene_whole_frames_per_s": (r["scene"]["whole_frames_per_s"], "frame/s"),
         **faulty(),
     }
 

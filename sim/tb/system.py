@@ -275,13 +275,20 @@ async def frames_over_gmii_are_shown_exactly(dut):
     system = await System.started(dut)
     p, dmd = system.p, system.dmd
     faults = p.get("faults", True)
-    count = p["frames"] + (5 if faults else 0)
+    count = p["frames"] + (9 if faults else 0)
     if p.get("scene"):
         images = default_scene(count, dmd.rows, dmd.columns)
     else:
         rng = np.random.default_rng(p["seed"])
         images = [rng.integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8) for _ in range(count)]
         images[0][0, :] = np.arange(dmd.columns) % 256      # every grey level appears
+    if faults:
+        # frames key + 1 .. key + 3: the key frame with a band of rows changed, sent as deltas
+        key = p["frames"] + 5
+        band_rng = np.random.default_rng(p["seed"] + 1)
+        for j, first in enumerate((3, dmd.rows // 3, dmd.rows // 2)):
+            images[key + 1 + j] = images[key].copy()
+            images[key + 1 + j][first:first + 8] = band_rng.integers(0, 256, (8, dmd.columns), dtype=np.uint8)
     wall0 = time.monotonic()
     report = {"frames": [], "period_cycles": system.plan.frame_cycles, "rate_hz": system.plan.rate_hz,
               "lsb_cycles": system.plan.params.lsb}
@@ -300,6 +307,13 @@ async def frames_over_gmii_are_shown_exactly(dut):
             bad_fcs = (2,)
             frames[3:3] = [system.datagram(r) for r in bad_records(system, images[index])]
         return frames, bad_fcs
+
+    def delta(index, base):
+        """Frame ``index`` as a delta of frame ``base``: the rows in which it differs from it."""
+        rows = codec.changed_rows(images[index], images[base])
+        payloads = codec.image_records(images[index], index, sequence=system.sequence, base=base, rows=rows)
+        system.sequence += len(payloads)
+        return [system.datagram(r) for r in payloads], ()
 
     async def show(index, plan, *, sending=None, burst=0, dark=False):
         """Trigger, and check that the camera sees frame ``index`` exactly under ``plan`` (or
@@ -386,6 +400,18 @@ async def frames_over_gmii_are_shown_exactly(dut):
         # (the triggers' pace is broken first: the frame is taken at once, not at the trigger after)
         await system.dmd_clock.cycles(later.frame_cycles)
         await show(n + 4, later)
+        # delta frames: a whole key frame, two frames sent as only the rows in which they differ
+        # from it (each shown exactly, the key kept for them), then a delta of frame n + 4, which
+        # the store no longer holds: refused row by row, the frame before it shows again
+        key = n + 5
+        await system.deliver(*encoded(key, interleave=False))
+        await show(key, later)
+        for index in (key + 1, key + 2):
+            await system.deliver(*delta(index, key))
+            await show(index, later)
+        await system.deliver(*delta(key + 3, n + 4))
+        await show(key + 2, later)
+        report["rows_no_base"] = len(codec.changed_rows(images[key + 3], images[n + 4]))
 
     # ---- the status reply: every counter as the test's ledger and the reference model say ----
     status = await system.status()
@@ -402,7 +428,9 @@ async def frames_over_gmii_are_shown_exactly(dut):
                  "mac_runt", "mac_oversize", "mac_preamble", "mac_rx_dropped", "mac_tx_underruns"):
         assert status[name] == 0, (name, status[name])
     assert status["store_frames_abandoned"] == (1 if faults else 0)
-    assert status["store_frames_complete"] == count - (1 if faults else 0)
+    # (with the faults: the frame with a lost record, and the delta without its base)
+    assert status["store_frames_complete"] == count - (2 if faults else 0)
+    assert status["store_rows_no_base"] == report.get("rows_no_base", 0)
     # the loss: the frame held, the one it was about to take (the same) ... every slot in use
     assert status["store_calibration_losses"] == (1 if faults else 0)
     assert status["store_frames_lost"] == (1 if faults else 0), status["store_frames_lost"]
