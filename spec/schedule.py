@@ -638,6 +638,11 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     load_g = (rows_g - 1) * row_period + R
     clear_g = max(len(b) for b in grp) * dmd.clear_row_cycles * R
     stagger = 0 if G == 1 else even(max(load_g, t_rst if strict_rst else R))
+    if depth == 1 and chain and G > 1:
+        # patterns back to back keep the bus busy: each group's rows at the row period, and its
+        # pulse's row cycle, before the next group's load can begin (a shorter stagger drifts:
+        # each pattern's loads end later until pulses come late)
+        stagger = even(max(stagger, rows_g * row_period + R))
     sep = t_rst if strict_rst else R
     settle_path = t_rst + t_settle + clear_g
     bus_path = stagger * G if G > 1 else 0
@@ -774,15 +779,26 @@ def ready_cycle(dmd, p, fr):
 def on_time(dmd, p, fr):
     """The frame ``fr`` played under ``p`` (three of them, chained) has no pulse late: every
     plane is shown at its length."""
-    r = simulate(dmd, p, [replace(fr, ready=0)] * (3 if p.chain else 1), [ready_cycle(dmd, p, fr)], max_frames=2)
+    n = _chained(dmd, p, fr)
+    r = simulate(dmd, p, [replace(fr, ready=0)] * n, [ready_cycle(dmd, p, fr)], max_frames=max(2, n - 1))
     return r.late == 0
+
+
+def _chained(dmd, p, fr):
+    """Frames a chained check plays: three, or for patterns enough that a load falling behind
+    by a row cycle a pattern would make a pulse late (every group's load drifting past its
+    slack)."""
+    if not p.chain:
+        return 1
+    return 3 if fr.depth > 1 else 4 + 2 * len(groups(dmd, p.reset_mode))
 
 
 def frame_period(dmd, p, fr):
     """Shortest trigger-to-trigger period (triggered) or frame period (chained)."""
     if p.chain:
-        r = simulate(dmd, p, [fr] * 4, [ready_cycle(dmd, p, fr)], max_frames=3)
-        return r.frame_starts[2] - r.frame_starts[1]
+        n = max(4, _chained(dmd, p, fr))
+        r = simulate(dmd, p, [fr] * n, [ready_cycle(dmd, p, fr)], max_frames=n - 1)
+        return r.frame_starts[-1] - r.frame_starts[-2]
     # trigger as soon as ready: a second strobe is obeyed once every group, its frame played,
     # is loaded again (the last thing each group does)
     first = ready_cycle(dmd, p, fr)

@@ -18,7 +18,8 @@ from spec.facts import TEST_DMD
 
 def test_layout_round_trip():
     layout = word_layout(TEST_DMD)
-    value = {"data": 0x8000_0000_0000_0001, "plane": 5, "word": 1, "block": 3, "frame": 9, "row": 95}
+    value = {"data": 0x8000_0000_0000_0001, "plane": 5, "word": 1, "block": 3, "frame": 9, "base": 7,
+             "carried": 12, "row": 95}
     assert unpack(layout, pack(layout, value)) == value
     nested = data.StructLayout({"a": data.ArrayLayout(8, 3), "b": 4})
     assert unpack(nested, pack(nested, {"a": [1, 2, 255], "b": 7})) == {"a": [1, 2, 255], "b": 7}

@@ -180,7 +180,7 @@ class Reader(wiring.Component):
                     m.next = "IDLE"
                 with m.Elif(joins):
                     with m.If(run_rows == 0):
-                        m.d.sync += [run_source.eq(src.source), run_first.eq(row)]
+                        m.d.sync += [run_source.eq(Mux(whole, slot, src.source)), run_first.eq(row)]
                     taken = Mux(whole, left, 1)        # a whole frame's request is one run
                     m.d.sync += [run_rows.eq(run_rows + taken), left.eq(left - taken), row.eq(row + taken)]
                     m.d.comb += src.row.eq(row + 1)

@@ -10,6 +10,13 @@ and, global, the camera model checks every level of a frame between two others; 
 measured between the frames' first pulses on the pins. Beside each measured rate,
 the schedule model's (``_model``). The DLP7000 in every reset mode at 200 and 400 MHz, and the
 plan finder's choice (:mod:`spec.plan_search`) at each; the DLP9500 global at 400 MHz.
+
+Binary patterns (:func:`binary`): 1-bit frames chained one after another on the full DLP7000 at
+DCLK 400 MHz, from the on-chip pseudo-random source and from the store at the row period the
+DDR2 leaves the plane reader in ``make sim``, global and phased: the period measured between
+block 0's pulses over the last of several patterns, the commands the schedule model's cycle for
+cycle, every rule checked; beside the memory rates, what that row period allows (a full load
+back to back: ``rows * row_period`` cycles a pattern).
 """
 
 import numpy as np
@@ -20,9 +27,9 @@ from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import frame_lights
 from spec import plan_search, schedule
 from spec.facts import DMDS
-from spec.registers import ResetMode
+from spec.registers import ResetMode, Source
 
-__all__ = ["measured_rate", "run", "cases", "best", "CASES"]
+__all__ = ["measured_rate", "run", "cases", "best", "binary", "binary_period", "CASES"]
 
 #: (DMD, reset mode, strict RST_ACTIVE reading, DCLK): the plans measured.
 CASES = [
@@ -69,6 +76,7 @@ def run():
     measured = {}
     figures = cases(measured)
     figures.update(best(measured))
+    figures.update(binary())
     return figures
 
 
@@ -101,6 +109,68 @@ def best(measured=None):
     return figures
 
 
+#: Binary patterns played back to back (the period is the median of the last ones).
+PATTERNS = 8
+
+
+def binary_period(plan, name, *, patterns=PATTERNS):
+    """Play 1-bit frames of ``plan`` (``chain``: each follows the one before without a trigger)
+    on the DLP7000's generated Verilog from one trigger; returns the measured cycles between
+    patterns (block 0's pulses)."""
+    dmd, p = DMDS["dlp7000"], plan.params
+    frames = [] if p.source == Source.PRNG else [(0, 1)]
+    model_frames = [schedule.Frame(0, 1)]
+    first = max(g.loaded_at for g in schedule.simulate(dmd, p, model_frames).groups)
+    pins = [first - PIN_TO_STROBE]
+    cycles = first + (patterns + 2) * plan.frame_cycles
+    run = run_rig(dmd, p, frames, pins=pins, cycles=cycles, name=name)
+    starts = [t for t, kind, blocks in run.commands if kind == "pulse" and 0 in blocks]
+    assert len(starts) >= patterns, f"{len(starts)} patterns played"
+    periods = [b - a for a, b in zip(starts[-patterns:], starts[-patterns + 1:], strict=False)]
+    model = schedule.simulate(dmd, p, model_frames, [t + PIN_TO_STROBE for t in pins], until=cycles)
+    horizon = run.status["now"] - 2 * dmd.dclk_per_row
+    assert [c for c in run.commands if c[0] < horizon] == [c for c in model.decoded() if c[0] < horizon], \
+        f"{name}: commands differ from the schedule model's"
+    return sorted(periods)[len(periods) // 2]
+
+
+def binary():
+    """Binary pattern rates on the DLP7000 at DCLK 400 MHz, measured: the on-chip source and the
+    store at the DDR2's row period, global and phased (quad: four blocks a pulse, TI's strict
+    RST_ACTIVE reading; single: one block a pulse, the loose reading, beside it)."""
+    from sim.fast_top import read_rate
+    from sim.models.mcb import McbTiming
+    from sim.xga import plan as xga_plan
+    dmd, dclk = DMDS["dlp7000"], 400e6
+    # the read bandwidth the memory leaves the plane reader under GigE ingest, as make sim plans
+    memory = {"words_per_cycle": read_rate(McbTiming(), schedule.FABRIC_HZ)}
+    prng = {"source": Source.PRNG}
+    plans = {
+        "prng_global": prng,
+        "prng_quad": {**prng, "reset_mode": ResetMode.QUAD},
+        "prng_single_loose": {**prng, "reset_mode": ResetMode.SINGLE, "strict_rst": False},
+        "memory_global": memory,
+        "memory_quad": {**memory, "reset_mode": ResetMode.QUAD},
+    }
+    row_period = xga_plan(dclk).params.row_period
+    allowed = schedule.FABRIC_HZ / (dmd.rows * row_period)
+    figures = {"seq.binary_row_period_cycles_memory": (row_period, "cycle"),
+               "seq.binary_rate_hz_memory_400mhz_allowed": (allowed, "Hz")}
+    for key, kwargs in plans.items():
+        plan = schedule.plan(dmd, dclk, depth=1, chain=True, **kwargs)
+        assert key.startswith("prng") or plan.params.row_period == row_period
+        rate = schedule.FABRIC_HZ / binary_period(plan, f"rates_binary_{key}_400")
+        figures[f"seq.binary_rate_hz_{key}_400mhz"] = (rate, "Hz")
+        figures[f"seq.binary_rate_hz_{key}_400mhz_model"] = (plan.rate_hz, "Hz")
+        if key.startswith("memory"):
+            figures[f"seq.binary_rate_{key}_fraction_of_allowed"] = (rate / allowed, "")
+    # the headline figures: phased under TI's rules
+    figures["seq.binary_rate_hz_prng_400mhz"] = figures["seq.binary_rate_hz_prng_quad_400mhz"]
+    figures["seq.binary_rate_hz_memory"] = figures["seq.binary_rate_hz_memory_quad_400mhz"]
+    return figures
+
+
 if __name__ == "__main__":
-    for figure, (value, unit) in run().items():
+    import sys
+    for figure, (value, unit) in (binary() if sys.argv[1:] == ["binary"] else run()).items():
         print(f"{figure:50s} {value:10.1f} {unit}")
