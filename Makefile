@@ -22,17 +22,19 @@ test: $(STAMP)
 	$(PY) -m pytest -n $(JOBS) -q
 
 # The main job: the system simulation on the default scene (DCLK 400 MHz; DCLK=200 for 200 MHz;
+# DMD=dlp9500: the DLP9500's core, four buses;
 # FAULTS=stalls|rst|all: the memory stalls at random, the DLPC410 holds RST_ACTIVE longer than
 # planned, or both; VIRTUAL=<seconds>|demo: the virtual projector on a TAP device in a network
 # namespace of its own, which host software in that namespace can talk to; needs root;
 # WINDOW=<k>: also dump every signal of the core (VCD) from 10 us before trigger k (1 to 3) to
 # just after its frame's first pulse, with a GTKWave save file grouped by block).
 DCLK ?= 400
+DMD ?=
 FAULTS ?=
 VIRTUAL ?=
 WINDOW ?=
 sim: $(STAMP)
-	$(PY) -m flow sim --dclk $(DCLK) $(if $(FAULTS),--faults $(FAULTS)) $(if $(VIRTUAL),--virtual $(VIRTUAL)) \
+	$(PY) -m flow sim --dclk $(DCLK) $(if $(DMD),--dmd $(DMD)) $(if $(FAULTS),--faults $(FAULTS)) $(if $(VIRTUAL),--virtual $(VIRTUAL)) \
 		$(if $(WINDOW),--window $(WINDOW))
 
 # The Spartan-6 ISE tree (Verilog, UCF, ISE scripts) and each block's Verilog, in build/spartan6.

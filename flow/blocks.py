@@ -84,6 +84,8 @@ BLOCKS = {
     "read_widener": _read_widener,
     "sequencer": _sequencer,
     "sequencer_dlp9500": lambda: _sequencer("dlp9500"),
+    # the whole core for the four-bus DMD (no board carries it yet: no platform top to count)
+    "core_dlp9500": lambda: core("dlp9500"),
     "register_crossing": _register_crossing,
 }
 

@@ -21,6 +21,8 @@ def main(argv=None):
     sim = sub.add_parser("sim", help="the system simulation on the default scene")
     sim.add_argument("--frames", type=int, default=None, help="number of frames to store and show")
     sim.add_argument("--dclk", type=float, default=400, choices=(200, 400), help="DCLK in MHz (default 400)")
+    sim.add_argument("--dmd", default="dlp7000", choices=("dlp7000", "dlp9500"),
+                     help="the DMD the core is built for (default dlp7000; dlp9500: four buses)")
     sim.add_argument("--faults", choices=("stalls", "rst", "all"), default=None,
                      help="memory stalls at random, RST_ACTIVE held longer than planned, or both (sim.xga.FAULTS)")
     sim.add_argument("--window", type=int, default=None, metavar="K",
@@ -59,7 +61,8 @@ def main(argv=None):
         return 0 if report.get("max_error_lsb") == 0 else 1
     if args.command == "sim":
         from sim.system import main as run
-        return run(frames=args.frames, dclk_hz=args.dclk * 1e6, faults=args.faults, window=args.window)
+        return run(frames=args.frames, dclk_hz=args.dclk * 1e6, faults=args.faults, window=args.window,
+                   dmd=args.dmd)
     if args.command == "waves":
         from sim.harness.waves import main as run
         return run()

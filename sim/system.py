@@ -83,14 +83,15 @@ def latency(shown):
     return latencies[len(latencies) // 2], latencies[-1]
 
 
-def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=None):
+def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=None, dmd="dlp7000"):
     """``make sim``: the full-XGA run of :mod:`sim.xga` on the default scene; prints the figures.
     ``faults`` (``make sim FAULTS=stalls|rst|all``): the same run with the chips misbehaving
     (:data:`sim.xga.FAULTS`). ``window`` (``make sim WINDOW=<k>``): every signal of the core is
     dumped from shortly before one-by-one trigger ``k`` to just after its frame's first clocking
-    pulse, with a save file of its own."""
+    pulse, with a save file of its own. ``dmd`` (``make sim DMD=dlp9500``): the projector's core for
+    another DMD (the DLP9500: four buses, 1920 of 2048 columns seen)."""
     frames = frames or XGA_FRAMES
-    dmd = xga.DMD
+    name, dmd = dmd, DMDS[dmd]
     print(f"make sim: the projector's core (generated Verilog, Verilator) on the default scene, "
           f"{dmd.columns}x{dmd.rows} 8-bit ({dmd.name}) at DCLK {dclk_hz / 1e6:g} MHz, {frames} frames "
           f"sent over GMII from a replay file (the first whole, the others as deltas of it) and stored as a "
@@ -106,9 +107,10 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=None):
         print(f"faults: RST_ACTIVE held {f['dlpc410_rst_extra']} cycles longer than the facts table's time; "
               f"a first short run measures it (status rst_active_cycles_max) and the run is planned with it")
     t0 = time.monotonic()
-    key = "-".join(["scene", *([faults] if faults else []), *([f"window{window}"] if window else [])])
+    key = "-".join(["scene", *([name] if name != "dlp7000" else []), *([faults] if faults else []),
+                    *([f"window{window}"] if window else [])])
     r = xga.run(key, frames=frames, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK, dclk_hz=dclk_hz,
-                faults=faults, window=window)
+                faults=faults, window=window, dmd=dmd)
     shown, status = r["frames"], r["status"]
     ns = 1e9 / xga.DMD_HZ
     typical, worst = latency(shown)
@@ -145,7 +147,7 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=None):
     if scene["deltas"]:
         print(f"scene over GigE, measured on the GMII pins at line rate (every frame complete in the store, none "
               f"dropped): the first frame whole, {scene['whole_frames_per_s']:.1f} frames/s; the next "
-              f"{scene['deltas']} as deltas of it (rows carried {scene['delta_rows']} of {xga.DMD.rows}), "
+              f"{scene['deltas']} as deltas of it (rows carried {scene['delta_rows']} of {dmd.rows}), "
               f"{scene['delta_frames_per_s']:.0f} frames/s")
     if faults:
         print(f"memory commands stalled: {r['mcb_stalls']}")

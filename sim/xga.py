@@ -78,26 +78,26 @@ WAVE_VIEW = 3000
 WINDOW_LEAD_US, WINDOW_AFTER_US = 10, 5
 
 
-def plan(dclk_hz=DCLK_HZ, t_rst_cycles=None):
+def plan(dclk_hz=DCLK_HZ, t_rst_cycles=None, dmd=DMD):
     """The schedule for the run: global reset, MSB first, rows paced to the read bandwidth the
     memory leaves the plane reader, early triggers held; ``t_rst_cycles``: the controller's
     RST_ACTIVE as the projector measured it (default: the facts table's)."""
-    return schedule.plan(DMD, dclk_hz, depth=8, words_per_cycle=read_rate(McbTiming(), DMD_HZ),
+    return schedule.plan(dmd, dclk_hz, depth=8, words_per_cycle=read_rate(McbTiming(), DMD_HZ),
                          trigger_hold=True, t_rst_cycles=t_rst_cycles)
 
 
-def calibrate(key, dclk_hz=DCLK_HZ, faults=None, log=print):
+def calibrate(key, dclk_hz=DCLK_HZ, faults=None, log=print, dmd=DMD):
     """The controller's RST_ACTIVE as the projector measures it, as a user calibrates before a
     run (``python -m host configure --t-rst measured``): a short run on the facts table's plan
     (one frame, triggered twice), then the status reply's ``rst_active_cycles_max``. That run's
     images are not judged: its plan was not made for this controller."""
     r = run(f"{key}-calibrate", frames=1, one_by_one=1, back_to_back=1, dclk_hz=dclk_hz, faults=faults,
-            log=log, calibrated=False)
+            log=log, calibrated=False, dmd=dmd)
     return r["status"]["rst_active_cycles_max"]
 
 
-def top(the_plan, window=False):
-    return FastSystem(DMD, the_plan.params.registers(DMD), mac=MAC, ip=IP_ADDR, port=PORT,
+def top(the_plan, window=False, dmd=DMD):
+    return FastSystem(dmd, the_plan.params.registers(dmd), mac=MAC, ip=IP_ADDR, port=PORT,
                       clocks={"sync": SYNC_HZ, "dmd": DMD_HZ}, init_cycles=INIT_CYCLES,
                       init_grace_cycles=INIT_GRACE, beats=the_plan.params.beats, window=window)
 
@@ -147,7 +147,7 @@ def _status(tx_trace):
 
 
 def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, faults=None, log=print,
-        calibrated=True, window=None):
+        calibrated=True, window=None, dmd=DMD):
     """Build and run the XGA system simulation on ``frames`` frames of the default scene, stored
     as a sequence; ``one_by_one`` frames triggered each when the sequencer is ready, then
     ``back_to_back`` frames triggered faster than they can be shown. Returns the report (dict).
@@ -157,17 +157,18 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
     misbehave; when the controller's RST_ACTIVE is not the facts table's, the run is planned
     with the time the projector measured in a first short run (:func:`calibrate`), unless
     ``calibrated`` is false. ``window``: dumps every signal around one-by-one trigger ``window``
-    (1 to ``one_by_one``); the report's ``window`` says where, its span and its markers."""
+    (1 to ``one_by_one``); the report's ``window`` says where, its span and its markers. ``dmd``:
+    the DLP7000 (default) or another DMD of :data:`spec.facts.DMDS` (the DLP9500: four buses)."""
     if window is not None and not 1 <= window <= one_by_one:
         raise ValueError(f"window: a trigger from 1 to {one_by_one}, not {window}")
     t_rst_cycles = None
     if calibrated and "dlpc410_rst_extra" in FAULTS.get(faults, {}):
-        t_rst_cycles = calibrate(key, dclk_hz, faults, log)
+        t_rst_cycles = calibrate(key, dclk_hz, faults, log, dmd)
         log(f"RST_ACTIVE measured by the projector: {t_rst_cycles} cycles from the pulse; planned with it")
-    the_plan = plan(dclk_hz, t_rst_cycles)
+    the_plan = plan(dclk_hz, t_rst_cycles, dmd)
     directory = build_dir("system", key)
     t0 = time.monotonic()
-    images = default_scene(frames, DMD.rows, DMD.columns)
+    images = default_scene(frames, dmd.rows, dmd.columns)
     replays, query, datagrams = _replay_files(directory, images)
     log(f"scene encoded: {frames} frames, {datagrams} datagrams ({time.monotonic() - t0:.1f} s)")
     files = {name: directory / f"{name}.txt" for name in ("pins", "tx")}
@@ -176,7 +177,7 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
          "period_cycles": the_plan.frame_cycles, "one_by_one": one_by_one, "back_to_back": back_to_back,
          "fast_period_cycles": round(FASTER * the_plan.frame_cycles),
          # at or just after the first frame's last pulse: its first pulse comes within 8 cycles
-         "last_pulse_cycles": _model_span(the_plan) + 8,
+         "last_pulse_cycles": _model_span(dmd, the_plan) + 8,
          # a frame's first plane is loaded about 155 us after its last byte (the stack forwards the
          # last datagram once its FCS is checked, then the plane is read from DDR2)
          "settle_us": 250,
@@ -190,8 +191,8 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
         plusargs.append(f"+{PLUSARGS['window']}={directory / 'window.vcd'}")
     t_build = time.monotonic()
     # the window's build traces: a key of its own, so that the other runs stay untraced
-    build = cocotb_run.run(top(the_plan, bool(window)), toplevel=TOPLEVEL, module="sim.tb.system_fast",
-                           key=f"dlp7000-{the_plan.params.beats}beats" + ("-window" if window else ""),
+    build = cocotb_run.run(top(the_plan, bool(window), dmd), toplevel=TOPLEVEL, module="sim.tb.system_fast",
+                           key=f"{_name(dmd)}-{the_plan.params.beats}beats" + ("-window" if window else ""),
                            params=p, extra_sources=SOURCES + (WINDOW_SOURCES if window else []), plusargs=plusargs,
                            waves=False, traced=bool(window), top_signals_only=True)
     stimulus = json.loads(report_path.read_text())
@@ -199,7 +200,7 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
     log(f"simulation done: build and run {time.monotonic() - t_build:.0f} s, of which the run {sim_wall:.0f} s; "
         f"checking the pins")
     report = analyse(the_plan, images, stimulus, files, one_by_one=one_by_one, back_to_back=back_to_back,
-                     build=build, faults=faults)
+                     build=build, faults=faults, dmd=dmd)
     report["t_rst_cycles"], report["t_rst_measured"] = the_plan.params.t_rst, t_rst_cycles is not None
     if window:
         report["window"] = _window(directory / "window.vcd", stimulus, report, window)
@@ -234,25 +235,25 @@ def _frames_shown(pins, layout, pulses):
     return frames
 
 
-def _model_back_to_back(the_plan, images, first, strobes):
+def _model_back_to_back(dmd, the_plan, images, first, strobes):
     """The schedule model's frame starts for the stored frames ``first, first + 1, ..`` of the
     sequence triggered at ``strobes`` (relative cycles, the first when every group is ready)."""
     p = the_plan.params
-    occupancy = [tuple(int(x) for x in bitplane.occupancy(image, DMD.rows_per_block)) for image in images]
+    occupancy = [tuple(int(x) for x in bitplane.occupancy(image, dmd.rows_per_block)) for image in images]
     frames = [schedule.Frame(k % len(images), 8, occupancy[k % len(images)], sequence=True)
               for k in range(first, first + len(strobes))]
-    ready = schedule.ready_cycle(DMD, p, frames[0])
-    r = schedule.simulate(DMD, p, frames, [ready + s for s in strobes])
+    ready = schedule.ready_cycle(dmd, p, frames[0])
+    r = schedule.simulate(dmd, p, frames, [ready + s for s in strobes])
     assert r.late == 0 and r.overruns == 0, (r.late, r.overruns)
     return [t - r.frame_starts[0] for t in r.frame_starts]
 
 
-def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, build=None, faults=None):
+def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, build=None, faults=None, dmd=DMD):
     t0 = time.monotonic()
     p = the_plan.params
-    layout = pin_layout(DMD.buses, p.beats)
+    layout = pin_layout(dmd.buses, p.beats)
     pins = trace.read(files["pins"])
-    model = Dlpc410(DMD, beats=p.beats, clock_hz=DMD_HZ, init_cycles=INIT_CYCLES, init_grace_cycles=INIT_GRACE)
+    model = Dlpc410(dmd, beats=p.beats, clock_hz=DMD_HZ, init_cycles=INIT_CYCLES, init_grace_cycles=INIT_GRACE)
     if faults:
         model.rst_active_cycles += FAULTS[faults].get("dlpc410_rst_extra", 0)
     trace.replay_dlpc410(model, pins, layout)
@@ -266,7 +267,8 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
     for index, (first, last) in enumerate(frames):
         image = images[index % len(images)]
         light = to_lsb(camera.image(first, first + period), lsb)
-        error = np.abs(light - image.astype(np.float64))
+        # (the camera sees the visible columns: the DLP9500's 1920 of the 2048 sent)
+        error = np.abs(light - image[:, :light.shape[1]].astype(np.float64))
         trigger = triggers[index]
         shown.append({"trigger_cycle": trigger, "start_cycle": first, "latency_cycles": first - trigger,
                       "held": index >= one_by_one + 1, "span_cycles": last - first,
@@ -275,7 +277,7 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
     # triggers (the first one found every group ready, the others were held)
     fast = shown[one_by_one:]
     starts = [f["start_cycle"] - fast[0]["start_cycle"] for f in fast]
-    want = _model_back_to_back(the_plan, images, one_by_one,
+    want = _model_back_to_back(dmd, the_plan, images, one_by_one,
                                [f["trigger_cycle"] - fast[0]["trigger_cycle"] for f in fast])
     # memory stalls delay rows and pulses; a controller's own RST_ACTIVE time is in the plan
     compared = "mcb_stall_permille" not in FAULTS.get(faults, {})
@@ -298,7 +300,7 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
         "period_cycles": period,
         "periods_measured": periods,
         "rate_hz": the_plan.rate_hz,
-        "model_span_cycles": _model_span(the_plan),
+        "model_span_cycles": _model_span(dmd, the_plan),
         "lsb_cycles": lsb,
         "row_period": the_plan.params.row_period,
         "pulse_to_mirror_cycles": round(TIMING["t_pulse_to_mirror"].value * DMD_HZ),
@@ -342,11 +344,16 @@ def _scene_rate(images, sends, status):
             "delta_rows": [int(len(codec.changed_rows(image, images[0]))) for image in images[1:]]}
 
 
-def _model_span(the_plan):
+def _name(dmd):
+    """The key of ``dmd`` in :data:`spec.facts.DMDS`."""
+    return next(name for name, known in DMDS.items() if known is dmd)
+
+
+def _model_span(dmd, the_plan):
     """First to last clocking pulse of one frame in the schedule model."""
     p = the_plan.params
     fr = schedule.Frame(0, 8)
-    r = schedule.simulate(DMD, p, [fr], [schedule.ready_cycle(DMD, p, fr)], max_frames=1)
+    r = schedule.simulate(dmd, p, [fr], [schedule.ready_cycle(dmd, p, fr)], max_frames=1)
     cycles = [c for c, *_ in r.pulses]
     return cycles[-1] - cycles[0]
 

@@ -28,6 +28,26 @@ def run():
         "eth.scene_frames_per_s": (r["scene"]["delta_frames_per_s"], "frame/s"),
         "eth.scene_whole_frames_per_s": (r["scene"]["whole_frames_per_s"], "frame/s"),
         **faulty(),
+        **dlp9500(),
+    }
+
+
+def dlp9500():
+    """The same run of the DLP9500's core (``make sim DMD=dlp9500``: four buses, 2048 columns
+    sent, 1920 seen): the frame period measured on the pins, latency, grey error."""
+    from spec.facts import DMDS
+    r = xga.run("bench-dlp9500", frames=XGA_FRAMES, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK,
+                log=lambda _text: None, dmd=DMDS["dlp9500"])
+    periods = sorted(r["periods_measured"])
+    typical, worst = latency(r["frames"])
+    return {
+        "sys.dlp9500_rate_hz_measured": (xga.DMD_HZ / periods[len(periods) // 2], "Hz"),
+        "sys.dlp9500_rate_hz_model": (r["rate_hz"], "Hz"),
+        "sys.dlp9500_gray_error_lsb_max": (max(f["max_error_lsb"] for f in r["frames"]), "LSB"),
+        "sys.dlp9500_trigger_latency_cycles": (typical, "cycle"),
+        "sys.dlp9500_trigger_latency_cycles_worst": (worst, "cycle"),
+        "eth.dlp9500_scene_frames_per_s": (r["scene"]["delta_frames_per_s"], "frame/s"),
+        "eth.dlp9500_scene_whole_frames_per_s": (r["scene"]["whole_frames_per_s"], "frame/s"),
     }
 
 
