@@ -90,6 +90,10 @@ BLOCKS = {
 }
 
 
+#: Blocks synthesised flattened: the WebAssembly ABC fails on a whole core's hierarchy.
+FLATTENED = {"core_dlp9500"}
+
+
 def core(dmd="dlp7000", dclk_hz=400e6):
     """The projector's core as the board builds it (:func:`gateware.top.platform.core`)."""
     from gateware.top.platform import core as board_core

@@ -12,6 +12,8 @@ import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+from flow.blocks import FLATTENED
+
 __all__ = ["XC6SLX45", "synthesise", "report", "main"]
 
 #: XC6SLX45 capacity (Spartan-6 family overview, DS160).
@@ -64,7 +66,8 @@ def report(outdir="build/spartan6"):
     outdir.mkdir(parents=True, exist_ok=True)
     blocks = emit_blocks(outdir)
     with ThreadPoolExecutor(max_workers=2) as pool:
-        futures = {name: pool.submit(synthesise, path, name) for name, path in blocks.items()}
+        futures = {name: pool.submit(synthesise, path, name, flatten=name in FLATTENED)
+                    for name, path in blocks.items()}
         results = {name: count(f.result()) for name, f in futures.items()}
     top = emit_platform(outdir)
     # the memory controller is the vendor's (generated, not ours to count): a black box here
