@@ -35,7 +35,7 @@ from amaranth.lib.wiring import In, Out
 from . import mcb
 from .addresses import WORD_BYTES, AddressMap
 from .layouts import SLOT_BITS, PlaneRequest
-from .slot_maps import RowSourceSignature
+from .slot_maps import RowLookupSignature
 
 __all__ = ["Reader"]
 
@@ -69,7 +69,7 @@ class Reader(wiring.Component):
         Requests dropped because they do not fit the frame.
     store_lost : In(1)
         The store has lost its contents and not recovered yet (answer with zeros).
-    sources : Out(RowSourceSignature(dmd))
+    sources : Out(RowLookupSignature(dmd))
         The row map: which slot each row of a slot shows, and whether the slot holds a delta.
     """
 
@@ -87,7 +87,7 @@ class Reader(wiring.Component):
             "mcb": Out(mcb.PortSignature(width)),
             "bad_requests": Out(16),
             "store_lost": In(1),
-            "sources": Out(RowSourceSignature(dmd)),
+            "sources": Out(RowLookupSignature(dmd)),
         })
 
     def elaborate(self, platform):

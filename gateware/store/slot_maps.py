@@ -21,7 +21,7 @@ from amaranth.utils import ceil_log2
 from .addresses import PLANES
 from .layouts import BLOCK_BITS, SLOT_BITS, OccupancySignature
 
-__all__ = ["SlotMaps", "RowLookupSignature", "RowSourceSignature", "map_write_layout", "row_entry_layout"]
+__all__ = ["SlotMaps", "RowLookupSignature", "map_write_layout", "row_entry_layout"]
 
 #: One entry of the row map.
 row_entry_layout = data.StructLayout({"stored": 1, "source": SLOT_BITS})
@@ -73,10 +73,6 @@ class RowLookupSignature(wiring.Signature):
         return isinstance(other, RowLookupSignature) and other._row_bits == self._row_bits
 
 
-#: The plane reader's port: the same lookup.
-RowSourceSignature = RowLookupSignature
-
-
 class SlotMaps(wiring.Component):
     """Row map and occupancy map of the frame slots.
 
@@ -94,7 +90,7 @@ class SlotMaps(wiring.Component):
         Row map read port (``sync``).
     base_occupancy : In(OccupancySignature())
         Occupancy read port (``sync``): a delta's map starts as its base's.
-    sources : In(RowSourceSignature(dmd))
+    sources : In(RowLookupSignature(dmd))
         Row map read port (``dmd``) for the plane reader.
     occupancy : In(OccupancySignature())
         Occupancy map read port (``dmd``).
@@ -106,7 +102,7 @@ class SlotMaps(wiring.Component):
             "writes": In(stream.Signature(map_write_layout(dmd), always_ready=True)),
             "bitmap": In(RowLookupSignature(dmd)),
             "base_occupancy": In(OccupancySignature()),
-            "sources": In(RowSourceSignature(dmd)),
+            "sources": In(RowLookupSignature(dmd)),
             "occupancy": In(OccupancySignature()),
         })
 

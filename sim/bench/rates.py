@@ -47,7 +47,7 @@ def measured_rate(dmd_name, mode, strict, dclk, *, frames=FRAMES, name=None, pla
     dmd = DMDS[dmd_name]
     plan = plan or schedule.plan(dmd, dclk, reset_mode=ResetMode[mode], strict_rst=strict, trigger_hold=True)
     p = plan.params
-    first = max(g.loaded_at for g in schedule.simulate(dmd, p, [schedule.Frame(0, 8)]).groups)
+    first = _ready(dmd, p, [schedule.Frame(0, 8)])
     pins = [first - PIN_TO_STROBE + k * plan.frame_cycles // 2 for k in range(2 * frames - 1)]
     cycles = first + (frames + 1) * plan.frame_cycles
     run = run_rig(dmd, p, [(0, 8)], pins=pins, cycles=cycles,
@@ -56,13 +56,8 @@ def measured_rate(dmd_name, mode, strict, dclk, *, frames=FRAMES, name=None, pla
     # it (sync out may stay high across back-to-back phased frames)
     frame_starts = [t - 1 - p.camera_offset for t, level in run.camera_out if level]
     assert len(frame_starts) >= frames, f"{len(frame_starts)} frames played"
-    periods = [b - a for a, b in zip(frame_starts, frame_starts[1:], strict=False)]
-    period = sorted(periods)[len(periods) // 2]
-    # the commands on the pins are the schedule model's, cycle for cycle
-    model = schedule.simulate(dmd, p, [schedule.Frame(0, 8)], [t + PIN_TO_STROBE for t in pins], until=cycles)
-    horizon = run.status["now"] - 2 * dmd.dclk_per_row
-    assert [c for c in run.commands if c[0] < horizon] == [c for c in model.decoded() if c[0] < horizon], \
-        f"{dmd_name} {mode}: commands differ from the schedule model's"
+    period = _median_period(frame_starts)
+    _same_as_model(dmd, p, [schedule.Frame(0, 8)], pins, cycles, run, f"{dmd_name} {mode}")
     # and, global, the frame between two others is exact in every level (phased groups overlap
     # the frames before and after: their levels are checked by the tests, triggered one by one)
     if mode == "GLOBAL":
@@ -70,6 +65,24 @@ def measured_rate(dmd_name, mode, strict, dclk, *, frames=FRAMES, name=None, pla
         expect = ramp_image(dmd, 0).astype(np.int64) * p.lsb
         assert np.array_equal(light, expect), f"{dmd_name} {mode}: a frame not exact"
     return period, plan
+
+
+def _ready(dmd, p, frames):
+    """The cycle from which every group is loaded with the first of ``frames`` (schedule model)."""
+    return max(g.loaded_at for g in schedule.simulate(dmd, p, frames).groups)
+
+
+def _median_period(starts):
+    periods = [b - a for a, b in zip(starts, starts[1:], strict=False)]
+    return sorted(periods)[len(periods) // 2]
+
+
+def _same_as_model(dmd, p, frames, pins, cycles, run, what):
+    """The commands on the pins are the schedule model's for the same triggers, cycle for cycle."""
+    model = schedule.simulate(dmd, p, frames, [t + PIN_TO_STROBE for t in pins], until=cycles)
+    horizon = run.status["now"] - 2 * dmd.dclk_per_row
+    assert [c for c in run.commands if c[0] < horizon] == [c for c in model.decoded() if c[0] < horizon], \
+        f"{what}: commands differ from the schedule model's"
 
 
 def run():
@@ -120,18 +133,13 @@ def binary_period(plan, name, *, patterns=PATTERNS):
     dmd, p = DMDS["dlp7000"], plan.params
     frames = [] if p.source == Source.PRNG else [(0, 1)]
     model_frames = [schedule.Frame(0, 1)]
-    first = max(g.loaded_at for g in schedule.simulate(dmd, p, model_frames).groups)
-    pins = [first - PIN_TO_STROBE]
-    cycles = first + (patterns + 2) * plan.frame_cycles
+    pins = [_ready(dmd, p, model_frames) - PIN_TO_STROBE]
+    cycles = pins[0] + PIN_TO_STROBE + (patterns + 2) * plan.frame_cycles
     run = run_rig(dmd, p, frames, pins=pins, cycles=cycles, name=name)
     starts = [t for t, kind, blocks in run.commands if kind == "pulse" and 0 in blocks]
     assert len(starts) >= patterns, f"{len(starts)} patterns played"
-    periods = [b - a for a, b in zip(starts[-patterns:], starts[-patterns + 1:], strict=False)]
-    model = schedule.simulate(dmd, p, model_frames, [t + PIN_TO_STROBE for t in pins], until=cycles)
-    horizon = run.status["now"] - 2 * dmd.dclk_per_row
-    assert [c for c in run.commands if c[0] < horizon] == [c for c in model.decoded() if c[0] < horizon], \
-        f"{name}: commands differ from the schedule model's"
-    return sorted(periods)[len(periods) // 2]
+    _same_as_model(dmd, p, model_frames, pins, cycles, run, name)
+    return _median_period(starts[-patterns:])
 
 
 def binary():

@@ -11,8 +11,7 @@ def run():
                 log=lambda _text: None)
     assert all(f["max_error_lsb"] == 0 for f in r["frames"]), "the XGA run showed a wrong image"
     typical, worst = latency(r["frames"])
-    periods = sorted(r["periods_measured"])
-    period = periods[len(periods) // 2]
+    period = _median_period(r)
     return {
         "sys.xga_dclk_hz": (r["dclk_hz"], "Hz"),
         "sys.xga_frame_period_cycles_measured": (period, "cycle"),
@@ -38,10 +37,9 @@ def dlp9500():
     from spec.facts import DMDS
     r = xga.run("bench-dlp9500", frames=XGA_FRAMES, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK,
                 log=lambda _text: None, dmd=DMDS["dlp9500"])
-    periods = sorted(r["periods_measured"])
     typical, worst = latency(r["frames"])
     return {
-        "sys.dlp9500_rate_hz_measured": (xga.DMD_HZ / periods[len(periods) // 2], "Hz"),
+        "sys.dlp9500_rate_hz_measured": (xga.DMD_HZ / _median_period(r), "Hz"),
         "sys.dlp9500_rate_hz_model": (r["rate_hz"], "Hz"),
         "sys.dlp9500_gray_error_lsb_max": (max(f["max_error_lsb"] for f in r["frames"]), "LSB"),
         "sys.dlp9500_trigger_latency_cycles": (typical, "cycle"),
@@ -59,11 +57,10 @@ def faulty():
     for kind in ("stalls", "all"):
         r = xga.run(f"bench-{kind}", frames=XGA_FRAMES, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK,
                     faults=kind, log=lambda _text: None)
-        periods = sorted(r["periods_measured"])
         status = r["status"]
         figures.update({
             f"sys.xga_faults_{kind}_gray_error_lsb_max": (max(f["max_error_lsb"] for f in r["frames"]), "LSB"),
-            f"sys.xga_faults_{kind}_rate_hz_measured": (xga.DMD_HZ / periods[len(periods) // 2], "Hz"),
+            f"sys.xga_faults_{kind}_rate_hz_measured": (xga.DMD_HZ / _median_period(r), "Hz"),
             f"sys.xga_faults_{kind}_memory_stalls": (r["mcb_stalls"], "command"),
             f"sys.xga_faults_{kind}_row_underruns": (status["row_underruns"], "row"),
             f"sys.xga_faults_{kind}_pulses_late": (status["pulses_late"], "pulse"),
@@ -71,3 +68,9 @@ def faulty():
             f"sys.xga_faults_{kind}_t_rst_measured_cycles": (status["rst_active_cycles_max"], "cycle"),
         })
     return figures
+
+
+def _median_period(r):
+    """The median of the back-to-back frame periods a run measured on the pins."""
+    periods = sorted(r["periods_measured"])
+    return periods[len(periods) // 2]
