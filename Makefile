@@ -26,8 +26,8 @@ test: $(STAMP)
 # FAULTS=stalls|rst|all: the memory stalls at random, the DLPC410 holds RST_ACTIVE longer than
 # planned, or both; VIRTUAL=<seconds>|demo: the virtual projector on a TAP device in a network
 # namespace of its own, which host software in that namespace can talk to; needs root;
-# WINDOW=<k>: also dump every signal of the core (VCD) from 10 us before trigger k (1 to 3) to
-# just after its frame's first pulse, with a GTKWave save file grouped by block).
+# WINDOW=1: also dump every signal of the core (VCD) from the first frame's last datagram through
+# the store to just after its first pulse, with a GTKWave save file grouped by block).
 DCLK ?= 400
 DMD ?=
 FAULTS ?=
@@ -35,7 +35,7 @@ VIRTUAL ?=
 WINDOW ?=
 sim: $(STAMP)
 	$(PY) -m flow sim --dclk $(DCLK) $(if $(DMD),--dmd $(DMD)) $(if $(FAULTS),--faults $(FAULTS)) $(if $(VIRTUAL),--virtual $(VIRTUAL)) \
-		$(if $(WINDOW),--window $(WINDOW))
+		$(if $(WINDOW),--window)
 
 # The Spartan-6 ISE tree (Verilog, UCF, ISE scripts) and each block's Verilog, in build/spartan6.
 verilog: $(STAMP)

@@ -25,9 +25,10 @@ def main(argv=None):
                      help="the DMD the core is built for (default dlp7000; dlp9500: four buses)")
     sim.add_argument("--faults", choices=("stalls", "rst", "all"), default=None,
                      help="memory stalls at random, RST_ACTIVE held longer than planned, or both (sim.xga.FAULTS)")
-    sim.add_argument("--window", type=int, default=None, metavar="K",
-                     help="also dump every signal of the core from 10 us before one-by-one trigger K (1 to 3) "
-                          "to just after its frame's first pulse, with a GTKWave save file grouped by block")
+    sim.add_argument("--window", action="store_true",
+                     help="also dump every signal of the core from the first frame's last datagram (every frame "
+                          "sent whole, that one held back) through the store to just after its first pulse, with "
+                          "a GTKWave save file grouped by block")
     sim.add_argument("--virtual", default=None, metavar="SECONDS|demo",
                      help="the virtual projector: the small core on a TAP in a network namespace of its own, for "
                           "that many seconds, or 'demo' (the host CLI talks to it); needs root (sim.virtual)")

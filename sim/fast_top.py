@@ -199,10 +199,11 @@ class FastSystem(wiring.Component):
         The memory ports' rule-break codes (``mcb_model.v``), 4 bits per port; 0 = none.
     mcb_stalls : Out(32)
         Commands the memory model stalled at random (plusargs; none by default).
-    wave_dump : In(1); sync_out : Out(1)
+    wave_dump : In(1); sync_out : Out(1); loading : Out(1)
         With ``window``: every signal is dumped while ``wave_dump`` is high (once, to the file
         of plusarg ``PLUSARGS["window"]``); the core's sync out, for the testbench to close the
-        window after a frame's first pulse.
+        window after a frame's first pulse; DVALID (a row on the bus), for it to trigger once
+        the first frame is being loaded (a trigger before the sequencer runs is ignored).
     """
 
     def __init__(self, dmd, registers, *, mac, ip, port, clocks, init_cycles=200, init_grace_cycles=4,
@@ -224,7 +225,7 @@ class FastSystem(wiring.Component):
             "flush": In(1),
             "mcb_fault": Out(8),
             "mcb_stalls": Out(32),
-            **({"wave_dump": In(1), "sync_out": Out(1)} if window else {}),
+            **({"wave_dump": In(1), "sync_out": Out(1), "loading": Out(1)} if window else {}),
         })
 
     def _memory(self, m, core):
@@ -299,5 +300,5 @@ class FastSystem(wiring.Component):
             i_flush=self.flush)
         if self._window:
             m.submodules.wave_window = Instance("wave_window", i_dump=self.wave_dump)
-            m.d.comb += self.sync_out.eq(core.sync_out)
+            m.d.comb += [self.sync_out.eq(core.sync_out), self.loading.eq(core.dlpc.dvalid.any())]
         return m

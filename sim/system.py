@@ -83,18 +83,21 @@ def latency(shown):
     return latencies[len(latencies) // 2], latencies[-1]
 
 
-def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=None, dmd="dlp7000"):
+def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=False, dmd="dlp7000"):
     """``make sim``: the full-XGA run of :mod:`sim.xga` on the default scene; prints the figures.
     ``faults`` (``make sim FAULTS=stalls|rst|all``): the same run with the chips misbehaving
-    (:data:`sim.xga.FAULTS`). ``window`` (``make sim WINDOW=<k>``): every signal of the core is
-    dumped from shortly before one-by-one trigger ``k`` to just after its frame's first clocking
-    pulse, with a save file of its own. ``dmd`` (``make sim DMD=dlp9500``): the projector's core for
-    another DMD (the DLP9500: four buses, 1920 of 2048 columns seen)."""
+    (:data:`sim.xga.FAULTS`). ``window`` (``make sim WINDOW=1``): every signal of the core is
+    dumped from the first frame's last datagram (every frame sent whole, that one held back) to
+    just after its first clocking pulse, with a save file of its own. ``dmd`` (``make sim
+    DMD=dlp9500``): the projector's core for another DMD (the DLP9500: four buses, 1920 of 2048
+    columns seen)."""
     frames = frames or XGA_FRAMES
     name, dmd = dmd, DMDS[dmd]
     print(f"make sim: the projector's core (generated Verilog, Verilator) on the default scene, "
           f"{dmd.columns}x{dmd.rows} 8-bit ({dmd.name}) at DCLK {dclk_hz / 1e6:g} MHz, {frames} frames "
-          f"sent over GMII from a replay file (the first whole, the others as deltas of it) and stored as a "
+          f"sent over GMII from a replay file ("
+          + ("every one whole, the first last, its last datagram held back for the wave window"
+             if window else "the first whole, the others as deltas of it") + ") and stored as a "
           f"sequence, {XGA_ONE_BY_ONE} triggered one by "
           f"one, then {XGA_BACK_TO_BACK} back to back; Verilog MCB model on both memory ports; DLPC410 pins "
           f"recorded and checked afterwards by the rule-checking DLPC410 model and the camera model; TI "
@@ -108,7 +111,7 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=None, dmd="dlp700
               f"a first short run measures it (status rst_active_cycles_max) and the run is planned with it")
     t0 = time.monotonic()
     key = "-".join(["scene", *([name] if name != "dlp7000" else []), *([faults] if faults else []),
-                    *([f"window{window}"] if window else [])])
+                    *(["window"] if window else [])])
     r = xga.run(key, frames=frames, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK, dclk_hz=dclk_hz,
                 faults=faults, window=window, dmd=dmd)
     shown, status = r["frames"], r["status"]
@@ -154,9 +157,9 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=None, dmd="dlp700
     print(f"grey error of the reconstructed images: max {max(f['max_error_lsb'] for f in shown):g} LSB "
           f"({sum(f['wrong_pixels'] for f in shown)} pixels wrong)")
     print(f"simulation speed: {r['dmd_cycles'] / r['sim_wall_s']:.0f} dmd cycles per wall second "
-          f"({r['dmd_cycles']:.0f} cycles = {r['dmd_cycles'] * ns / 1e6:.1f} ms in {r['sim_wall_s']:.0f} s); "
-          f"the first frame from its first packet to the last clocking pulse of the first frame shown: "
-          f"{r['xga_frame_sim_wall_s']:.1f} s wall")
+          f"({r['dmd_cycles']:.0f} cycles = {r['dmd_cycles'] * ns / 1e6:.1f} ms in {r['sim_wall_s']:.0f} s)"
+          + (f"; the first frame from its first packet to the last clocking pulse of the first frame shown: "
+             f"{r['xga_frame_sim_wall_s']:.1f} s wall" if r["xga_frame_sim_wall_s"] is not None else ""))
     print(f"pin check and camera: {r['check_wall_s']:.0f} s over {r['trace_records']} trace records; "
           f"wall time {time.monotonic() - t0:.0f} s including the Verilator build")
     vcd = Path(r["waves"])
@@ -166,7 +169,7 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=None, dmd="dlp700
           f"written from the pin trace; the full design is not dumped at XGA)\n"
           f"  GTKWave save file: {save} (opens on the trigger; markers A trigger, B first pulse, C last pulse)")
     if window:
-        print_window(r["window"], window)
+        print_window(r["window"])
     exact = all(f["max_error_lsb"] == 0 for f in shown) and len(shown) == XGA_ONE_BY_ONE + XGA_BACK_TO_BACK
     return 0 if exact else 1
 
@@ -187,7 +190,7 @@ SAVE_GROUPS = {
 }
 
 
-#: The core's blocks in the whole-core dump (``make sim WINDOW=<k>``): the scopes, under the core,
+#: The core's blocks in the whole-core dump (``make sim WINDOW=1``): the scopes, under the core,
 #: whose own signals each group of the save file shows.
 WINDOW_GROUPS = {
     "MAC: GMII receive": ["ethernet.rx.mac"],
@@ -220,16 +223,16 @@ def window_groups(vcd, core="fast_system.core"):
     return {group: names for group, names in groups.items() if names}
 
 
-def print_window(w, k):
+def print_window(w):
     """Writes the whole-core dump's save file and says where both are."""
     vcd = Path(w["path"])
     start, end = w["span_ps"]
     markers = w["markers"]
     save = write_save_file(vcd, window_groups(vcd), "fast_system.core", view=(start, end), markers=markers)
     print(f"whole core dumped (every signal, VCD): {vcd}, {vcd.stat().st_size / 2**20:.0f} MiB, "
-          f"{start / 1e6:.3f} to {end / 1e6:.3f} us ({(end - start) / 1e6:.1f} us of simulated time): from "
-          f"{xga.WINDOW_LEAD_US} us before trigger {k} to {xga.WINDOW_AFTER_US} us after its frame's first "
-          f"clocking pulse\n"
+          f"{start / 1e6:.3f} to {end / 1e6:.3f} us ({(end - start) / 1e6:.1f} us of simulated time): the "
+          f"first frame from the start of its last datagram (every frame sent whole, that one held back) "
+          f"through the store to {xga.WINDOW_AFTER_US} us after its first clocking pulse\n"
           f"  GTKWave save file: {save} (grouped by block, buses in hex; opens on the window; markers "
           + ", ".join(f"{chr(ord('A') + i)} {name} {t / 1e6:.3f} us" for i, (name, t) in enumerate(markers.items()))
           + ")")

@@ -19,9 +19,13 @@ RST_ACTIVE is measured first, in a short run, and the run is planned with it (as
 with ``rst_active_cycles_max``); memory stalls make the frame starts differ from the schedule
 model's (the sequencer waits for late rows), so they are then reported, not compared.
 
-With ``window`` (a one-by-one trigger ``k``), every signal of the design is dumped for a bounded
-window: from :data:`WINDOW_LEAD_US` before trigger ``k`` to :data:`WINDOW_AFTER_US` after its
-frame's first clocking pulse (:mod:`sim.tb.system_fast`), from a build with tracing of its own.
+With ``window``, every signal of the design is dumped for a bounded window that follows the
+first frame shown from its last GMII byte to its first clocking pulse: every frame is sent whole,
+the first one last, and its last datagram is held back until the one-by-one phase. The sequence
+is complete, and the frame showable, only once that datagram is in; the window opens as it
+starts, the first trigger comes right after its last byte (held until the frame is loaded) and
+the window closes :data:`WINDOW_AFTER_US` after the frame's first clocking pulse
+(:mod:`sim.tb.system_fast`), from a build with tracing of its own.
 
 Timing: DCLK 400 MHz (two beats per 200 MHz ``dmd`` cycle) by default, or 200 MHz; RST_ACTIVE and
 settle from the facts table (no scaling); only the DLPC410's initialisation (220 ms) is shortened,
@@ -72,10 +76,10 @@ FAULTS = {"stalls": _STALLS, "rst": _RST, "all": {**_STALLS, **_RST}}
 #: to this many after its last pulse; its save file opens on this many cycles from the trigger.
 WAVE_WINDOW = (1000, 2000)
 WAVE_VIEW = 3000
-#: The dump of every signal (``window``) opens this long before the trigger (which comes that
-#: much later) and closes this long after the frame's first clocking pulse: the idle core dumps
-#: about 1.5 MB a microsecond (status counters of a thousand bits change every cycle).
-WINDOW_LEAD_US, WINDOW_AFTER_US = 10, 5
+#: The dump of every signal (``window``) closes this long after the frame's first clocking pulse:
+#: the idle core dumps about 1.5 MB a microsecond (status counters of a thousand bits change
+#: every cycle).
+WINDOW_AFTER_US = 5
 
 
 def plan(dclk_hz=DCLK_HZ, t_rst_cycles=None, dmd=DMD):
@@ -109,30 +113,43 @@ def _datagrams(payloads, port=PORT):
                   / Raw(payload)) for payload in payloads]
 
 
-def _replay_files(directory, images):
-    """GMII replay files: a control record that makes the store keep the frames as a sequence,
-    then one per frame (its image records, then the first record again addressed to another UDP
-    port, which the stack must drop and count), and one with a status query. The first frame
-    goes whole; each later one, as a user streams a moving target, goes as a delta of it: only
-    the rows in which it differs from the first."""
-    files, sequence, datagrams = [], 0, 0
+def _replay_files(directory, images, hold_last=False):
+    """GMII replay files, as the sends the testbench makes in order (``path``, ``what``,
+    ``kind``): a control record that makes the store keep the frames as a sequence, then one per
+    frame (its image records, then the first record again addressed to another UDP port, which
+    the stack must drop and count); and one with a status query. The first frame goes whole; each
+    later one, as a user streams a moving target, goes as a delta of it: only the rows in which it
+    differs from the first. ``hold_last`` (the wave window): every frame goes whole, the first one
+    last, and its last datagram in a replay of its own (``held``, else None), sent later.
+    Returns (sends, held, query, datagrams)."""
+    sends, held, sequence = [], None, 0
     setup = directory / "sequence.bin"
     gmii.replay_file(setup, _datagrams([codec.control_record(sequence, sequence_length=len(images))]))
     sequence, datagrams = 1, 1
-    files.append(str(setup))
-    for index, image in enumerate(images):
-        delta = {} if index == 0 else {"base": 0, "rows": codec.changed_rows(image, images[0]) if
-                                        (image != images[0]).any() else [0]}
+    sends.append({"path": str(setup), "what": "sequence of stored frames (control record)", "kind": "control"})
+    order = list(range(len(images)))
+    if hold_last:
+        order = order[1:] + order[:1]
+    for index in order:
+        image, kind = images[index], "delta" if index and not hold_last else "whole"
+        delta = {} if kind == "whole" else {"base": 0, "rows": codec.changed_rows(image, images[0]) if
+                                            (image != images[0]).any() else [0]}
         payloads = codec.image_records(image, frame=index, sequence=sequence, **delta)
         sequence += len(payloads)
         stray = _datagrams(payloads[:1], port=PORT + 1)
         datagrams += len(payloads) + len(stray)
+        what = f"frame {index + 1}/{len(images)}"
+        if hold_last and index == 0:
+            payloads, last = payloads[:-1], payloads[-1:]
+            path = directory / "frame0_last.bin"
+            gmii.replay_file(path, _datagrams(last))
+            held = {"path": str(path), "what": f"{what}: its last datagram", "kind": "held"}
         path = directory / f"frame{index}.bin"
         gmii.replay_file(path, _datagrams(payloads) + stray)
-        files.append(str(path))
+        sends.append({"path": str(path), "what": what, "kind": kind})
     query = directory / "status_query.bin"
     gmii.replay_file(query, _datagrams([codec.status_query(sequence)]))
-    return files, str(query), datagrams + 1
+    return sends, held, str(query), datagrams + 1
 
 
 def _status(tx_trace):
@@ -147,7 +164,7 @@ def _status(tx_trace):
 
 
 def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, faults=None, log=print,
-        calibrated=True, window=None, dmd=DMD):
+        calibrated=True, window=False, dmd=DMD):
     """Build and run the XGA system simulation on ``frames`` frames of the default scene, stored
     as a sequence; ``one_by_one`` frames triggered each when the sequencer is ready, then
     ``back_to_back`` frames triggered faster than they can be shown. Returns the report (dict).
@@ -156,11 +173,10 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
     the images' errors are in the report. ``faults``: a key of :data:`FAULTS`, the chips
     misbehave; when the controller's RST_ACTIVE is not the facts table's, the run is planned
     with the time the projector measured in a first short run (:func:`calibrate`), unless
-    ``calibrated`` is false. ``window``: dumps every signal around one-by-one trigger ``window``
-    (1 to ``one_by_one``); the report's ``window`` says where, its span and its markers. ``dmd``:
+    ``calibrated`` is false. ``window``: dumps every signal from the first frame's last GMII byte
+    to its first clocking pulse (every frame sent whole; see the module's notes); the report's
+    ``window`` says where, its span and its markers. ``dmd``:
     the DLP7000 (default) or another DMD of :data:`spec.facts.DMDS` (the DLP9500: four buses)."""
-    if window is not None and not 1 <= window <= one_by_one:
-        raise ValueError(f"window: a trigger from 1 to {one_by_one}, not {window}")
     t_rst_cycles = None
     if calibrated and "dlpc410_rst_extra" in FAULTS.get(faults, {}):
         t_rst_cycles = calibrate(key, dclk_hz, faults, log, dmd)
@@ -169,11 +185,11 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
     directory = build_dir("system", key)
     t0 = time.monotonic()
     images = default_scene(frames, dmd.rows, dmd.columns)
-    replays, query, datagrams = _replay_files(directory, images)
+    sends, held, query, datagrams = _replay_files(directory, images, hold_last=window)
     log(f"scene encoded: {frames} frames, {datagrams} datagrams ({time.monotonic() - t0:.1f} s)")
     files = {name: directory / f"{name}.txt" for name in ("pins", "tx")}
     report_path = directory / "stimulus.json"
-    p = {"frames": frames, "replays": replays, "status_query": query, "replay": str(directory / "replay.bin"),
+    p = {"frames": frames, "sends": sends, "held": held, "status_query": query, "replay": str(directory / "replay.bin"),
          "period_cycles": the_plan.frame_cycles, "one_by_one": one_by_one, "back_to_back": back_to_back,
          "fast_period_cycles": round(FASTER * the_plan.frame_cycles),
          # at or just after the first frame's last pulse: its first pulse comes within 8 cycles
@@ -182,7 +198,7 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
          # last datagram once its FCS is checked, then the plane is read from DDR2)
          "settle_us": 250,
          "margin_us": 20, "reply_us": 30, "progress_us": 2000, "report": str(report_path),
-         "window": window and {"trigger": window, "lead_us": WINDOW_LEAD_US, "after_us": WINDOW_AFTER_US}}
+         "window": window and {"after_us": WINDOW_AFTER_US}}
     plusargs = [f"+{PLUSARGS['replay']}={p['replay']}", f"+{PLUSARGS['pins']}={files['pins']}",
                 f"+{PLUSARGS['tx']}={files['tx']}"]
     if faults:
@@ -200,26 +216,29 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
     log(f"simulation done: build and run {time.monotonic() - t_build:.0f} s, of which the run {sim_wall:.0f} s; "
         f"checking the pins")
     report = analyse(the_plan, images, stimulus, files, one_by_one=one_by_one, back_to_back=back_to_back,
-                     build=build, faults=faults, dmd=dmd)
+                     build=build, faults=faults, dmd=dmd, window=window)
     report["t_rst_cycles"], report["t_rst_measured"] = the_plan.params.t_rst, t_rst_cycles is not None
     if window:
-        report["window"] = _window(directory / "window.vcd", stimulus, report, window)
+        report["window"] = _window(directory / "window.vcd", stimulus, report)
     return report
 
 
-def _window(path, stimulus, report, k):
+def _window(path, stimulus, report):
     """The dump of every signal: its path, size, span and markers (ps of simulated time, as in
-    the dump): trigger ``k`` and its frame's first clocking pulse."""
-    frame = report["frames"][k - 1]
-    # a pin trace cycle is the dmd edge that sampled the pins; trigger k's edge is known
-    edge_ns = stimulus["trigger_edges_ns"][k - 1]
+    the dump): the first frame's last GMII byte, the first trigger and the frame's first
+    clocking pulse."""
+    frame = report["frames"][0]
+    # a pin trace cycle is the dmd edge that sampled the pins; the trigger's edge is known
+    edge_ns = stimulus["trigger_edges_ns"][0]
 
     def ps(ns):
         return round(ns * 1e3)
     first_pulse_ns = edge_ns + (frame["start_cycle"] - frame["trigger_cycle"]) * 1e9 / DMD_HZ
+    last_byte_ns = next(s["end_ns"] for s in stimulus["sends"] if s["kind"] == "held")
     w = stimulus["window"]
     return {"path": str(path), "bytes": path.stat().st_size, "span_ps": (ps(w["open_ns"]), ps(w["close_ns"])),
-            "markers": {"trigger": ps(stimulus["triggers_ns"][k - 1]), "first pulse": ps(first_pulse_ns)}}
+            "markers": {"last GMII byte": ps(last_byte_ns), "trigger": ps(stimulus["triggers_ns"][0]),
+                        "first pulse": ps(first_pulse_ns)}}
 
 
 def _frames_shown(pins, layout, pulses):
@@ -248,7 +267,8 @@ def _model_back_to_back(dmd, the_plan, images, first, strobes):
     return [t - r.frame_starts[0] for t in r.frame_starts]
 
 
-def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, build=None, faults=None, dmd=DMD):
+def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, build=None, faults=None, dmd=DMD,
+            window=False):
     t0 = time.monotonic()
     p = the_plan.params
     layout = pin_layout(dmd.buses, p.beats)
@@ -271,7 +291,8 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
         error = np.abs(light - image[:, :light.shape[1]].astype(np.float64))
         trigger = triggers[index]
         shown.append({"trigger_cycle": trigger, "start_cycle": first, "latency_cycles": first - trigger,
-                      "held": index >= one_by_one + 1, "span_cycles": last - first,
+                      # (with the window, the first trigger comes before its frame is loaded)
+                      "held": index >= one_by_one + 1 or (window and index == 0), "span_cycles": last - first,
                       "max_error_lsb": float(error.max()), "wrong_pixels": int((error > 1e-9).sum())})
     # back to back: the frame starts the gateware made, against the schedule model's for the same
     # triggers (the first one found every group ready, the others were held)
@@ -292,7 +313,6 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
         waves = trace.write_vcd(Path(files["pins"]).with_suffix(".vcd"), pins, layout,
                                 start=start, end=frames[0][1] + WAVE_WINDOW[1], ns_per_cycle=1e9 / DMD_HZ)
     sends = stimulus["sends"]
-    first_frame = next(s for s in sends if s["what"].startswith("frame 1/"))
     scene = _scene_rate(images, sends, status)
     return {
         "frames": shown,
@@ -313,7 +333,10 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
         "scene": scene,
         "dmd_cycles": stimulus["sim_ns"] / (1e9 / DMD_HZ),
         "sim_wall_s": stimulus["wall_s"],
-        "xga_frame_sim_wall_s": stimulus["wall"]["first_frame_last_pulse"] - first_frame["wall_start"],
+        # from the first frame's first packet to its last pulse (none marked with the window: its
+        # trigger is held)
+        "xga_frame_sim_wall_s": (stimulus["wall"]["first_frame_last_pulse"] - sends[1]["wall_start"]
+                                 if "first_frame_last_pulse" in stimulus["wall"] else None),
         "trace_records": len(pins),
         "waves": str(waves),
         # the save file's view and named markers (ps in the VCD), the VCD's fields and widths
@@ -334,14 +357,14 @@ def _scene_rate(images, sends, status):
     dropped = {name: status[name] for name in ("drop_overflow", "mac_rx_dropped", "rows_incomplete",
                                               "store_rows_refused") if status[name]}
     assert not dropped and status["store_frames_complete"] == len(images), (dropped, status["store_frames_complete"])
-    frames = [s for s in sends if s["what"].startswith("frame ")]
-    whole_s = (frames[0]["end_ns"] - frames[0]["start_ns"]) * 1e-9
-    deltas = frames[1:]
+    whole = next(s for s in sends if s["kind"] == "whole")
+    whole_s = (whole["end_ns"] - whole["start_ns"]) * 1e-9
+    deltas = [s for s in sends if s["kind"] == "delta"]
     delta_s = (deltas[-1]["end_ns"] - deltas[0]["start_ns"]) * 1e-9 if deltas else None
     return {"whole_frames_per_s": 1 / whole_s,
             "delta_frames_per_s": len(deltas) / delta_s if deltas else None,
             "deltas": len(deltas),
-            "delta_rows": [int(len(codec.changed_rows(image, images[0]))) for image in images[1:]]}
+            "delta_rows": [int(len(codec.changed_rows(image, images[0]))) for image in images[1:]] if deltas else []}
 
 
 def _name(dmd):

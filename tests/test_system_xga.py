@@ -40,3 +40,51 @@ def test_xga_frames_end_to_end():
     # the sequence of two frames plays on: the last frame shown is the first again
     assert status["shown_frame"] == (len(shown) - 1) % 2 and status["newest_frame"] == 1
     assert status["rows_incomplete"] == 0
+
+
+def _records(path):
+    """The UDP payloads of a GMII replay file (read back from its bytes: preamble and FCS cut)
+    with their destination ports."""
+    from scapy.layers.inet import UDP
+    from scapy.layers.l2 import Ether
+
+    data = path.read_bytes()
+    frames, frame = [], bytearray()
+    for k in range(0, len(data), 2):
+        if data[k] & 1:
+            frame.append(data[k + 1])
+        elif frame:
+            frames.append(bytes(frame[8:-4]))
+            frame = bytearray()
+    udp = [Ether(f)[UDP] for f in frames]
+    return [(u.dport, bytes(u.payload)[:u.len - 8]) for u in udp]      # (short frames are padded)
+
+
+def test_window_holds_back_the_first_frames_last_datagram(tmp_path):
+    """``make sim WINDOW=1``'s stimulus: every frame whole, the first one last, its last record in
+    a replay of its own; every record numbered in the order it is sent, and the first frame's
+    records, held one included, exactly the host encoder's."""
+    from pathlib import Path
+
+    import numpy as np
+
+    from host import codec
+    from sim.scene import default_scene
+
+    images = default_scene(3, 96, 128)
+    sends, held, query, _ = xga._replay_files(tmp_path, images, hold_last=True)
+    assert [s["kind"] for s in sends] == ["control", "whole", "whole", "whole"]
+    assert [s["what"].split(":")[0] for s in sends[1:]] == ["frame 2/3", "frame 3/3", "frame 1/3"]
+    assert held["kind"] == "held"
+    sent = [r for s in [*sends, held, {"path": query}] for r in _records(Path(s["path"]))]
+    ours = [payload for port, payload in sent if port == xga.PORT]
+    numbers = [codec.decode(payload)[0]["sequence"] for payload in ours]
+    assert numbers == [k % 256 for k in range(len(ours))]
+    first = [payload for port, payload in _records(Path(sends[3]["path"])) if port == xga.PORT]
+    (last,) = [payload for _, payload in _records(Path(held["path"]))]
+    expect = codec.image_records(images[0], frame=0, sequence=codec.decode(first[0])[0]["sequence"])
+    assert [*first, last] == [bytes(r) for r in expect]
+    # the normal run: the first frame whole and first, the others as deltas of it
+    sends, held, _, _ = xga._replay_files(tmp_path, images)
+    assert held is None and [s["kind"] for s in sends] == ["control", "whole", "delta", "delta"]
+    assert np.any(images[1] != images[0])

@@ -13,10 +13,11 @@ come faster than frames can be shown (every ``fast_period_cycles``): each is hel
 sequencer is ready. At the end a status query is sent and the reply is recorded on the transmit
 pins.
 
-With ``window`` (``{"trigger": k, "lead_us": .., "after_us": ..}``), every signal is dumped
-from ``lead_us`` before one-by-one trigger ``k`` (which comes that much later) to ``after_us``
-after sync out rises at its frame's first pulse. (The frame's last GMII byte is milliseconds
-earlier: frames are all sent first, and a window reaching back to it would be gigabytes.)
+With ``window`` (``{"after_us": ..}``), the first frame's last datagram (``held``) is sent in
+the one-by-one phase: every signal is dumped from the moment it starts, through its last byte,
+the frame's way through the store and its first row on the bus (``loading``), when the first
+trigger comes (it is held until the frame is loaded), to ``after_us`` after sync out rises at the
+frame's first pulse.
 """
 
 import json
@@ -57,7 +58,7 @@ class Run:
         await Timer(750, "ps")
         Clock(dut.dmd_clk, DMD_NS, unit="ns").start()
 
-    async def send(self, path, what):
+    async def send(self, path, what, kind):
         """Play one replay file; returns when its last byte is on the pins."""
         dut = self.dut
         shutil.copyfile(path, self.p["replay"])
@@ -67,7 +68,7 @@ class Run:
         await RisingEdge(dut.clk)
         dut.replay_start.value = 0
         await FallingEdge(dut.replay_busy)
-        self.events["sends"].append({"what": what, "start_ns": t0, "end_ns": self.now_ns(),
+        self.events["sends"].append({"what": what, "kind": kind, "start_ns": t0, "end_ns": self.now_ns(),
                                      "wall_start": w0 - self.wall0, "wall_end": time.monotonic() - self.wall0})
         self.log(f"{what} sent over GMII")
 
@@ -84,11 +85,10 @@ class Run:
         await Timer(40, "ns")
         dut.trigger_in.value = 0
 
-    async def window_open(self, lead_us):
-        """Opens the wave window, then waits ``lead_us``."""
+    def window_open(self):
+        """Opens the wave window."""
         self.dut.wave_dump.value = 1
         self.events["window"] = {"open_ns": self.now_ns()}
-        await Timer(lead_us, "us")
 
     async def window_close(self, after_us):
         """Closes the wave window ``after_us`` after sync out rises (the frame's first pulse)."""
@@ -120,22 +120,29 @@ async def stream_frames(dut):
     await run.start()
     cocotb.start_soon(run.progress(p["progress_us"]))
     period_ns = p["period_cycles"] * DMD_NS
-    frames = p["frames"]
     window = p.get("window")
     if window:
         dut.wave_dump.value = 0
-    await run.send(p["replays"][0], "sequence of stored frames (control record)")
-    for index in range(frames):
-        await run.send(p["replays"][index + 1], f"frame {index + 1}/{frames}")
+    for send in p["sends"]:
+        await run.send(send["path"], send["what"], send["kind"])
     await Timer(p["settle_us"], "us")
     shown = 0
     for index in range(p["one_by_one"]):
-        if window and index == window["trigger"] - 1:
-            await run.window_open(window["lead_us"])
+        if window and index == 0:
+            # the first frame's last datagram: the frame (and the sequence) complete on its last byte
+            run.window_open()
             cocotb.start_soon(run.window_close(window["after_us"]))
+            held = p["held"]
+            await run.send(held["path"], held["what"], held["kind"])
+            # a trigger before the sequencer runs would be ignored: it runs once it loads rows
+            await RisingEdge(dut.loading)
+            run.log("the first frame's first row on the bus")
         # a different phase of the trigger against DCLK each time: latency has a spread
         await run.trigger((index * 1300) % int(DMD_NS * 1000))
-        if index == 0:
+        if window and index == 0:
+            # held until the frame is loaded: wait for its first pulse before the next trigger
+            await RisingEdge(dut.sync_out)
+        elif index == 0:
             last_pulse = run.events["triggers_ns"][0] + p["last_pulse_cycles"] * DMD_NS
             cocotb.start_soon(run.mark(last_pulse, "first_frame_last_pulse"))
         await Timer(round(period_ns + p["margin_us"] * 1e3), "ns")
@@ -151,7 +158,7 @@ async def stream_frames(dut):
         await Timer(round(start + fast_ns - run.now_ns()), "ns")
     await Timer(round(2 * period_ns + p["margin_us"] * 1e3), "ns")
     run.check_memory()
-    await run.send(p["status_query"], "status query")
+    await run.send(p["status_query"], "status query", "query")
     await Timer(p["reply_us"], "us")
     dut.flush.value = 1
     await ClockCycles(dut.clk, 2)
