@@ -14,7 +14,7 @@ import sys
 import numpy as np
 
 from spec import plan_search, schedule
-from spec.facts import DMDS
+from spec.facts import DMDS, SETTLE_READINGS
 from spec.registers import PlaneOrder, ResetMode, TriggerMode
 
 from .client import DEFAULT_PORT, DELTA_ROWS, Client, ClientError, period_fault
@@ -59,10 +59,11 @@ def _t_rst(args):
 def _plan(args):
     dmd = DMDS[args.dmd]
     common = dict(depth=args.depth, exposure_s=args.exposure, words_per_cycle=args.read_rate,
-                  t_rst_cycles=_t_rst(args))
+                  t_rst_cycles=_t_rst(args), reading=args.settle_reading)
     if args.best:
         found = plan_search.find(dmd, args.dclk, **common)
-        print(f"plan finder: every reset mode, plane order and hide threshold under TI's rules\n{found.table()}\n"
+        print(f"plan finder: every reset mode, plane order and hide threshold under the {args.settle_reading} "
+              f"settle reading\n{found.table()}\n"
               f"fastest: {found.binds}")
         plan = found.plan
     else:
@@ -82,8 +83,9 @@ def _plan(args):
 def describe(plan):
     """What a register set reaches, from the schedule model: one line."""
     p = plan.params
-    return (f"{plan.rate_hz:.1f} frames/s ({plan.frame_cycles} DCLK cycles per frame), "
-            f"least significant plane {p.lsb} cycles ({p.lsb / plan.dclk_hz * 1e6:.2f} us), "
+    # durations are in ``dmd`` cycles (200 MHz) at either DCLK
+    return (f"{plan.rate_hz:.1f} frames/s ({plan.frame_cycles} cycles of {schedule.FABRIC_HZ / 1e6:g} MHz "
+            f"per frame), least significant plane {p.lsb} cycles ({p.lsb / schedule.FABRIC_HZ * 1e6:.2f} us), "
             f"set by {plan.binds}")
 
 
@@ -132,6 +134,10 @@ def main(argv=None):
                                 "facts table's 4.54 us)")
     configure.add_argument("--read-rate", type=float, default=1.0,
                            help="the store's read bandwidth in 64-bit words per DCLK cycle (row pacing)")
+    configure.add_argument("--settle-reading", default="ti", choices=sorted(SETTLE_READINGS),
+                           help="what the mirror settle time forbids: 'ti' (default; TI: no load while the "
+                                "mirrors settle) or 'paper' (the four-DMD paper's reading, which TI's documents "
+                                "forbid: loads while they settle, pulses a settle time apart); docs/bounds.md")
     configure.add_argument("--dry-run", action="store_true", help="say the rate, send nothing")
     for name, text in (("arm", "let triggers reach the sequencer"), ("disarm", "ignore every trigger"),
                        ("trigger", "a software trigger (the sequencer's trigger mode must be software)")):

@@ -17,12 +17,15 @@ DLP7000     DLP7000 datasheet (timing 7.12, initialisation 8.3)
 DLPC910     sister part's datasheet (same interface family)
 refHDL      TI's applications-FPGA reference HDL as quoted in public repositories
 forum       TI E2E forum answers (quoting the datasheet); Mathews et al., IEEE QCE 2022 (measured)
+DLPU133     DLPC964 applications FPGA user guide (loading into settling mirrors)
+four-DMD    the tiled four-DLP9500 projector paper (2026), eq. 6-7 (450.6 Hz 8-bit, runs at 400 Hz)
 """
 
 import enum
 from dataclasses import dataclass
 
-__all__ = ["Fact", "TIMING", "PHY", "DmdType", "DMDS", "RowMode", "BlockMode", "TEST_DMD", "TEST_DMD4",
+__all__ = ["Fact", "TIMING", "SettleReading", "SETTLE_READINGS", "PHY", "DmdType", "DMDS", "RowMode", "BlockMode",
+           "TEST_DMD", "TEST_DMD4",
            "TEST_DMD_400", "TEST_DMD4_400"]
 
 
@@ -59,6 +62,35 @@ TIMING = {
     "t_watchdog": Fact(10.0, "s", "DLPC410", "medium", "WDT_ENBLZ low: forced reset if none issued"),
     "dclk_min": Fact(200e6, "Hz", "DLP7000 table 8-2", "high"),
     "dclk_max": Fact(400e6, "Hz", "DLP7000 table 8-2; DLPU045A (new PROM: 400 MHz only)", "high"),
+}
+
+
+@dataclass(frozen=True)
+class SettleReading:
+    """What the mirrors' settle time (``TIMING["t_settle"]``) forbids.
+
+    ``frozen``: a pulsed block's memory must not change until ``t_settle`` after RST_ACTIVE falls.
+    Otherwise (``flip``) it may change as soon as RST_ACTIVE falls, and only the block's next pulse
+    must wait: no sooner than ``t_settle`` after its last one.
+    """
+    name: str
+    frozen: bool
+    source: str
+    note: str
+
+    @property
+    def flip(self):
+        return not self.frozen
+
+
+#: Readings of the settle time. TI's is the default and the only one the rule model takes unless
+#: told; the four-DMD paper's is kept to compare like with like, never as a default.
+SETTLE_READINGS = {
+    "ti": SettleReading("ti", True, "DLPU133; DLPA008B 4.1",
+                        "loading data into mirrors that are settling can put the DMD in an unknown state"),
+    "paper": SettleReading("paper", False, "four-DMD eq. 6-7",
+                           "the settle forbids only a new flip: memory loads as soon as RST_ACTIVE falls, "
+                           "and a block's pulses come at least t_settle apart (the equations' 8 us unit)"),
 }
 
 

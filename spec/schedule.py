@@ -59,18 +59,25 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .facts import TIMING, BlockMode
+from .facts import SETTLE_READINGS, TIMING, BlockMode
 from .registers import PlaneOrder, ResetMode, Source, TriggerMode, group_size
 
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate", "FABRIC_HZ",
-           "beats_at", "row_cycles",
-           "plan", "bound", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS", "flush_rows",
-           "RST_MARGIN", "even", "ready_cycle", "reload_bound", "reload_cycles", "on_time", "frame_period"]
+           "beats_at", "row_cycles", "row_rate_words",
+           "plan", "bound", "paper_eq_rate_hz", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS",
+           "flush_rows", "PAPER_SETTLE_CYCLES", "RST_MARGIN",
+           "even", "ready_cycle", "reload_bound", "reload_cycles", "on_time", "frame_period"]
 
 #: The ``dmd`` domain's clock: every cycle count of the model and the sequencer is in its cycles.
 #: DCLK is this (one beat per cycle) or twice this (two beats per cycle: 400 MHz through the
 #: platform's 4:1 serialisers).
 FABRIC_HZ = 200e6
+
+
+def row_rate_words(dmd, dclk_hz):
+    """64-bit store words a ``dmd`` cycle that feed a row at the row cycle (every bus, every
+    beat): 1 for the DLP7000 at DCLK 200 MHz, 2 at 400 MHz, 4 for the DLP9500 at 400 MHz."""
+    return dmd.bits_per_dclk * beats_at(dclk_hz) // 64
 
 
 def beats_at(dclk_hz):
@@ -108,6 +115,11 @@ def flush_rows(dmd):
     return 2 * dmd.rows_per_block + WORD_FIFO_ROWS + 1
 
 
+#: Under the four-DMD paper's settle reading a group's memory may change as soon as RST_ACTIVE
+#: falls; the sequencer learns of the fall through its synchroniser and releases the group this
+#: many cycles after ``t_rst``, so the plan keeps them as its ``t_settle`` (TI's settle covers them).
+PAPER_SETTLE_CYCLES = 2
+
 #: Cycles added to the RST_ACTIVE time: the command leaves one cycle after its decision, and the
 #: sequencer sees RST_ACTIVE through a two-flip-flop synchroniser; ``t_rst`` must cover the
 #: pin's high time plus this.
@@ -144,6 +156,8 @@ class Params:
     ns_flip: bool = False
     park: bool = False
     beats: int = 1               # DCLK beats per dmd cycle: the sequencer's build, not a register
+    t_flip: int = 0              # the four-DMD paper's settle reading: a group's pulses at least this
+                                 # far apart (t_settle 0: memory loads once RST_ACTIVE falls); 0: TI's
 
     def registers(self, dmd):
         """The values of :class:`~gateware.registers.Registers`, as a dict."""
@@ -602,7 +616,7 @@ def _lattice_ok(M, s, G, sep):
 def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetMode.GLOBAL,
          exposure_s=0.0, strict_rst=True, chain=False, words_per_cycle=1.0, source=Source.STORE,
          t_rst_s=None, t_settle_s=None, frame=None, order_table=(7, 6, 5, 4, 3, 2, 1, 0),
-         reload_lead=RELOAD_LEAD, trigger_hold=False, t_rst_cycles=None):
+         reload_lead=RELOAD_LEAD, trigger_hold=False, t_rst_cycles=None, reading="ti"):
     """A parameter set that shows every plane exactly on time, and the rate it reaches.
 
     ``exposure_s`` asks for a least significant plane at least that long (0: the shortest legal
@@ -623,12 +637,19 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     reply's ``rst_active_cycles_max``, from the pulse's decision to the fall: the synchroniser's
     margin included), taken as ``t_rst`` instead of the facts table's time plus
     :data:`RST_MARGIN`.
+    ``reading``: a key of :data:`spec.facts.SETTLE_READINGS`. TI's (default) freezes a pulsed
+    group's memory for ``t_rst + t_settle``; the four-DMD paper's frees it once RST_ACTIVE falls
+    (``t_settle`` register :data:`PAPER_SETTLE_CYCLES`) and keeps the group's pulses ``t_settle``
+    apart instead (``t_flip``).
     """
     beats = beats_at(dclk_hz)
     R = row_cycles(dmd, beats)
     t_rst = even(t_rst_cycles) if t_rst_cycles is not None else \
         even(_cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s) + RST_MARGIN)
     t_settle = _cycles(TIMING["t_settle"].value if t_settle_s is None else t_settle_s)
+    t_flip = 0
+    if SETTLE_READINGS[reading].flip:
+        t_settle, t_flip = PAPER_SETTLE_CYCLES, t_settle
     words = dmd.words_per_row
     # the on-chip source needs no memory bandwidth: one row per row cycle on any bus width
     row_period = R if source == Source.PRNG else even(max(R, math.ceil(words / words_per_cycle - 1e-9)))
@@ -652,6 +673,8 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
         lsb_min = max(t_rst + t_settle + load_g, bus_path, 2)
         binds = "bus (row loads)" if G > 1 and bus_path >= t_rst + t_settle + load_g \
             else "settle + load (a pulse freezes its group's memory)"
+    if t_flip > lsb_min:
+        lsb_min, binds = t_flip, "flip spacing (the paper's reading: t_settle between a block's pulses)"
     want = _cycles(exposure_s)
     if want > lsb_min:
         lsb_min, binds = want, "requested exposure"
@@ -663,27 +686,28 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
         if G == 1 or _lattice_ok(lsb, stagger, G, sep):
             # phased: on the LSB lattice that keeps groups' pulses apart; global: no lattice
             reload = t_rst + t_settle + load_g + slack
-            dark_gap = even(reload) if G == 1 else lsb * math.ceil(reload / lsb)
+            dark_gap = even(max(reload, t_flip)) if G == 1 else lsb * math.ceil(reload / lsb)
             p = Params(lsb=lsb, t_rst=t_rst, t_settle=t_settle, hide=hide, dark_gap=dark_gap,
                        reset_mode=reset_mode, order=order, order_table=order_table, chain=chain,
                        strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period,
-                       reload_lead=reload_lead, beats=beats, trigger_hold=trigger_hold)
+                       reload_lead=reload_lead, beats=beats, trigger_hold=trigger_hold, t_flip=t_flip)
             fr = frame or Frame(0, depth)
             if on_time(dmd, p, fr):
                 break
         lsb += max(2, even(lsb // 128))
     else:
         raise ValueError("no feasible schedule found")
+    floor = binds
     if lsb > lsb_min and binds != "requested exposure":
         binds += " + pulse spacing" if G > 1 else ""
     frame_cycles = frame_period(dmd, p, fr)
     if G > 1 and not chain and depth > 1:
         # phased PWM: the LSB lattice against spread groups, whichever is faster
-        spread = _spread(dmd, replace(p, dark_gap=even(t_rst + t_settle + load_g + slack)), fr,
+        spread = _spread(dmd, replace(p, dark_gap=even(max(t_rst + t_settle + load_g + slack, t_flip))), fr,
                          even(lsb_min), sep, load_g, clear_g, frame_cycles)
         if spread is not None:
             p, frame_cycles = spread
-            binds = ("settle (t_rst + t_settle + clears) + load queue order: groups spread so that "
+            binds = (f"{floor} + load queue order: groups spread so that "
                      "no group's clears wait behind another group's plane load"
                      if p.lsb == even(lsb_min) else
                      "load queue order + pulse spacing (groups spread, LSB above the settle path)")
@@ -806,11 +830,28 @@ def frame_period(dmd, p, fr):
     return max(st.loaded_at for st in r.groups) - first
 
 
-def bound(dmd, dclk_hz, depth=8, *, t_rst_s=None, t_settle_s=None):
+def bound(dmd, dclk_hz, depth=8, *, t_rst_s=None, t_settle_s=None, reading="ti"):
     """Upper bound on the continuous-light PWM frame rate, any schedule: the least significant
-    plane lasts at least RST_ACTIVE + settle + one clear row cycle, and a frame is
-    ``2**depth - 1`` such units (derivation: ``docs/bounds.md``)."""
+    plane lasts at least RST_ACTIVE + settle + one clear row cycle (TI's reading; the paper's:
+    RST_ACTIVE + a clear, and no less than the settle time), and a frame is ``2**depth - 1``
+    such units (derivation: ``docs/bounds.md``)."""
     t_rst = TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s
     t_settle = TIMING["t_settle"].value if t_settle_s is None else t_settle_s
-    t0 = t_rst + t_settle + dmd.clear_row_cycles * dmd.dclk_per_row / dclk_hz
+    t_clear = dmd.clear_row_cycles * dmd.dclk_per_row / dclk_hz
+    t0 = t_rst + t_settle + t_clear if SETTLE_READINGS[reading].frozen else max(t_rst + t_clear, t_settle)
     return 1 / ((2 ** depth - 1) * t0)
+
+
+#: The four-DMD paper's 8-bit frame (eq. 6-7): 255 units of the settle time, then, not weighted,
+#: its reset waits and the loads no plane hides.
+PAPER_RESET_WAITS, PAPER_LOADS = 11, 3
+
+
+def paper_eq_rate_hz(dmd, dclk_hz):
+    """The four-DMD paper's own 8-bit rate (eq. 6-7) for ``dmd`` at ``dclk_hz``: a frame is 255
+    settle times, :data:`PAPER_RESET_WAITS` RST_ACTIVE times and :data:`PAPER_LOADS` full loads
+    (``rows * dclk_per_row`` DCLK cycles). Arithmetic, not a schedule: a ``_model`` figure."""
+    load = dmd.rows * dmd.dclk_per_row / dclk_hz
+    frame = (255 * TIMING["t_settle"].value + PAPER_RESET_WAITS * TIMING["t_rst_active"].value
+             + PAPER_LOADS * load)
+    return 1 / frame

@@ -306,6 +306,32 @@ def test_settle_ends_in_time():
     assert model.log[-1].row == 37
 
 
+def test_paper_reading_loads_while_settling_and_spaces_flips():
+    """The four-DMD paper's reading (never the default): a pulsed block loads as soon as
+    RST_ACTIVE falls, but is not pulsed again sooner than the settle time after its pulse."""
+    model, d = started(reading="paper")
+    p = d.pulse("single", 1)
+    d.wait_until(p + R + 1)
+    d.row(RowMode.ADDRESSED, rowad=37)
+    model.run(d.items)
+    assert model.log[-1].row == 37
+    d.items.clear()
+    d.wait_until(p + S - 4)
+    q = d.pulse("single", 1)      # on the row cycle before p + S
+    assert q < p + S
+    breaks("flip", model, d.items, f"pulse of block 1 {q - p} cycles after its last, needs {S}")
+    model, d = started(reading="paper")
+    p = d.pulse("single", 1)
+    d.clear(1)
+    breaks("settle", model, d.items, "while RST_ACTIVE is high")
+    model, d = started(reading="paper")
+    p = d.pulse("single", 1)
+    d.wait_until(p + S)
+    q = d.pulse("single", 1)
+    model.run(d.items)
+    assert model.pulse_cycles[1] == [p, q]
+
+
 def test_rule_settle_clear_and_during_rst_active():
     model, d = started()
     d.pulse("global")

@@ -18,6 +18,26 @@ def test_bound_matches_derived_figure():
     assert schedule.bound(XGA, 200e6, depth=1) > 50 * schedule.bound(XGA, 200e6)
 
 
+def test_paper_reading_bound_plan_and_equations():
+    """The four-DMD paper's settle reading on the DLP9500 at 400 MHz: its equations give about
+    450 Hz; its bound is 255 settle times (the flip spacing binds, not RST_ACTIVE and the clears);
+    the plan under it keeps every pulse of a block a settle time apart (the rule model's ``flip``
+    rule, on the model's commands) and lands between the two; TI's reading stays below 310 Hz."""
+    d = DMDS["dlp9500"]
+    assert 450 < schedule.paper_eq_rate_hz(d, 400e6) < 451
+    assert schedule.bound(d, 400e6, reading="paper") == pytest.approx(1 / (255 * 8e-6))
+    assert schedule.bound(d, 400e6) < 310
+    plan = schedule.plan(d, 400e6, reading="paper", words_per_cycle=4, trigger_hold=True)
+    p = plan.params
+    assert (p.t_flip, p.lsb, p.t_settle) == (1600, 1600, schedule.PAPER_SETTLE_CYCLES)
+    assert "flip spacing" in plan.binds
+    assert schedule.paper_eq_rate_hz(d, 400e6) < plan.rate_hz < schedule.bound(d, 400e6, reading="paper")
+    frame = schedule.Frame(0, 8)
+    r = schedule.simulate(d, p, [frame], [schedule.ready_cycle(d, p, frame)])
+    pulses = [t for t, kind, *_ in r.decoded() if kind == "pulse"]
+    assert len(pulses) >= 8 and min(b - a for a, b in zip(pulses, pulses[1:], strict=False)) >= p.t_flip
+
+
 def test_exponents():
     assert schedule.exponents(PlaneOrder.MSB_FIRST, None, 3) == [2, 1, 0]
     assert schedule.exponents(PlaneOrder.LSB_FIRST, None, 3) == [0, 1, 2]

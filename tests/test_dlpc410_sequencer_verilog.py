@@ -1,5 +1,6 @@
 """The sequencer's generated Verilog on full XGA, on the full DLP9500 (1080p, four buses) at DCLK
-400 MHz, and on the small four-bus geometry, on the sequencer rig (:mod:`sim.seq_rig`): one
+400 MHz with rows at the row cycle, and on the small four-bus geometries (one under the four-DMD
+paper's settle reading), on the sequencer rig (:mod:`sim.seq_rig`): one
 triggered frame of the ramp image (every grey level on
 every row), RST_ACTIVE and settle scaled down (run-time parameters). The rule-checking DLPC410
 model, on the replayed pin trace, must break no rule and agree with the responder; its command
@@ -19,21 +20,27 @@ from spec.registers import PlaneOrder, ResetMode
 
 
 @pytest.mark.verilog
-@pytest.mark.parametrize("dmd,mode,strict,order,depth,dclk", [
-    ("dlp7000", "GLOBAL", True, "MSB_FIRST", 8, 200e6),     # every grey level 0..255
-    ("dlp7000", "SINGLE", False, "LSB_FIRST", 4, 200e6),    # phased: 16 groups; 4 bits keep it short
-    ("test4", "QUAD", True, "MSB_FIRST", 8, 200e6),         # four buses (DIN_A..D), 1080p-style clears
-    ("dlp9500", "GLOBAL", True, "MSB_FIRST", 8, 400e6),     # full 1080p, four buses, two beats a cycle
+@pytest.mark.parametrize("dmd,mode,strict,order,depth,dclk,words,reading", [
+    ("dlp7000", "GLOBAL", True, "MSB_FIRST", 8, 200e6, 1, "ti"),     # every grey level 0..255
+    ("dlp7000", "SINGLE", False, "LSB_FIRST", 4, 200e6, 1, "ti"),    # phased: 16 groups; 4 bits keep it short
+    ("test4", "QUAD", True, "MSB_FIRST", 8, 200e6, 1, "ti"),         # four buses (DIN_A..D), 1080p-style clears
+    # full 1080p, four buses, two beats a cycle, rows at the row cycle (four store words a cycle)
+    ("dlp9500", "GLOBAL", True, "MSB_FIRST", 8, 400e6, 4, "ti"),
+    # the four-DMD paper's settle reading: loads while the mirrors settle, pulses a settle apart
+    ("test4_400", "GLOBAL", True, "MSB_FIRST", 8, 400e6, 4, "paper"),
 ])
-def test_sequencer_verilog_xga(dmd, mode, strict, order, depth, dclk, test_name):
+def test_sequencer_verilog_xga(dmd, mode, strict, order, depth, dclk, words, reading, test_name):
     dmd = DMDS[dmd]
     p = schedule.plan(dmd, dclk, t_rst_s=40 / 200e6, t_settle_s=80 / 200e6, reset_mode=ResetMode[mode],
-                      strict_rst=strict, order=PlaneOrder[order], depth=depth).params
+                      strict_rst=strict, order=PlaneOrder[order], depth=depth, words_per_cycle=words,
+                      reading=reading).params
+    assert p.t_flip == (80 if reading == "paper" else 0) and p.lsb >= p.t_flip
     frames = [schedule.Frame(0, depth)]   # repeated: a newer frame offered while waiting would be reloaded
     pin = max(g.loaded_at for g in schedule.simulate(dmd, p, frames).groups) + 6
     model_run = schedule.simulate(dmd, p, frames, [pin + PIN_TO_STROBE])
     end = model_run.commands[-1][0] + 64
-    run = run_rig(dmd, p, [(0, depth)], pins=[pin], cycles=end, name=test_name)
+    run = run_rig(dmd, p, [(0, depth)], pins=[pin], cycles=end, name=test_name, store_words=words)
+    assert run.model.reading.name == reading
     got = [c for c in run.commands if c[0] < end]
     want = [c for c in model_run.decoded() if c[0] < end]
     first = next((i for i, (x, y) in enumerate(zip(got, want, strict=False)) if x != y), None)

@@ -14,7 +14,7 @@ from host import Client, ClientError, cli, codec, levels
 from sim.models.net import Model
 from sim.models.slots import SlotPolicy
 from spec import records, wire
-from spec.facts import TEST_DMD
+from spec.facts import DMDS, TEST_DMD
 from spec.registers import TriggerMode
 
 #: The store's refusals, summed into the status reply's ``store_rows_refused``.
@@ -334,7 +334,12 @@ def test_cli_configure_says_the_rate_and_sends_the_plan(projector, capsys):
     # the projector here is built for DCLK 200 MHz (one beat a cycle); the default is 400 MHz
     assert cli.main(base + ["configure", "--dmd", "test", "--dclk", "200e6", "--depth", "6", "--dry-run"]) == 0
     out = capsys.readouterr().out
-    assert f"{plan.rate_hz:.1f} frames/s ({plan.frame_cycles} DCLK cycles per frame)" in out
+    assert f"{plan.rate_hz:.1f} frames/s ({plan.frame_cycles} cycles of 200 MHz per frame)" in out
+    assert f"least significant plane {plan.params.lsb} cycles ({plan.params.lsb / 200:.2f} us)" in out
+    # at 400 MHz the durations are still in 200 MHz cycles (a bug once halved the microseconds)
+    assert cli.main(base + ["configure", "--dmd", "test_400", "--dclk", "400e6", "--depth", "6", "--dry-run"]) == 0
+    p400 = schedule.plan(DMDS["test_400"], 400e6, depth=6).params
+    assert f"least significant plane {p400.lsb} cycles ({p400.lsb / 200:.2f} us)" in capsys.readouterr().out
     assert projector.received == []
     assert cli.main(base + ["configure", "--dmd", "test", "--dclk", "200e6", "--depth", "6"]) == 0
     assert cli.main(base + ["arm"]) == 0

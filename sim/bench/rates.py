@@ -1,7 +1,8 @@
 """8-bit frame rates measured on the gateware, per reset mode and DCLK, at TI timing.
 
-The sequencer's generated Verilog (:mod:`sim.seq_rig`: the store stand-in keeps up with any row
-period, so these are the sequencer's and the DLPC410's rates, not the DDR2's) plays the ramp
+The sequencer's generated Verilog (:mod:`sim.seq_rig`: the store stand-in feeds a row at the row
+cycle, two words a cycle at 400 MHz and four for the DLP9500, so these are the sequencer's and
+the DLPC410's rates, not the DDR2's; ``make sim`` plays at the DDR2's pace) plays the ramp
 frame of every grey level over and over, each trigger coming half a frame after the one before
 and held until every group is ready (``trigger_hold``): the frames follow one another back to
 back. RST_ACTIVE and settle are the facts table's (no scaling). The rule-checking DLPC410 model
@@ -31,26 +32,33 @@ from spec.registers import ResetMode, Source
 
 __all__ = ["measured_rate", "run", "cases", "best", "binary", "binary_period", "CASES"]
 
-#: (DMD, reset mode, strict RST_ACTIVE reading, DCLK): the plans measured.
+#: (DMD, reset mode, strict RST_ACTIVE reading, DCLK, settle reading): the plans measured.
 CASES = [
-    *[("dlp7000", mode, strict, dclk) for dclk in (200e6, 400e6)
+    *[("dlp7000", mode, strict, dclk, "ti") for dclk in (200e6, 400e6)
       for mode, strict in (("GLOBAL", True), ("QUAD", True), ("DUAL", True), ("SINGLE", False))],
-    ("dlp9500", "GLOBAL", True, 400e6),
+    ("dlp9500", "GLOBAL", True, 400e6, "ti"),
+    ("dlp9500", "QUAD", True, 400e6, "ti"),
+    # the four-DMD paper's settle reading (loads while the mirrors settle), to compare like with like
+    ("dlp9500", "GLOBAL", True, 400e6, "paper"),
 ]
 #: Frames played back to back (the period is the median of the last ones).
 FRAMES = 4
 
 
-def measured_rate(dmd_name, mode, strict, dclk, *, frames=FRAMES, name=None, plan=None):
-    """Play ``frames`` frames back to back; returns (measured period cycles, the plan). ``plan``:
-    play this one (early triggers held) rather than :func:`spec.schedule.plan`'s for ``mode``."""
+def measured_rate(dmd_name, mode, strict, dclk, reading="ti", *, frames=FRAMES, name=None, plan=None):
+    """Play ``frames`` frames back to back, the store stand-in feeding :func:`spec.schedule.row_rate_words` words a
+    cycle; returns (measured period cycles, the plan). ``plan``: play this one (early triggers
+    held) rather than :func:`spec.schedule.plan`'s for ``mode`` under the settle ``reading``
+    (the rule model checks the reading the plan was made for: :func:`sim.tb.seq_sim.dlpc410_for`)."""
     dmd = DMDS[dmd_name]
-    plan = plan or schedule.plan(dmd, dclk, reset_mode=ResetMode[mode], strict_rst=strict, trigger_hold=True)
+    words = schedule.row_rate_words(dmd, dclk)
+    plan = plan or schedule.plan(dmd, dclk, reset_mode=ResetMode[mode], strict_rst=strict, trigger_hold=True,
+                                 words_per_cycle=words, reading=reading)
     p = plan.params
     first = _ready(dmd, p, [schedule.Frame(0, 8)])
     pins = [first - PIN_TO_STROBE + k * plan.frame_cycles // 2 for k in range(2 * frames - 1)]
     cycles = first + (frames + 1) * plan.frame_cycles
-    run = run_rig(dmd, p, [(0, 8)], pins=pins, cycles=cycles,
+    run = run_rig(dmd, p, [(0, 8)], pins=pins, cycles=cycles, store_words=words,
                   name=name or f"rates_{dmd_name}_{mode.lower()}_{int(dclk / 1e6)}")
     # group 0's first pulse of each frame: the camera trigger rises ``camera_offset + 1`` after
     # it (sync out may stay high across back-to-back phased frames)
@@ -96,12 +104,23 @@ def run():
 def cases(measured):
     """The :data:`CASES`, each played on the gateware; ``measured`` gets each (period, plan)."""
     figures = {}
-    for dmd_name, mode, strict, dclk in CASES:
-        period, plan = measured_rate(dmd_name, mode, strict, dclk)
-        measured[dmd_name, mode, strict, dclk] = period, plan
-        key = f"{dmd_name}_{mode.lower()}_{int(dclk / 1e6)}mhz"
+    for dmd_name, mode, strict, dclk, reading in CASES:
+        key = f"{dmd_name}_{mode.lower()}_{int(dclk / 1e6)}mhz" + ("_paper_timing" if reading == "paper" else "")
+        period, plan = measured_rate(dmd_name, mode, strict, dclk, reading, name=f"rates_{key}")
+        measured[dmd_name, mode, strict, dclk, reading] = period, plan
         figures[f"seq.gray8_rate_hz_{key}"] = (schedule.FABRIC_HZ / period, "Hz")
         figures[f"seq.gray8_rate_hz_{key}_model"] = (plan.rate_hz, "Hz")
+        print(f"{key}: {schedule.FABRIC_HZ / period:.1f} Hz measured; binds: {plan.binds}")
+    # the DLP9500 under TI's rules (its fastest reset mode) and under the paper's reading, with
+    # the bounds and the paper's own arithmetic beside them
+    dlp9500, clock = DMDS["dlp9500"], 400e6
+    figures["seq.gray8_rate_hz_dlp9500"] = max(figures["seq.gray8_rate_hz_dlp9500_global_400mhz"],
+                                               figures["seq.gray8_rate_hz_dlp9500_quad_400mhz"])
+    figures["seq.gray8_bound_hz_dlp9500_400mhz"] = (schedule.bound(dlp9500, clock), "Hz")
+    figures["seq.gray8_rate_hz_dlp9500_paper_timing"] = figures["seq.gray8_rate_hz_dlp9500_global_400mhz_paper_timing"]
+    figures["seq.gray8_bound_hz_dlp9500_400mhz_paper_reading"] = (
+        schedule.bound(dlp9500, clock, reading="paper"), "Hz")
+    figures["seq.gray8_rate_hz_dlp9500_paper_eq_model"] = (schedule.paper_eq_rate_hz(dlp9500, clock), "Hz")
     return figures
 
 
@@ -110,9 +129,10 @@ def best(measured=None):
     hide threshold) at each DCLK, played on the gateware (unless ``measured`` holds it already)."""
     figures, measured = {}, measured or {}
     for dclk in (200e6, 400e6):
-        found = plan_search.find(DMDS["dlp7000"], dclk, trigger_hold=True)
+        dmd = DMDS["dlp7000"]
+        found = plan_search.find(dmd, dclk, trigger_hold=True, words_per_cycle=schedule.row_rate_words(dmd, dclk))
         plan, mode = found.plan, found.best.reset_mode.name
-        period, known = measured.get(("dlp7000", mode, True, dclk), (None, None))
+        period, known = measured.get(("dlp7000", mode, True, dclk, "ti"), (None, None))
         if known is None or known.params != plan.params:
             period, _ = measured_rate("dlp7000", mode, True, dclk, plan=plan,
                                       name=f"rates_dlp7000_best_{int(dclk / 1e6)}")

@@ -86,21 +86,24 @@ def newer_frame(dmd, p, *, late, gateware=False):
 
 
 def dlp9500_figures(f, sfx):
-    """Four buses (DLP9500, 1080p clears): the store gives one 64-bit word per cycle, half a
-    DLP9500 beat, so rows come every two row cycles (``row_period``); the same plans with a
-    store of two words per cycle show what that costs. The on-chip source needs no store."""
+    """Four buses (DLP9500, 1080p clears): the store gives one 64-bit word per cycle, a half
+    (200 MHz) or a quarter (400 MHz) of a cycle's DLP9500 beats, so rows come every two or four
+    row cycles (``row_period``); the same plans with rows at the row cycle
+    (:func:`spec.schedule.row_rate_words`) show what that costs. The on-chip source needs no
+    store."""
     d = DMDS["dlp9500"]
+    row_rate = schedule.row_rate_words(d, f)
     gray = schedule.plan(d, f)
     mem = schedule.plan(d, f, depth=1, chain=True)
     return {
         f"seq.row_period_cycles_dlp9500_store{sfx}": (gray.params.row_period, "cycle"),
         f"seq.gray8_rate_hz_dlp9500_global{sfx}_model": (gray.rate_hz, "Hz"),
         f"seq.gray8_rate_hz_dlp9500_global_at_row_rate{sfx}_model": (
-            schedule.plan(d, f, words_per_cycle=2.0).rate_hz, "Hz"),
+            schedule.plan(d, f, words_per_cycle=row_rate).rate_hz, "Hz"),
         f"seq.gray8_bound_hz_dlp9500{sfx}": (schedule.bound(d, f), "Hz"),
         f"seq.binary_rate_hz_memory_dlp9500{sfx}_model": (mem.rate_hz, "Hz"),
         f"seq.binary_rate_hz_memory_dlp9500_at_row_rate{sfx}_model": (
-            schedule.plan(d, f, depth=1, chain=True, words_per_cycle=2.0).rate_hz, "Hz"),
+            schedule.plan(d, f, depth=1, chain=True, words_per_cycle=row_rate).rate_hz, "Hz"),
         f"seq.binary_rate_hz_prng_dlp9500{sfx}_model": (
             schedule.plan(d, f, depth=1, chain=True, source=Source.PRNG).rate_hz, "Hz"),
         f"seq.binary_rate_hz_prng_dlp9500_phased_loose{sfx}_model": (
@@ -243,16 +246,18 @@ def run():
     for mhz in (200, 400):
         f = mhz * 1e6
         sfx = "" if mhz == 200 else "_400mhz"
-        glob = schedule.plan(XGA, f)
-        quad = schedule.plan(XGA, f, reset_mode=ResetMode.QUAD)
-        single_loose = schedule.plan(XGA, f, reset_mode=ResetMode.SINGLE, strict_rst=False)
+        # rows at the row cycle (the rates bench plays these plans: sim.bench.rates)
+        row_rate = {"words_per_cycle": schedule.row_rate_words(XGA, f)}
+        glob = schedule.plan(XGA, f, **row_rate)
+        quad = schedule.plan(XGA, f, reset_mode=ResetMode.QUAD, **row_rate)
+        single_loose = schedule.plan(XGA, f, reset_mode=ResetMode.SINGLE, strict_rst=False, **row_rate)
         figures[f"seq.gray8_rate_hz_dlp7000_global{sfx}_model"] = (glob.rate_hz, "Hz")
         figures[f"seq.gray8_frame_cycles_dlp7000_global{sfx}"] = (glob.frame_cycles, "cycle")
         figures[f"seq.gray8_lsb_cycles_dlp7000_global{sfx}"] = (glob.params.lsb, "cycle")
         figures[f"seq.gray8_rate_hz_dlp7000_phased{sfx}_model"] = (quad.rate_hz, "Hz")
         figures[f"seq.gray8_lsb_cycles_dlp7000_phased{sfx}"] = (quad.params.lsb, "cycle")
         figures[f"seq.gray8_stagger_cycles_dlp7000_phased{sfx}"] = (quad.params.stagger, "cycle")
-        dual = schedule.plan(XGA, f, reset_mode=ResetMode.DUAL)
+        dual = schedule.plan(XGA, f, reset_mode=ResetMode.DUAL, **row_rate)
         figures[f"seq.gray8_rate_hz_dlp7000_phased_dual{sfx}_model"] = (dual.rate_hz, "Hz")
         figures[f"seq.gray8_rate_hz_dlp7000_phased_single_loose{sfx}_model"] = (single_loose.rate_hz, "Hz")
         figures[f"seq.gray8_bound_hz_dlp7000{sfx}"] = (schedule.bound(XGA, f), "Hz")

@@ -56,7 +56,10 @@ Assumptions where the TI documents are uncertain (see also ``docs/dlpc410_model.
   (default) no pulse may start while RST_ACTIVE is high; with it off, a pulse may start while
   RST_ACTIVE is high from a pulse of other blocks, never of its own blocks.
 * Settle: any write (row or clear) to a block from its pulse until ``settle_cycles`` after its
-  RST_ACTIVE fell breaks the rule, whether or not the data differ.
+  RST_ACTIVE fell breaks the rule, whether or not the data differ (TI's reading, the default).
+  Under the four-DMD paper's reading (``reading="paper"``, never the default) a write breaks it
+  only while RST_ACTIVE is high, and a block's pulse sooner than ``settle_cycles`` after its last
+  breaks ``flip``.
 * Initialisation: INIT_ACTIVE is high while ARSTZ is low and for ``init_cycles`` after ARSTZ
   rises (counting from ECP2_FINISHED if that comes later). The training pattern (DLPC410
   datasheet: a repeating ``0100`` on every data pin, any phase; four edges = two cycles) must be on
@@ -84,7 +87,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gateware.dlpc410.beat import PINS_PER_BUS, lanes_to_word
-from spec.facts import TIMING, BlockMode, RowMode
+from spec.facts import SETTLE_READINGS, TIMING, BlockMode, RowMode
 
 __all__ = ["Rule", "RULES", "RuleBreak", "Command", "Dlpc410", "timing_cycles",
            "INPUTS", "OUTPUTS", "amaranth_process", "CocotbAdapter"]
@@ -109,6 +112,7 @@ class RuleBreak(AssertionError):
 _RULES = [
     Rule("rst_active", "DLPC410 RST_ACTIVE (forum)", "pulse while RST_ACTIVE"),
     Rule("settle", "DLPA008B 4.1", "settle"),
+    Rule("flip", "four-DMD eq. 6-7 (the paper's settle reading)", "pulse while the block settles"),
     Rule("clear_overlap", "DLPA008B 4.2", "clear overlapping a row load"),
     Rule("dvalid_gap", "DLPU045A", "odd DVALID idle gap"),
     Rule("row_cycle", "DLPC410 row addressing", "row cycle cut short"),
@@ -197,6 +201,11 @@ class Dlpc410:
         A restart mid-run (see the module's notes); ``restart_at`` None: none.
     strict_rst_active : bool
         No pulse at all while RST_ACTIVE is high (default), or only none of the same blocks.
+    reading : str
+        What the settle time forbids (a key of :data:`spec.facts.SETTLE_READINGS`): ``"ti"``
+        (default), any change to a pulsed block's memory until ``settle_cycles`` after RST_ACTIVE
+        falls; ``"paper"``, only the block's next pulse sooner than ``settle_cycles`` after its
+        last (its memory may change once RST_ACTIVE falls).
     check_training : bool
         Require the training pattern during initialisation.
     keep_history : bool
@@ -222,7 +231,7 @@ class Dlpc410:
     def __init__(self, dmd, *, beats=1, clock_hz=200e6, rst_active_cycles=None, settle_cycles=None,
                  init_cycles=None, init_to_dvalid_clocks=None, init_grace_cycles=0, ecp2_cycles=4,
                  strict_rst_active=True, check_training=True, keep_history=True, ddc_version=0,
-                 restart_at=None, restart_cycles=0, restart_ecp2_cycles=0, restart_grace_cycles=4):
+                 restart_at=None, restart_cycles=0, restart_ecp2_cycles=0, restart_grace_cycles=4, reading="ti"):
         if dmd.bits_per_dclk % 64:
             raise ValueError(f"{dmd.name}: {dmd.bits_per_dclk} bits per DCLK is not modelled")
         if dmd.dclk_per_row % beats:
@@ -242,6 +251,7 @@ class Dlpc410:
         self.restart_at, self.restart_cycles = restart_at, restart_cycles
         self.restart_ecp2_cycles, self.restart_grace_cycles = restart_ecp2_cycles, restart_grace_cycles
         self.strict_rst_active = strict_rst_active
+        self.reading = SETTLE_READINGS[reading]
         self.check_training = check_training
         self.keep_history = keep_history
         self.ddc_version = ddc_version
@@ -542,6 +552,8 @@ class Dlpc410:
     def _pulse(self, c, blkmd, blkad, rst2blkz):
         kind, blocks = self._blocks(c, blkmd, blkad, rst2blkz)
         self._check_rst_active(c, blocks)
+        if self.reading.flip:
+            self._check_flip(c, blocks)
         for b in blocks:
             self._last_pulse[b] = c
             self.pulse_cycles[b].append(c)
@@ -592,12 +604,19 @@ class Dlpc410:
                                 f"pulse of block {b} {c - p} cycles after its own pulse, while its "
                                 f"RST_ACTIVE is high ({self.rst_active_cycles} cycles)")
 
+    def _check_flip(self, c, blocks):
+        for b in blocks:
+            p = self._last_pulse[b]
+            if p is not None and c < p + self.settle_cycles:
+                raise RuleBreak(RULES["flip"], c, f"pulse of block {b} {c - p} cycles after its last, "
+                                                  f"needs {self.settle_cycles}")
+
     def _check_settle(self, c, block, what, verb):
         p = self._last_pulse[block]
         if p is None:
             return
         fall = p + self.rst_active_cycles + 1
-        if c < fall + self.settle_cycles:
+        if c < fall + (self.settle_cycles if self.reading.frozen else 0):
             when = (f"{c - fall} cycles after RST_ACTIVE fell" if c >= fall
                     else f"{c - p} cycles after its pulse, while RST_ACTIVE is high")
             raise RuleBreak(RULES["settle"], c,

@@ -59,9 +59,12 @@ class Run:
 
 def dlpc410_for(dmd, p, *, init_cycles=INIT_CYCLES, ecp2_cycles=4):
     """The rule model with the RST_ACTIVE and settle times ``p`` (schedule Params) was planned
-    for (``t_rst`` covers RST_ACTIVE plus :data:`~spec.schedule.RST_MARGIN`), at its beats."""
+    for (``t_rst`` covers RST_ACTIVE plus :data:`~spec.schedule.RST_MARGIN`), at its beats, and
+    under the settle reading it was planned for (the paper's when ``p.t_flip``)."""
+    paper = p.t_flip > 0
     return Dlpc410(dmd, beats=p.beats, clock_hz=FABRIC_HZ, rst_active_cycles=p.t_rst - RST_MARGIN,
-                   settle_cycles=p.t_settle, init_cycles=init_cycles, init_grace_cycles=INIT_GRACE,
+                   settle_cycles=p.t_flip if paper else p.t_settle, reading="paper" if paper else "ti",
+                   init_cycles=init_cycles, init_grace_cycles=INIT_GRACE,
                    ecp2_cycles=ecp2_cycles, strict_rst_active=p.strict_rst)
 
 
