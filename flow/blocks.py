@@ -71,6 +71,12 @@ def _register_crossing():
     return RegisterCrossing(schedule.plan(dmd, 200e6).params.registers(dmd))
 
 
+def _sync_master():
+    from gateware.sync.master import SyncMaster
+    from gateware.top.sync_master import BOARDS
+    return SyncMaster(BOARDS)
+
+
 #: Each block under one name: its class's, in snake case (``res.<name>.*``, ``blocks/<name>.v``).
 BLOCKS = {
     "receive_path": _receive_path,
@@ -87,6 +93,7 @@ BLOCKS = {
     # the whole core for the four-bus DMD (no board carries it yet: no platform top to count)
     "core_dlp9500": lambda: core("dlp9500"),
     "register_crossing": _register_crossing,
+    "sync_master": _sync_master,
 }
 
 

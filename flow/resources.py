@@ -60,7 +60,8 @@ def synthesise(verilog_path, top, *, iopads=False, blackboxes=(), flatten=False)
 
 
 def report(outdir="build/spartan6"):
-    """Synthesise every block (and the platform top); returns {name: counts}."""
+    """Synthesise every block, the platform top (``total``) and the sync master's board top
+    (``sync_master_board``); returns {name: counts}."""
     from flow.verilog import emit_blocks, emit_platform
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
@@ -77,6 +78,11 @@ def report(outdir="build/spartan6"):
     # flattened: the WebAssembly ABC fails on the whole hierarchy of the projector's top
     results["total"] = count(synthesise(outdir / f"{top}.v", top, iopads=True, blackboxes=[blackbox], flatten=True))
     results["total"]["top"] = top
+    # the sync master's own build (a tiled display's main control board), pads included
+    from flow.verilog import emit_sync_master
+    master = emit_sync_master(outdir / "sync_master")
+    results["sync_master_board"] = count(synthesise(outdir / "sync_master" / f"{master}.v", master, iopads=True,
+                                                    flatten=True))
     return results
 
 

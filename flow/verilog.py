@@ -2,7 +2,9 @@
 
 ``build/spartan6/`` receives what Amaranth's Xilinx platform writes for ISE (``<top>.v``,
 ``<top>.ucf``, ``<top>.prj``, ``<top>.xst``, ``build_<top>.sh``) without running ISE, plus
-``blocks/<block>.v`` for every block in :data:`flow.blocks.BLOCKS`.
+``blocks/<block>.v`` for every block in :data:`flow.blocks.BLOCKS`; ``sync_master/`` the same
+for the sync master's own build (a tiled display's main control board,
+:mod:`gateware.top.sync_master`).
 """
 
 import subprocess
@@ -12,7 +14,7 @@ from amaranth.back import verilog as amaranth_verilog
 
 from flow.blocks import BLOCKS
 
-__all__ = ["emit_blocks", "emit_platform", "lint", "main"]
+__all__ = ["emit_blocks", "emit_platform", "emit_sync_master", "lint", "main"]
 
 
 def block_verilog(name):
@@ -52,6 +54,13 @@ def emit_platform(outdir):
     return name
 
 
+def emit_sync_master(outdir):
+    """The sync master's ISE tree in ``outdir``; returns its top's name."""
+    from gateware.top.sync_master import SyncMasterPlatform, SyncMasterTop
+    SyncMasterPlatform().build(SyncMasterTop(), name="sync_master", do_build=False).extract(str(outdir))
+    return "sync_master"
+
+
 def lint(paths):
     """Verilator ``--lint-only`` on each file; returns {name: (ok, messages)}."""
     from sim.harness.cocotb_run import VERILATOR_ARGS, setup_verilator
@@ -70,10 +79,12 @@ def main(outdir="build/spartan6"):
     outdir.mkdir(parents=True, exist_ok=True)
     top = emit_platform(outdir)
     blocks = emit_blocks(outdir)
-    print(f"Spartan-6 ISE tree for top '{top}' in {outdir}/:")
-    for path in sorted(outdir.iterdir()):
-        if path.is_file():
-            print(f"  {path.name}")
+    master = emit_sync_master(outdir / "sync_master")
+    for name, where in ((top, outdir), (master, outdir / "sync_master")):
+        print(f"Spartan-6 ISE tree for top '{name}' in {where}/:")
+        for path in sorted(where.iterdir()):
+            if path.is_file():
+                print(f"  {path.name}")
     print(f"block Verilog in {outdir}/blocks/: {', '.join(sorted(blocks))}")
     failed = False
     for name, (ok, messages) in lint(blocks).items():

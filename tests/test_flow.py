@@ -28,6 +28,25 @@ def test_ise_tree_has_verilog_ucf_and_scripts():
         assert primitive in v, primitive
 
 
+def test_sync_master_tree_drives_every_board_from_a_pad_flip_flop():
+    """The sync master's own build: a sync line per board and the camera trigger, each from a
+    flip-flop ISE must pack into its pad (the pulses leave within the pads' skew)."""
+    from gateware.top.sync_master import BOARDS
+    out = build_dir("test_flow", "sync_master")
+    top = verilog.emit_sync_master(out)
+    ucf = (out / f"{top}.ucf").read_text()
+    outputs = [f"board_sync_{k}__io" for k in range(BOARDS)] + ["camera_trigger_out_0__io"]
+    for name in outputs + [f"board_ready_{k}__io" for k in range(BOARDS)] + ["frame_trigger_in_0__io"]:
+        assert f'NET "{name}" LOC=' in ucf, name
+    for name in outputs:
+        assert f'NET "{name}" SLEW=FAST;' in ucf, name
+    # each output's buffer module holds its flip-flop, marked for the pad
+    modules = {text.split("(")[0].strip(): text for text in (out / f"{top}.v").read_text().split("\nmodule ")[1:]}
+    for buffer in [f"sync{k}" for k in range(BOARDS)] + ["camera"]:
+        assert '(* IOB = "TRUE" *)' in modules[f"\\sync_master.{buffer}"], buffer
+    assert not any("IOB" in text for name, text in modules.items() if "ready" in name or "switches" in name)
+
+
 @pytest.mark.parametrize("name", sorted(BLOCKS))
 def test_block_lint_clean(name):
     """Each block's Verilog (one test each, so that the large ones spread over the workers)."""
