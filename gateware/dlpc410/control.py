@@ -68,6 +68,9 @@ class FrameControl(wiring.Component):
         The planner's commands (see :class:`~gateware.dlpc410.planner.Planner`).
     running : Out(1)
         The groups run (pulses and loads may be made).
+    ready : Out(1)
+        A trigger now would be obeyed at once: a frame is loaded in every group, none plays, no
+        newer frame is being taken and no trigger is held (a sync master's ready line).
     flushing : Out(1)
         Stale loads are being dropped.
     triggers, overruns, early, held : Out(COUNTER_BITS)
@@ -96,6 +99,7 @@ class FrameControl(wiring.Component):
             "trigger": Out(event(TIME_BITS)),
             "queue_first": Out(event(gb)),
             "running": Out(1),
+            "ready": Out(1),
             "flushing": Out(1),
             "triggers": Out(COUNTER_BITS),
             "overruns": Out(COUNTER_BITS),
@@ -189,6 +193,7 @@ class FrameControl(wiring.Component):
         holding = Signal()
         ready = self.running & self.all_ready & ~take_idle
         release = holding & ready
+        m.d.comb += self.ready.eq(ready & ~holding)
 
         def obey():
             m.d.comb += [self.trigger.valid.eq(1), self.trigger.payload.eq((now + 2) & ~1)]

@@ -83,6 +83,9 @@ class Sequencer(wiring.Component):
     camera_out : Out(1)
         Camera trigger: ``camera_width`` cycles, starting ``camera_offset`` cycles after the
         frame's first clocking pulse appears on the pins.
+    ready : Out(1)
+        A trigger (or sync pulse) now would be obeyed at once: every group holds its first plane
+        and waits (the ready line a tiled display's sync master reads).
     frames : In(stream.Signature(FrameInfo))
         The newest complete frame; taken when a new frame is due (else the last one repeats),
         or, triggered and not chained, as soon as every group waits loaded for a trigger: the
@@ -121,6 +124,7 @@ class Sequencer(wiring.Component):
             "soft_trigger": In(1),
             "sync_out": Out(1),
             "camera_out": Out(1),
+            "ready": Out(1),
             "frames": In(stream.Signature(FrameInfo)),
             "requests": Out(stream.Signature(PlaneRequest)),
             "words": In(stream.Signature(64 * store_words)),
@@ -187,6 +191,7 @@ class Sequencer(wiring.Component):
             control.strobe.eq(trig.strobe),
             control.reload.eq(self.reload),
             self.at_rest.eq(control.at_rest),
+            self.ready.eq(control.ready),
             control.offer.eq(planner.offer),
             control.all_ready.eq(planner.all_ready),
             control.playing.eq(planner.playing),

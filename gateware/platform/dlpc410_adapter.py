@@ -66,10 +66,13 @@ def dlpc410_resources():
 
 
 def trigger_resources():
-    """Trigger in, sync out, camera trigger out on PMOD JB (pins 1, 2, 3)."""
+    """Trigger in, sync out, camera trigger out, sync in (from a tiled display's sync master) and
+    the ready line back to it on PMOD JB (pins 1, 2, 3, 4, 7)."""
     io = Attrs(IOSTANDARD="LVCMOS33")
     return [
         Resource("trigger_in", 0, Pins("1", dir="i", conn=("pmod", 0)), io),
         Resource("sync_out", 0, Pins("2", dir="o", conn=("pmod", 0)), io),
         Resource("camera_trigger_out", 0, Pins("3", dir="o", conn=("pmod", 0)), io),
+        Resource("sync_in", 0, Pins("4", dir="i", conn=("pmod", 0)), io),
+        Resource("ready_out", 0, Pins("7", dir="o", conn=("pmod", 0)), io),
     ]

@@ -161,28 +161,36 @@ class Dlpc410Pins(Elaboratable):
 
 
 class TriggerPins(Elaboratable):
-    """Trigger in (IOB register on ``dmd``), sync out and camera-trigger out (IOB registers).
+    """Trigger and sync in (IOB registers on ``dmd``), sync out, camera-trigger out and the
+    ready line to a sync master (IOB registers).
 
-    The input's IOB register is the first synchronising stage; the core adds the rest.
+    The inputs' IOB registers are the first synchronising stage; the core adds the rest.
 
     Attributes
     ----------
-    trigger : Signal, to the core (``dmd``, one IOB stage, not yet synchronised)
-    sync, camera : Signal, from the core
+    trigger, sync_in : Signal, to the core (``dmd``, one IOB stage, not yet synchronised)
+    sync, camera, ready : Signal, from the core
     """
 
     def __init__(self):
         self.trigger = Signal()
+        self.sync_in = Signal()
         self.sync = Signal()
         self.camera = Signal()
+        self.ready = Signal()
 
     def elaborate(self, platform):
         m = Module()
-        m.submodules.trigger = trig = io.FFBuffer("i", platform.request("trigger_in", 0, dir="-"), i_domain="dmd")
-        m.submodules.sync = sync = io.FFBuffer("o", platform.request("sync_out", 0, dir="-"), o_domain="dmd")
-        m.submodules.camera = cam = io.FFBuffer(
-            "o", platform.request("camera_trigger_out", 0, dir="-"), o_domain="dmd")
-        m.d.comb += [self.trigger.eq(trig.i), sync.o.eq(self.sync), cam.o.eq(self.camera)]
+
+        def pad(direction, name):
+            buffer = io.FFBuffer(direction, platform.request(name, 0, dir="-"),
+                                 **{f"{direction}_domain": "dmd"})
+            m.submodules[name] = buffer
+            return buffer
+        trig, sync_in = pad("i", "trigger_in"), pad("i", "sync_in")
+        sync, cam, ready = pad("o", "sync_out"), pad("o", "camera_trigger_out"), pad("o", "ready_out")
+        m.d.comb += [self.trigger.eq(trig.i), self.sync_in.eq(sync_in.i), sync.o.eq(self.sync),
+                     cam.o.eq(self.camera), ready.o.eq(self.ready)]
         return m
 
 

@@ -81,8 +81,10 @@ class PlatformTop(Elaboratable):
         wiring.connect(m, projector.dlpc, dlpc.bus)
         m.d.comb += [
             projector.trigger_in.eq(trigger.trigger),
+            projector.sync_in.eq(trigger.sync_in),
             trigger.sync.eq(projector.sync_out),
             trigger.camera.eq(projector.camera_out),
+            trigger.ready.eq(projector.ready_out),
         ]
         # ---- DDR2 through the memory controller ----------------------------------------------
         m.submodules.mcb = mcb = McbInstance(port0_domain="sync", port1_domain="dmd")

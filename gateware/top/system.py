@@ -91,6 +91,9 @@ class Projector(wiring.Component):
         TTL trigger and sync inputs (asynchronous).
     sync_out, camera_out : Out(1)
         Frame shown; camera trigger (``dmd``).
+    ready_out : Out(1)
+        A trigger or sync pulse now would be obeyed at once (``dmd``): the ready line to a tiled
+        display's sync master.
     shown : Out(ShownFrame)
         The frame shown last (``dmd``); its id also reaches the status reply (``shown_frame``).
     """
@@ -120,6 +123,7 @@ class Projector(wiring.Component):
             "sync_in": In(1),
             "sync_out": Out(1),
             "camera_out": Out(1),
+            "ready_out": Out(1),
             "shown": Out(ShownFrame),
         })
 
@@ -180,6 +184,7 @@ class Projector(wiring.Component):
             seq.sync_in.eq(self.sync_in),
             self.sync_out.eq(seq.sync_out),
             self.camera_out.eq(seq.camera_out),
+            self.ready_out.eq(seq.ready),
         ]
         m.submodules.soft_trigger = soft = PulseSynchronizer(i_domain="sync", o_domain="dmd")
 
