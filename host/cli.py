@@ -9,6 +9,7 @@ projector took every record (``--no-check`` not to)."""
 
 import argparse
 import dataclasses
+import json
 import sys
 
 import numpy as np
@@ -110,6 +111,15 @@ def main(argv=None):
                            f"sent when at most this fraction of its rows changed (e.g. {DELTA_ROWS}); "
                            "default 0: whole frames")
     send.add_argument("--no-check", action="store_true", help="do not check the status after each frame")
+    play = sub.add_parser("sequence", help="store images as a sequence and play it by an entry table")
+    play.add_argument("images", nargs="+", help=".npy or image files, grey: frame k goes to slot k")
+    play.add_argument("--entries", required=True,
+                      help="JSON file: a list of entries, each {\"slot\": k} with optional \"lsb\", \"dark\" "
+                           "(cycles), \"follow\", \"camera\" (see docs/protocol.md)")
+    play.add_argument("--once", action="store_true", help="play the entries once (default: in a loop)")
+    play.add_argument("--depth", type=int, default=None, help="bit depth, 1..8 (default: as send chooses)")
+    play.add_argument("--rate", type=float, default=100e6, help="pacing in bytes per second")
+    play.add_argument("--mtu", type=int, default=None, help="IP MTU of the path to the projector")
     configure = sub.add_parser("configure", help="plan a schedule, say the rate it reaches, send it")
     configure.add_argument("--dmd", default="dlp7000", choices=sorted(DMDS))
     configure.add_argument("--dclk", type=float, default=400e6,
@@ -165,6 +175,13 @@ def main(argv=None):
                           f"rounding error {frame.error_lsb:.3g} LSB{kind}")
                 print(f"sent {len(images)} frame(s) in {sum(f.records for f in sent)} records "
                       f"of at most {client.limit} bytes (MTU {client.mtu})")
+            elif args.command == "sequence":
+                with open(args.entries) as f:
+                    entries = json.load(f)
+                sent = client.play_sequence([_load(path) for path in args.images], entries, loop=not args.once,
+                                            depth=args.depth)
+                print(f"sequence of {len(sent)} frames stored; {len(entries)} entries played "
+                      f"{'once' if args.once else 'in a loop'} from the next trigger")
             elif args.command == "configure":
                 client.configure(plan, dmd)
                 client.control(bit_depth=args.depth)

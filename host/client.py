@@ -358,6 +358,32 @@ class Client:
         if "bit_depth" in config:
             self._depth = config["bit_depth"]
 
+    def play_sequence(self, images, entries, *, loop=True, depth=None, tolerance=0.5):
+        """Store ``images`` as a sequence (frame ``k`` in slot ``k``) and play it by an entry
+        table: ``entries``, each a dict of :func:`host.codec.entry_record`'s settings with its
+        ``slot`` (``lsb``, ``dark``, ``follow``, ``camera``; see ``docs/protocol.md``), in a loop
+        or once. The table and the control record that plays it go first, then the frames, so
+        that the projector gives out nothing before both are in; each frame is checked as
+        :meth:`send_image` checks it. Returns the :class:`Sent` of each image."""
+        if not 2 <= len(images) <= 16:
+            raise ClientError(f"a stored sequence holds 2 to 16 frames, not {len(images)}")
+        if not 1 <= len(entries) <= records.ENTRIES:
+            raise ClientError(f"an entry table holds 1 to {records.ENTRIES} entries, not {len(entries)}")
+        outside = [e["slot"] for e in entries if not 0 <= e["slot"] < len(images)]
+        if outside:
+            raise ClientError(f"entries name slots {outside} outside the sequence of {len(images)} frames")
+        settings = [{k: v for k, v in entry.items() if k != "slot"} for entry in entries]
+        for index, (entry, extra) in enumerate(zip(entries, settings, strict=True)):
+            try:            # checked before anything is sent
+                codec.entry_record(index, entry["slot"], **extra)
+            except ValueError as error:
+                raise ClientError(f"entry {index}: {error}") from None
+        self.control(sequence_length=len(images))
+        for index, (entry, extra) in enumerate(zip(entries, settings, strict=True)):
+            self._send(codec.entry_record(index, entry["slot"], self._next(), **extra))
+        self._send(codec.control_record(self._next(), entries=len(entries), loop=int(loop), sequence_start=True))
+        return [self.send_image(image, k, depth=depth, tolerance=tolerance) for k, image in enumerate(images)]
+
     def configure(self, plan, dmd):
         """Send the register set of a :func:`spec.schedule.plan` (checked as the
         projector checks it, and a periodic trigger against the plan's frame period:

@@ -7,7 +7,8 @@ from spec.records import Action, RecordType
 from spec.schedule import row_cycles
 
 __all__ = ["ProtocolError", "header", "image_record", "image_records", "changed_rows", "sequence_records",
-           "pixels_per_record", "control_record", "sequencer_record", "status_query", "status_reply", "decode",
+           "pixels_per_record", "control_record", "sequencer_record", "entry_record", "status_query",
+           "status_reply", "decode",
            "SEQUENCE_MASK", "DEFAULT_LIMIT"]
 
 #: Record sequence numbers wrap at this mask.
@@ -100,15 +101,16 @@ def sequence_records(images, first_frame=0, *, sequence=0, limit=DEFAULT_LIMIT):
     return out
 
 
-def control_record(sequence=0, *, software_trigger=False, **config):
+def control_record(sequence=0, *, software_trigger=False, sequence_start=False, **config):
     """A control record setting the given :data:`~spec.records.CONFIG` fields
-    (others unchanged) and optionally firing a software trigger."""
+    (others unchanged) and optionally firing a software trigger or playing the sequence's
+    entries from the first (``sequence_start``, after the fields are set)."""
     names = [name for name, _ in records.CONFIG]
     unknown = set(config) - set(names)
     if unknown:
         raise KeyError(f"not a configuration field: {sorted(unknown)}")
     apply = sum(1 << names.index(name) for name in config)
-    action = Action.SOFTWARE_TRIGGER if software_trigger else 0
+    action = (Action.SOFTWARE_TRIGGER if software_trigger else 0) | (Action.SEQUENCE_START if sequence_start else 0)
     body = wire.pack(records.CONTROL, {"apply": apply, "action": int(action), **config})
     return header(RecordType.CONTROL, sequence) + body
 
@@ -133,6 +135,21 @@ def sequencer_record(registers, sequence=0, *, dmd=None, beats=1):
     return header(RecordType.SEQUENCER, sequence) + body
 
 
+def entry_record(index, slot, sequence=0, *, lsb=0, dark=0, follow=False, camera=True):
+    """A sequence entry record: entry ``index`` shows the frame of ``slot`` with a least
+    significant plane of ``lsb`` cycles (0: the sequencer's register), at least ``dark`` cycles
+    dark after it before a frame that follows it, following the frame before it with no trigger
+    (``follow``) or waiting for one, with a camera trigger or none. Raises :class:`ValueError`
+    on what the projector would drop (:func:`spec.records.entry_faults`, but the slot's check
+    against the sequence in force)."""
+    fields = {"index": index, "slot": slot, "lsb": lsb, "dark": dark, "follow": int(follow),
+              "camera_off": int(not camera)}
+    failed = [check for check, bad in records.entry_faults(fields, 1 << 8).items() if bad]
+    if failed:
+        raise ValueError(f"the projector cannot take this entry: {', '.join(failed)}")
+    return header(RecordType.ENTRY, sequence) + wire.pack(records.ENTRY, fields)
+
+
 def status_query(sequence=0):
     return header(RecordType.STATUS_QUERY, sequence)
 
@@ -148,6 +165,7 @@ _BODIES = {
     RecordType.STATUS_QUERY: [],
     RecordType.STATUS_REPLY: records.STATUS_REPLY,
     RecordType.SEQUENCER: records.SEQUENCER,
+    RecordType.ENTRY: records.ENTRY,
 }
 
 

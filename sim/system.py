@@ -66,11 +66,12 @@ def core(p):
                      armed=False, mdio_cycles=(40, 10))
 
 
-def run(key="test", **overrides):
-    """Build and run the system testbench; returns its report (dict)."""
-    report = build_dir("system") / f"{key}.json"
+def run(key="test", testcase="frames_over_gmii_are_shown_exactly", **overrides):
+    """Build and run one test of the system testbench (``testcase``); returns its report (dict)."""
+    report = build_dir("system") / f"{key}-{testcase}.json"
     p = {**PARAMS, **overrides, "report": str(report)}
-    build = cocotb_run.run(core(p), toplevel="projector", module="sim.tb.system", key=key, params=p)
+    build = cocotb_run.run(core(p), toplevel="projector", module="sim.tb.system", key=key, params=p,
+                           testcase=testcase)
     result = json.loads(report.read_text())
     result["build"] = str(build)
     return result

@@ -14,8 +14,9 @@ store's bit depth and sequence, arming, the network addresses.
 """
 
 __all__ = [
-    "MAGIC", "VERSION", "RecordType", "Action",
-    "HEADER", "IMAGE", "CONTROL", "CONFIG", "SEQUENCER", "NET_COUNTERS", "RECORD_COUNTERS",
+    "MAGIC", "VERSION", "RecordType", "Action", "ENTRIES",
+    "HEADER", "IMAGE", "CONTROL", "CONFIG", "SEQUENCER", "ENTRY", "entry_faults", "config_faults",
+    "NET_COUNTERS", "RECORD_COUNTERS",
     "ROW_COUNTERS", "GEOMETRY", "APP_COUNTERS", "SYSTEM_STATUS", "STATUS_REPLY", "IMAGE_HEADER",
     "MAX_RECORD", "UDP_IP_OVERHEAD", "record_limit", "frame_newer",
     "register_wire", "registers_bits", "register_faults",
@@ -32,7 +33,7 @@ from .wire import size
 MAGIC = 0x444D
 #: Protocol version this tree speaks; records with any other version are dropped and counted.
 #: ``magic`` and ``version`` keep their places in every version, so that a projector can tell.
-VERSION = 4
+VERSION = 5
 #: IPv4 and UDP headers around a record: a record fills an MTU less these.
 UDP_IP_OVERHEAD = 28
 #: Largest record: a UDP payload inside a 9000-byte IP MTU (9000 - 20 IPv4 - 8 UDP).
@@ -45,10 +46,16 @@ class RecordType(_enum.IntEnum):
     STATUS_QUERY = 3
     STATUS_REPLY = 4
     SEQUENCER = 5
+    ENTRY = 6
 
 
 class Action(_enum.IntFlag):
     SOFTWARE_TRIGGER = 1
+    SEQUENCE_START = 2       # play the sequence's entries from the first
+
+
+#: Entries a sequence's table holds (entry records' ``index`` below it).
+ENTRIES = 256
 
 
 #: Common header of every record. A record is a whole UDP payload: its length is the datagram's.
@@ -77,6 +84,8 @@ CONFIG = [
     ("bit_depth", 8),        # 1..8 planes stored per frame
     ("armed", 8),            # 1: triggers reach the sequencer; 0: every trigger source is ignored
     ("sequence_length", 16), # frame slots in the sequence (1 = a single frame, streamed)
+    ("entries", 16),         # entries of the sequence's table played (0: its slots in order)
+    ("loop", 8),             # 1: the entries play in a loop; 0: once, then triggers are ignored
     ("mac", 48),             # our MAC address
     ("ip", 32),              # our IPv4 address
     ("port", 16),            # our UDP port
@@ -90,6 +99,19 @@ CONTROL = [("apply", 16), ("action", 8)] + CONFIG
 #: widened to whole bytes (the high bits must be zero). An enum field carries its value;
 #: ``order_table`` carries entry ``j`` in bits ``3j..3j+2``.
 SEQUENCER = [(f.name, -(-f.bits // 8) * 8) for f in _registers.FIELDS]
+
+#: Sequence entry record body: entry ``index`` of the sequence's table shows the frame of slot
+#: ``slot`` with a least significant plane of ``lsb`` cycles (0: the sequencer register's), at
+#: least ``dark`` cycles dark after it before a frame that follows it, and it ``follow``s the
+#: frame before it with no trigger (1) or waits for one (0); ``camera_off`` 1: no camera trigger.
+ENTRY = [
+    ("index", 16),
+    ("slot", 8),
+    ("lsb", 24),
+    ("dark", 24),
+    ("follow", 8),
+    ("camera_off", 8),
+]
 
 #: Counters kept by the network stack (frames, by outcome).
 NET_COUNTERS = [
@@ -128,7 +150,8 @@ RECORD_COUNTERS = [
     ("drop_app_empty", 32),    # an image record without pixels
     ("drop_app_length", 32),   # the datagram shorter than its type's header, or not its type's size
     ("drop_app_rows", 32),     # pixels beyond the frame
-    ("drop_app_value", 32),    # a control or sequencer record with a value it cannot obey
+    ("drop_app_value", 32),    # a control, sequencer or entry record with a value it cannot obey
+    ("records_entry", 32),     # sequence entry records written to the table
     ("sequence_gaps", 32),     # records whose sequence number was not the previous + 1
 ]
 
@@ -187,6 +210,8 @@ SYSTEM_STATUS = [
     ("rst_active_cycles_max", 32),     # the longest RST_ACTIVE seen, in dmd cycles from a pulse: the t_rst to plan with
     ("frames_period_short", 32),       # frames the periodic trigger started whose planes outlast its period
     ("store_rows_no_base", 32),        # rows of a delta refused: its base is not a whole frame the store holds
+    ("triggers_after_end", 32),        # triggers ignored: a sequence played once had ended
+    ("sequence_entries_skipped", 32),  # sequence entries skipped: their slot is outside the sequence
 ]
 
 #: Status reply body (after :data:`HEADER`).
@@ -240,6 +265,32 @@ def register_faults(wire, row_cycles, clear_row_cycles):
     faults["period_keepable"] = ((wire["trigger"] == _registers.TriggerMode.PERIODIC.value)
                                  & (wire["period"] < wire["lsb"]))
     return faults
+
+
+def entry_faults(wire, sequence_length):
+    """Why an entry record cannot be written (``{check: condition}``, as
+    :func:`register_faults`): its index beyond the table, a slot outside the sequence in force
+    (``sequence_length``), an odd time, a flag other than 0 or 1."""
+    return {
+        "index": wire["index"] >= ENTRIES,
+        "slot": wire["slot"] >= sequence_length,
+        "lsb_even": (wire["lsb"] & 1) != 0,
+        "dark_even": (wire["dark"] & 1) != 0,
+        "follow": wire["follow"] > 1,
+        "camera_off": wire["camera_off"] > 1,
+    }
+
+
+def config_faults(wire, applies):
+    """Why a control record cannot be applied (``{check: condition}``): a field it applies
+    (``applies(name)`` true) holds a value nothing obeys."""
+    return {
+        "bit_depth": applies("bit_depth") & ((wire["bit_depth"] == 0) | (wire["bit_depth"] > 8)),
+        "armed": applies("armed") & (wire["armed"] > 1),
+        "sequence_length": applies("sequence_length") & (wire["sequence_length"] == 0),
+        "entries": applies("entries") & (wire["entries"] > ENTRIES),
+        "loop": applies("loop") & (wire["loop"] > 1),
+    }
 
 
 #: Bytes of an image record before its pixels.

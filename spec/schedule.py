@@ -175,12 +175,19 @@ class Params:
 @dataclass
 class Frame:
     """A frame the store offers: its slot, bit depth and occupancy (blocks,) bytes, bit k =
-    stored plane k has a bit set in the block (:func:`sim.models.bitplane.occupancy`)."""
+    stored plane k has a bit set in the block (:func:`sim.models.bitplane.occupancy`); and how
+    a sequence entry shows it (the defaults: as the registers say)."""
     slot: int
     depth: int
     occupancy: tuple = None      # None: every block full
     ready: int = 0               # cycle from which the store offers it
     sequence: bool = False       # the next of a stored sequence: never replaces a waiting frame
+    lsb: int = 0                 # its least significant plane's time (0: the register's)
+    dark: int = 0                # at least this long dark after it before a frame that follows
+    follow: bool = False         # starts as soon as the frame before it ends, with no trigger
+    camera_off: bool = False     # no camera trigger for it
+    last: bool = False           # the last entry of a sequence played once: nothing follows it,
+                                 # and triggers after it starts are ignored (``ended``)
 
     def occupied(self, plane, block):
         return self.occupancy is None or bool((self.occupancy[block] >> plane) & 1)
@@ -193,9 +200,11 @@ class Result:
     late: int = 0
     overruns: int = 0
     held: int = 0                # triggers held until every group was ready
+    ended: int = 0               # triggers ignored after a sequence played once had ended
     bad_frames: int = 0
     accepted: list = field(default_factory=list)   # cycles triggers were obeyed (strobe or held)
     frame_starts: list = field(default_factory=list)
+    camera_starts: list = field(default_factory=list)  # frame starts whose frame pulses the camera
     shown: list = field(default_factory=list)        # frames taken, in order
 
     def decoded(self):
@@ -303,6 +312,7 @@ class _Model:
         self.bus_free = 0
         self.t = 0
         self.holding = False                # a trigger held until every group is ready
+        self.ended = False                  # a sequence played once has started its last frame
         self.idle_take = not p.chain and p.source != Source.PRNG
         # the trigger's pace (the guard of take_while_waiting): the periodic timer's is known
         # from the start (its first strobe comes ``period - 1`` cycles in), a pin's after two
@@ -334,15 +344,30 @@ class _Model:
             self.next_frame = self.frames.take(self.t)
         return self.next_frame
 
+    def follows(self, g, t):
+        """Whether the frame after group ``g``'s frame starts without a trigger: chained, or that
+        frame follows (group 0: the one offered now, if any, else its own again; the others: the
+        one group 0 took); never after the last frame of a sequence played once."""
+        p, frame = self.p, self.res.shown[self.st[g].pos[1]]
+        if frame.last:
+            return False
+        after = self.res.shown[self.next_frame]
+        nxt = self.frames.offer() if g == 0 and p.source != Source.PRNG else None
+        if nxt is not None and nxt[1] <= t:
+            after = self.frames.offered[nxt[0]]
+        return p.chain or after.follow
+
     def after_pulse(self, g, t):
         p, s = self.p, self.st[g]
         kind, fi, j = s.pos
+        frame = self.res.shown[fi]
         exps = self.exps_of(fi)
         last = j == len(exps) - 1
+        follow = last and self.follows(g, t)
         if kind == "plane":
-            d = p.lsb << exps[j]
+            d = (frame.lsb or p.lsb) << exps[j]
             s.pulse_at = t + d
-            if d >= p.hide and (not last or p.chain):
+            if d >= p.hide and (not last or (follow and not frame.dark)):
                 nfi, nj = (fi, j + 1) if not last else (self.next_frame_for(g), 0)
                 s.pos = ("plane", nfi, nj)
                 self.enqueue(g, nfi, nj)
@@ -350,10 +375,10 @@ class _Model:
                 s.pos = ("dark", fi, j)
                 self.enqueue(g, fi, None)
         else:
-            s.pulse_at = t + p.dark_gap
+            s.pulse_at = t + (max(p.dark_gap, frame.dark) if last else p.dark_gap)
             nfi, nj = (fi, j + 1) if not last else (self.next_frame_for(g), 0)
             s.pos = ("plane", nfi, nj)
-            if last and not p.chain:
+            if last and not follow:
                 s.pending = False
             self.enqueue(g, nfi, nj)
 
@@ -370,6 +395,11 @@ class _Model:
         for g in range(self.G):
             self.st[g].pos = ("plane", fi, 0)
             self.enqueue(g, fi, 0)
+
+    def takes_idle(self, k):
+        """Offered frame ``k`` replaces the waiting one: a streamed frame, or any once a sequence
+        played once has ended (a sequence frame otherwise waits for its turn)."""
+        return not self.frames.offered[k].sequence or self.ended
 
     def fits(self, t):
         """A newer frame may replace the waiting one at ``t`` unless the triggers come at a steady
@@ -394,6 +424,7 @@ class _Model:
         stale loads still queued (their words are discarded for ``flush_rows`` row periods)."""
         wait = 0 if self.waiting(t) else flush_rows(self.dmd) * self.row_period
         fi = self.next_frame = self.frames.take(t, repeat=False)
+        self.ended = False
         self.queued_at = t + wait + self.G + 1
         self.queue.clear()
         for g in range(self.G):
@@ -421,7 +452,9 @@ class _Model:
         if self.last_strobe is not None and self.p.trigger != TriggerMode.PERIODIC:
             self.interval = s_t - self.last_strobe
         self.last_strobe = s_t
-        if self.waiting(s_t):
+        if self.ended:
+            self.res.ended += 1
+        elif self.waiting(s_t):
             self.obey(s_t)
         elif self.p.trigger_hold and not self.holding:
             self.holding = True
@@ -454,6 +487,10 @@ class _Model:
             res.pulses.append((t, g, kind, fi, self.exps_of(fi)[j] if kind == "plane" else None))
             if kind == "plane" and j == 0 and g == 0:
                 res.frame_starts.append(t)
+                frame = res.shown[fi]
+                if not frame.camera_off:
+                    res.camera_starts.append(t)
+                self.ended = self.ended or frame.last
             s.rst_free = t + p.t_rst
             self.rst_any = t + p.t_rst
             s.writable = t + p.t_rst + p.t_settle
@@ -496,7 +533,7 @@ class _Model:
             cands.append(max(st[g].writable, self.next_row) if ops[i][0] == "row" else st[g].writable)
         nxt = self.frames.offer()
         take_at = None
-        if self.idle_take and nxt is not None and not self.playing() and not self.frames.offered[nxt[0]].sequence:
+        if self.idle_take and nxt is not None and not self.playing() and self.takes_idle(nxt[0]):
             take_at = self.fits_from(max(nxt[1], self.queued_at, t + 1))
             cands.append(take_at)
         hold_at = None
@@ -520,7 +557,7 @@ class _Model:
             t = self.t
             nxt = self.frames.offer()
             take_now = (self.idle_take and nxt is not None and nxt[1] <= t and t >= self.queued_at
-                        and not self.playing() and not self.frames.offered[nxt[0]].sequence and self.fits(t))
+                        and not self.playing() and self.takes_idle(nxt[0]) and self.fits(t))
             if t % 2 == 0 and t >= self.bus_free and self.decide(t):
                 if max_frames is not None and len(self.res.frame_starts) > max_frames:
                     break
@@ -549,7 +586,8 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
         bad bit depth is dropped the cycle it is offered): each time group 0 needs a new frame
         it takes the offered one, else shows the current one again; triggered and not chained,
         one offered while every group waits loaded for a trigger is taken at once (unless it is
-        the next frame of a stored sequence).
+        the next frame of a stored sequence). Each is shown as its fields say (a sequence
+        entry's exposure, dark time, follow, camera and last).
     strobes : iterable of int
         Cycles at which the trigger block signals a trigger (see :mod:`gateware.dlpc410.trigger`).
     until : int

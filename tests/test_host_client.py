@@ -400,3 +400,51 @@ def test_configure_plans_with_the_measured_rst_active(projector, capsys):
     longer = schedule.plan(TEST_DMD, 200e6, t_rst_cycles=default.params.t_rst + 91)
     assert longer.params.t_rst == default.params.t_rst + 92 and longer.params.lsb > default.params.lsb
     assert f"{longer.rate_hz:.1f} frames/s" in capsys.readouterr().out
+
+
+def test_play_sequence_sends_the_table_then_the_frames(projector):
+    """``play_sequence``: the sequence mode, each entry record (checked by the reference model as
+    the projector checks it), the control record that plays them once, then the frames; entries
+    the projector would drop are refused before anything is sent."""
+    rng = np.random.default_rng(5)
+    images = [rng.integers(0, 256, SHAPE, dtype=np.uint8) for _ in range(2)]
+    entries = [{"slot": 1}, {"slot": 0, "lsb": 400, "follow": True, "camera": False}, {"slot": 1, "dark": 90 * 2}]
+    with Client("127.0.0.1", projector.port, timeout=1.0, rate=50e6, mtu=1500) as client:
+        with pytest.raises(ClientError, match="outside the sequence"):
+            client.play_sequence(images, [{"slot": 2}])
+        with pytest.raises(ClientError, match="entry 0: .*lsb_even"):
+            client.play_sequence(images, [{"slot": 0, "lsb": 3}])
+        assert projector.received == []
+        sent = client.play_sequence(images, entries, loop=False, depth=8)
+    model = projector.model
+    assert [(e["slot"], e["lsb"], e["dark"], e["follow"], e["camera_off"]) for e in model.entries] == \
+        [(1, 0, 0, 0, 0), (0, 400, 0, 1, 1), (1, 0, 180, 0, 0)]
+    assert model.counters["records_entry"] == 3 and model.counters["drop_app_value"] == 0
+    assert model.config["sequence_length"] == 2 and model.config["entries"] == 3 and model.config["loop"] == 0
+    assert model.sequence_starts == 1
+    kinds = [raw[3] for raw in projector.received]
+    assert kinds[:5] == [records.RecordType.CONTROL] + [records.RecordType.ENTRY] * 3 + [records.RecordType.CONTROL]
+    assert records.RecordType.IMAGE not in kinds[:5] and records.RecordType.IMAGE in kinds[5:]
+    assert [s.frame for s in sent] == [0, 1]
+
+
+def test_cli_sequence_plays_an_entry_table(projector, tmp_path):
+    """``python -m host sequence``: the images stored as a sequence, the entries file's table
+    played once."""
+    rng = np.random.default_rng(9)
+    paths = []
+    for k in range(2):
+        paths.append(tmp_path / f"frame{k}.npy")
+        np.save(paths[-1], rng.integers(0, 256, SHAPE, dtype=np.uint8))
+    table = tmp_path / "entries.json"
+    table.write_text('[{"slot": 1}, {"slot": 0, "lsb": 600, "follow": true}]')
+    base = ["--address", "127.0.0.1", "--port", str(projector.port)]
+    assert cli.main(base + ["sequence", *map(str, paths), "--entries", str(table), "--once", "--depth", "8"]) == 0
+    model = projector.model
+    assert [(e["slot"], e["lsb"], e["follow"]) for e in model.entries] == [(1, 0, 0), (0, 600, 1)]
+    assert model.config["entries"] == 2 and model.config["loop"] == 0 and model.sequence_starts == 1
+    # an entry the projector would drop: refused before anything is sent
+    sent = len(projector.received)
+    table.write_text('[{"slot": 0, "dark": 5}]')
+    assert cli.main(base + ["sequence", *map(str, paths), "--entries", str(table)]) == 1
+    assert len(projector.received) == sent

@@ -57,6 +57,7 @@ def test_bad_frame_dropped_and_counted(case, one_by_one):
     assert delta == expected
     assert after["pixel_count"] == before["pixel_count"], "pixels of a dropped frame leaked"
     assert after["register_count"] == before["register_count"], "registers of a dropped record were handed on"
+    assert after["entry_count"] == before["entry_count"], "an entry of a dropped record was handed on"
     assert after["config"] == before["config"], "a dropped record changed the configuration"
     assert after["tx_count"] == before["tx_count"], "a dropped frame was answered"
     # The reference model names the same cause.

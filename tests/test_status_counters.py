@@ -19,7 +19,7 @@ SEQUENCER = {"frames": "frames_shown", "triggers": "triggers", "overruns": "trig
              "underruns": "row_underruns", "bad_frames": "frames_bad_depth",
              "rst_late": "rst_active_late", "rst_faults": "rst_active_faults",
              "restarts": "dlpc410_restarts", "rst_longest": "rst_active_cycles_max",
-             "period_short": "frames_period_short"}
+             "period_short": "frames_period_short", "after_end": "triggers_after_end"}
 #: The store's counters: five reported alone, the row refusals as one sum.
 STORE = {"frames_complete": "store_frames_complete", "frames_replaced": "store_frames_replaced",
          "frames_abandoned": "store_frames_abandoned", "calibration_losses": "store_calibration_losses",

@@ -602,9 +602,10 @@ def test_random_events_against_policy_model(seed, test_name):
     bench.run([producer, consumer], test_name, deadline=3e-3)
     assert checked["events"] == len(events)
     exercised = {name for name, value in policy.counters.items() if value}
-    # (a lost memory: test_calibration_loss_forgets_every_frame; deltas: test_delta_frames)
+    # (a lost memory: test_calibration_loss_forgets_every_frame; deltas: test_delta_frames;
+    # sequence entries: test_sequence_entries)
     assert exercised >= set(policy.counters) - {"bad_releases", "calibration_losses", "frames_lost",
-                                                "rows_no_base"}, policy.counters
+                                                "rows_no_base", "entries_skipped"}, policy.counters
 
 
 def test_mode_change_keeps_the_shown_frame(test_name):
@@ -853,3 +854,71 @@ def test_calibration_loss_mid_burst(moment, test_name):
     else:
         assert seen["pushed"] == seen["burst"], seen
     assert seen["written"] == seen["back"] == 0, "nothing of the interrupted frame reached the memory"
+
+
+def test_sequence_entries(test_name):
+    """A sequence of 3 frames played by an entry table, once: the entries' slots in the table's
+    order (the same slot twice in a row too), each answer with its entry's settings, an entry
+    whose slot is outside the sequence skipped and counted, the last entry's answer marked last
+    and no answer after it, until ``sequence_start`` plays the entries from the first again;
+    played in a loop, the entries wrap round."""
+    bench = Bench(SHORT_DMD)
+    dut = bench.dut
+    images = {f: store_stim.random_image(SHORT_DMD, 1300 + f) for f in range(3)}
+    table = [(2, 100, 0, 0, 0), (0, 0, 40, 1, 1), (0, 0, 0, 1, 0), (5, 0, 0, 0, 0), (1, 60, 0, 1, 0)]
+    got = []
+
+    async def producer(ctx):
+        for index, (slot, lsb, dark, follow, camera_off) in enumerate(table):
+            ctx.set(dut.entry_writes.payload, {"index": index, "slot": slot, "lsb": lsb, "dark": dark,
+                                                "follow": follow, "camera_off": camera_off})
+            ctx.set(dut.entry_writes.valid, 1)
+            await ctx.tick()
+        ctx.set(dut.entry_writes.valid, 0)
+        ctx.set(dut.entries, len(table))
+        ctx.set(dut.loop, 0)
+        await bench.feed_sequence(ctx, images, (0, 1, 2))
+
+    async def answer(ctx, wait=None):
+        """The next answer's (slot, frame id, showing), or None if none comes in ``wait`` cycles."""
+        ctx.set(dut.ask.valid, 1)
+        ctx.set(dut.frames.ready, 1)
+        for _ in range(wait or 100_000):
+            _, _, asked, valid, payload = await ctx.tick("dmd").sample(dut.ask.ready, dut.frames.valid,
+                                                                       dut.frames.payload)
+            if asked:
+                ctx.set(dut.ask.valid, 0)
+            if valid:
+                ctx.set(dut.frames.ready, 0)
+                s = payload.showing
+                return (int(payload.slot), int(payload.frame_id),
+                        tuple(int(x) for x in (s.lsb, s.dark, s.follow, s.camera_off, s.last)))
+        ctx.set(dut.ask.valid, 0)
+        ctx.set(dut.frames.ready, 0)
+        return None
+
+    async def consumer(ctx):
+        held = None
+        for _ in range(4):
+            slot, frame, showing = await answer(ctx)
+            assert slot == frame
+            got.append((slot, showing))
+            if held is not None and held != slot:
+                await bench.release(ctx, held)
+            held = slot
+        assert await answer(ctx, wait=400) is None, "an answer after the last entry of a sequence played once"
+        assert bench.counters(ctx)["entries_skipped"] == 1
+        ctx.set(dut.sequence_start, 1)
+        await ctx.tick()
+        ctx.set(dut.sequence_start, 0)
+        got.append(((await answer(ctx))[0], None))
+        ctx.set(dut.loop, 1)
+        for _ in range(4):
+            slot, _, showing = await answer(ctx)
+            got.append((slot, showing[-1]))
+        assert bench.counters(ctx)["bad_releases"] == 0
+
+    bench.run([producer, consumer], test_name, deadline=8e-4)
+    assert got[:4] == [(2, (100, 0, 0, 0, 0)), (0, (0, 40, 1, 1, 0)), (0, (0, 0, 1, 0, 0)), (1, (60, 0, 1, 0, 1))]
+    # started again: entry 0; in a loop: entries 1, 2, (3 skipped) 4, 0, none marked last
+    assert got[4:] == [(2, None), (0, 0), (0, 0), (1, 0), (2, 0)]

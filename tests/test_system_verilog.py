@@ -35,3 +35,13 @@ def test_system_small_geometry():
     assert status["mac_bad_fcs"] == status["drop_udp_port"] == n + 1
     assert status["drop_app_value"] == 4 * (n + 1) and status["drop_app_length"] == n + 1
     assert status["records_sequencer"] == 2 and status["records_control"] == 2
+
+
+@pytest.mark.verilog
+def test_system_sequence_entries():
+    """A sequence played by its entry table, end to end: configured over GMII, every pixel's
+    light each entry's frame at its own exposure, a trigger after the last entry ignored
+    (``sim/tb/system.py``, ``sequence_entries_play_as_their_table_says``)."""
+    report = system.run("test", testcase="sequence_entries_play_as_their_table_says")
+    assert report["latency_cycles"] <= 8
+    assert report["status"]["triggers_after_end"] == 1

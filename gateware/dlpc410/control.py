@@ -26,9 +26,8 @@ from amaranth.lib.wiring import In, Out
 from spec.schedule import INIT_TO_DVALID, flush_rows, reload_cycles, row_cycles
 
 from ..registers import DURATION_BITS, TIME_BITS, Registers, Source, TriggerMode
-from ..store.layouts import SLOT_BITS
 from .layouts import COUNTER_BITS, event, group_bits
-from .planner import Offer
+from .planner import START, Offer
 from .timebase import diff
 
 __all__ = ["FrameControl"]
@@ -60,7 +59,7 @@ class FrameControl(wiring.Component):
         and waiting for a trigger.
     offer : In(:class:`~gateware.dlpc410.planner.Offer`)
         The frame the store offers.
-    all_ready, playing : In(1)
+    all_ready, playing, ended : In(1)
         From the planner.
     drained : In(1)
         No load job queued or looked up, and no word owed by the store.
@@ -73,10 +72,11 @@ class FrameControl(wiring.Component):
         newer frame is being taken and no trigger is held (a sync master's ready line).
     flushing : Out(1)
         Stale loads are being dropped.
-    triggers, overruns, early, held : Out(COUNTER_BITS)
+    triggers, overruns, early, held, after_end : Out(COUNTER_BITS)
         Triggers obeyed; ignored because a frame played or was not loaded yet (and one was held
         already, or ``trigger_hold`` is low); before the groups ran (or while the controller
-        restarts); held until every group was ready (``trigger_hold``).
+        restarts); held until every group was ready (``trigger_hold``); ignored because a
+        sequence played once had ended.
     """
 
     def __init__(self, dmd, *, beats=1):
@@ -93,8 +93,9 @@ class FrameControl(wiring.Component):
             "offer": In(Offer),
             "all_ready": In(1),
             "playing": In(1),
+            "ended": In(1),
             "drained": In(1),
-            "start": Out(event(data.StructLayout({"slot": SLOT_BITS, "depth": 4, "take": 1}))),
+            "start": Out(event(START)),
             "retake": Out(event(data.StructLayout({"newer": 1, "abandon": 1, "lead": TIME_BITS}))),
             "trigger": Out(event(TIME_BITS)),
             "queue_first": Out(event(gb)),
@@ -105,6 +106,7 @@ class FrameControl(wiring.Component):
             "overruns": Out(COUNTER_BITS),
             "early": Out(COUNTER_BITS),
             "held": Out(COUNTER_BITS),
+            "after_end": Out(COUNTER_BITS),
         })
 
     def elaborate(self, platform):
@@ -136,6 +138,8 @@ class FrameControl(wiring.Component):
                     m.d.comb += [self.start.valid.eq(1), begin.take.eq(~use_prng),
                                  begin.slot.eq(Mux(use_prng, 0, self.offer.slot)),
                                  begin.depth.eq(Mux(use_prng, 1, self.offer.depth))]
+                    with m.If(~use_prng):
+                        m.d.comb += begin.showing.eq(self.offer.showing)
                     m.next = "QUEUE"
             with m.State("QUEUE"):
                 queue_first_planes()
@@ -171,7 +175,8 @@ class FrameControl(wiring.Component):
         # abandoned is pulsed (no trigger is obeyed before every group is loaded again), and the
         # settle times of the last pulses still hold. With ``reload`` at rest, the same frame is
         # loaded again under new registers.
-        newer = ~use_prng & ~regs.chain & self.offer.valid & ~self.offer.sequence
+        # (once a sequence played once has ended, the next frame offered is taken at once too)
+        newer = ~use_prng & ~regs.chain & self.offer.valid & (~self.offer.sequence | self.ended)
         idle = fsm.ongoing("RUN") & ~self.playing
         resting = fsm.ongoing("RUN") & self.all_ready
         m.d.comb += [take_idle.eq((idle & newer & self._fits(m)) | (resting & self.reload)),
@@ -193,7 +198,7 @@ class FrameControl(wiring.Component):
         holding = Signal()
         ready = self.running & self.all_ready & ~take_idle
         release = holding & ready
-        m.d.comb += self.ready.eq(ready & ~holding)
+        m.d.comb += self.ready.eq(ready & ~holding & ~self.ended)
 
         def obey():
             m.d.comb += [self.trigger.valid.eq(1), self.trigger.payload.eq((now + 2) & ~1)]
@@ -206,6 +211,8 @@ class FrameControl(wiring.Component):
         with m.If(self.strobe):
             with m.If(~self.running):
                 m.d.sync += self.early.eq(self.early + 1)
+            with m.Elif(self.ended):
+                m.d.sync += self.after_end.eq(self.after_end + 1)
             with m.Elif(ready & ~release):
                 obey()
             with m.Elif(regs.trigger_hold & (~holding | release)):

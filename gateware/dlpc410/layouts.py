@@ -62,7 +62,8 @@ class Status(data.Struct):
     ``rst_faults`` RST_ACTIVE missing after a pulse or stuck high; ``restarts`` the controller
     initialised again mid-run (INIT_ACTIVE high again or ECP2_FINISHED low); ``rst_longest`` the
     longest RST_ACTIVE seen, in cycles from the pulse's decision; ``period_short`` frames started
-    by the periodic timer whose planes outlast its period.
+    by the periodic timer whose planes outlast its period; ``after_end`` triggers ignored because
+    a sequence played once had ended.
     """
     now: TIME_BITS
     frames: COUNTER_BITS
@@ -78,3 +79,4 @@ class Status(data.Struct):
     restarts: COUNTER_BITS
     rst_longest: COUNTER_BITS
     period_short: COUNTER_BITS
+    after_end: COUNTER_BITS

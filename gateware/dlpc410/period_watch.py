@@ -1,6 +1,6 @@
 """A periodic trigger faster than the frames it starts.
 
-With :attr:`~gateware.registers.TriggerMode.PERIODIC`, a frame whose planes alone (``lsb`` times
+With :attr:`~gateware.registers.TriggerMode.PERIODIC`, a frame whose planes alone (its ``lsb`` times
 ``2**depth - 1`` cycles, the least any plan gives them) outlast ``period`` cannot end before the
 next strobe: that strobe is then held or an overrun (``trigger_hold``), and the triggers no
 longer come at the period the user set. The frame is still shown; each such frame is counted,
@@ -24,10 +24,10 @@ class PeriodWatch(wiring.Component):
     Members
     -------
     regs : In(:class:`~gateware.registers.Registers`)
-        ``trigger``, ``period``, ``lsb``.
-    depth : In(4)
-        Bit depth of the frame the first group plays; it is set at least a plane before that
-        frame's first pulse.
+        ``trigger``, ``period``.
+    depth, lsb : In(4), In(LSB_BITS)
+        Bit depth and least significant plane's time of the frame the first group plays; they
+        are set at least a plane before that frame's first pulse.
     frame_start : In(1)
         A frame's first pulse.
     short : Out(COUNTER_BITS)
@@ -35,6 +35,7 @@ class PeriodWatch(wiring.Component):
     """
     regs: In(Registers)
     depth: In(4)
+    lsb: In(LSB_BITS)
     frame_start: In(1)
     short: Out(COUNTER_BITS)
 
@@ -44,7 +45,7 @@ class PeriodWatch(wiring.Component):
         # two registered stages (a shift, then a compare): the depth and the registers are
         # steady for a plane or more before the frame's first pulse
         planes, too_short = Signal(LSB_BITS + 15), Signal()
-        m.d.sync += [planes.eq((regs.lsb << self.depth) - regs.lsb),
+        m.d.sync += [planes.eq((self.lsb << self.depth) - self.lsb),
                      too_short.eq((regs.trigger == TriggerMode.PERIODIC) & (regs.period < planes))]
         with m.If(self.frame_start & too_short):
             m.d.sync += self.short.eq(self.short + 1)

@@ -11,14 +11,14 @@ last plane of a frame group 0 takes the newest complete frame, if one is offered
 repeats). The frame control starts, reloads and triggers the groups through command events.
 """
 
-from amaranth import Array, Cat, Module, Mux, Signal
+from amaranth import Array, Cat, Module, Mux, Shape, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from spec.schedule import INIT_TO_DVALID, row_cycles
 
-from ..registers import TIME_BITS, Registers, Source
-from ..store.layouts import SLOT_BITS, FrameInfo
+from ..registers import LSB_BITS, TIME_BITS, Registers, Source
+from ..store.layouts import SLOT_BITS, FrameInfo, Showing
 from .layouts import COUNTER_BITS, event, group_bits, load_job
 from .reset_watch import ResetWatch
 from .timebase import diff, exponent
@@ -29,11 +29,24 @@ __all__ = ["Planner", "Offer"]
 class Offer(data.Struct):
     """The frame the store offers now: ``valid`` when it has a bit depth the sequencer plays;
     ``sequence`` when it is the next frame of a stored sequence (it does not replace a frame
-    waiting for its trigger)."""
+    waiting for its trigger); ``showing``, its sequence entry's settings."""
     valid: 1
     slot: SLOT_BITS
     depth: 4
     sequence: 1
+    showing: Showing
+
+
+#: The entry settings each group keeps of its frame.
+_PER_GROUP = ("lsb", "dark", "camera_off", "last")
+
+
+def _width(name):
+    return Shape.cast(data.Layout.cast(Showing)[name].shape).width
+
+
+#: What the frame control's ``start`` begins: a frame, and whether it is the one offered.
+START = data.StructLayout({"slot": SLOT_BITS, "depth": 4, "showing": Showing, "take": 1})
 
 
 class Planner(wiring.Component):
@@ -62,9 +75,9 @@ class Planner(wiring.Component):
         The bus made this group's pulse this cycle.
     loaded : In(event(group))
         The bus finished this group's load this cycle.
-    start : In(event(slot, depth, take))
-        Every group begins the frame ``slot`` of ``depth`` planes at its first plane; ``take``:
-        that frame is the one offered, taken now.
+    start : In(event(START))
+        Every group begins the frame ``slot`` of ``depth`` planes, shown as ``showing`` says, at
+        its first plane; ``take``: that frame is the one offered, taken now.
     retake : In(event(newer, abandon, lead))
         A newer frame (``newer``: the one offered, taken now) or the same frame under new
         registers replaces what every group holds; each group's memory may change no sooner than
@@ -89,6 +102,11 @@ class Planner(wiring.Component):
         Some group plays a frame.
     frame_start : Out(1)
         This cycle's pulse is the first of a frame.
+    camera_start : Out(1)
+        The same, for a frame whose entry pulses the camera.
+    ended : Out(1)
+        The last frame of a sequence played once has started; a frame taken anew (``start``,
+        ``retake`` of a newer one) clears it.
     sync_out : Out(1)
         High while a frame is shown (first pulse to the last group's final dark pulse).
     frames_started, late, bad_frames : Out(COUNTER_BITS)
@@ -96,8 +114,14 @@ class Planner(wiring.Component):
     rst_late, rst_faults, rst_longest : Out(COUNTER_BITS)
         RST_ACTIVE falls later than planned; RST_ACTIVE missing after a pulse or stuck high; the
         longest RST_ACTIVE seen (:class:`~gateware.dlpc410.reset_watch.ResetWatch`).
-    depth : Out(4)
-        The bit depth of the frame the first group plays (or is about to).
+    depth, lsb : Out(4), Out(LSB_BITS)
+        The bit depth and the least significant plane's time of the frame the first group plays
+        (or is about to).
+
+    A frame's entry (:class:`~gateware.store.layouts.Showing`) sets its least significant
+    plane's time, and for the frame after it (group 0: the one offered, if any, else its own
+    again; the others: the one group 0 took) whether it follows without a trigger, after at
+    least its dark time; the last frame of a sequence played once is followed by nothing.
     """
 
     def __init__(self, dmd, *, beats=1):
@@ -113,7 +137,7 @@ class Planner(wiring.Component):
             "offer": Out(Offer),
             "pulse": In(event(gb)),
             "loaded": In(event(gb)),
-            "start": In(event(data.StructLayout({"slot": SLOT_BITS, "depth": 4, "take": 1}))),
+            "start": In(event(START)),
             "retake": In(event(data.StructLayout({"newer": 1, "abandon": 1, "lead": TIME_BITS}))),
             "trigger": In(event(TIME_BITS)),
             "queue_first": In(event(gb)),
@@ -125,6 +149,8 @@ class Planner(wiring.Component):
             "all_ready": Out(1),
             "playing": Out(1),
             "frame_start": Out(1),
+            "camera_start": Out(1),
+            "ended": Out(1),
             "sync_out": Out(1),
             "frames_started": Out(COUNTER_BITS),
             "late": Out(COUNTER_BITS),
@@ -133,6 +159,7 @@ class Planner(wiring.Component):
             "rst_faults": Out(COUNTER_BITS),
             "rst_longest": Out(COUNTER_BITS),
             "depth": Out(4),
+            "lsb": Out(LSB_BITS),
         })
 
     def elaborate(self, platform):
@@ -153,10 +180,22 @@ class Planner(wiring.Component):
         dark = per_group(1, "dark")
         slot = per_group(SLOT_BITS, "slot")
         depth = per_group(4, "depth")
+        # the entry settings of each group's frame (its follow flag is only read of the frame
+        # taken next)
+        show = {name: per_group(_width(name), f"show_{name}") for name in _PER_GROUP}
         rst_any = Signal(TIME_BITS)
         next_slot = Signal(SLOT_BITS)          # the newest frame taken
         next_depth = Signal(4)
+        next_show = Signal(Showing)
         m.d.comb += self.depth.eq(depth[0])
+
+        def lsb_of(g):
+            """The least significant plane's time of group ``g``'s frame."""
+            return Mux(show["lsb"][g] != 0, show["lsb"][g], regs.lsb)
+        m.d.comb += self.lsb.eq(lsb_of(0))
+
+        def set_show(g, value):
+            return [show[name][g].eq(value[name]) for name in _PER_GROUP]
         active = [Signal(name=f"active{g}") for g in range(G)]
         for g in range(G):
             m.d.comb += active[g].eq(g < self.n_groups)
@@ -191,7 +230,8 @@ class Planner(wiring.Component):
         frame_ok = (depth_in != 0) & (depth_in <= 8)
         m.d.comb += [self.offer.valid.eq(self.frames.valid & frame_ok),
                      self.offer.slot.eq(self.frames.payload.slot), self.offer.depth.eq(depth_in),
-                     self.offer.sequence.eq(self.frames.payload.sequence)]
+                     self.offer.sequence.eq(self.frames.payload.sequence),
+                     self.offer.showing.eq(self.frames.payload.showing)]
         with m.If(self.frames.valid & ~frame_ok):
             m.d.comb += self.frames.ready.eq(1)
             m.d.sync += self.bad_frames.eq(self.bad_frames + 1)
@@ -206,12 +246,21 @@ class Planner(wiring.Component):
         pe = exponent(m, regs, pj, pdepth, "pulse_exp")
         last = pj == pdepth - 1
         plane_len = Signal.like(regs.hide)
-        m.d.comb += plane_len.eq(regs.lsb << pe)
-        hidden = ~pdark & (plane_len >= regs.hide) & (~last | regs.chain)
+        m.d.comb += plane_len.eq(lsb_of(p) << pe)
+        # the frame after this one starts without a trigger: chained, or it follows (group 0
+        # takes the one offered, if any); never after a sequence's last frame, nor hidden behind
+        # a frame that wants dark time after it
+        offered = (p == 0) & self.offer.valid & ~use_prng
+        follow = Signal()
+        m.d.comb += follow.eq((regs.chain | Mux(offered, self.offer.showing.follow, next_show.follow))
+                              & ~show["last"][p])
+        pdark_time = show["dark"][p]
+        hidden = ~pdark & (plane_len >= regs.hide) & (~last | (follow & (pdark_time == 0)))
         new_frame = last & (pdark | hidden)
         take = Signal()
         n_slot = Mux(take, self.frames.payload.slot, next_slot)
         n_depth = Mux(take, depth_in, next_depth)
+        n_show = Mux(take, self.frames.payload.showing.as_value(), next_show.as_value())
         m.d.comb += take.eq(self.pulse.valid & new_frame & (p == 0) & self.offer.valid & ~use_prng)
         with m.If(take):
             m.d.comb += self.frames.ready.eq(1)
@@ -224,27 +273,30 @@ class Planner(wiring.Component):
                 rst_free[p].eq(now + regs.t_rst),
                 rst_any.eq(now + regs.t_rst),
                 loaded[p].eq(0),
-                pulse_at[p].eq(now + Mux(pdark, regs.dark_gap, plane_len)),
+                pulse_at[p].eq(now + Mux(pdark, Mux(last & (pdark_time > regs.dark_gap), pdark_time, regs.dark_gap),
+                                         plane_len)),
             ]
             with m.If(p == 0):
-                m.d.sync += [next_slot.eq(n_slot), next_depth.eq(n_depth)]
+                m.d.sync += [next_slot.eq(n_slot), next_depth.eq(n_depth), next_show.eq(n_show)]
             m.d.comb += [self.jobs.valid.eq(1), job.group.eq(p), job.slot.eq(slot[p]),
                          job.depth.eq(pdepth), job.pos.eq(pj + 1)]
             with m.If(pdark | hidden):
                 m.d.sync += [dark[p].eq(0), pos[p].eq(Mux(last, 0, pj + 1))]
                 with m.If(last):
-                    m.d.sync += [slot[p].eq(n_slot), depth[p].eq(n_depth)]
+                    m.d.sync += [slot[p].eq(n_slot), depth[p].eq(n_depth), *set_show(p, Showing(n_show))]
                     m.d.comb += [job.slot.eq(n_slot), job.depth.eq(n_depth), job.pos.eq(0)]
-                    with m.If(pdark & ~regs.chain):
+                    with m.If(pdark & ~follow):
                         m.d.sync += pending[p].eq(0)
             with m.Else():
                 m.d.sync += dark[p].eq(1)
                 m.d.comb += job.clear.eq(1)
             # frame boundaries: sync out, the frame counter
             with m.If((p == 0) & ~pdark & (pj == 0)):
-                m.d.comb += self.frame_start.eq(1)
+                m.d.comb += [self.frame_start.eq(1), self.camera_start.eq(~show["camera_off"][0])]
                 m.d.sync += [self.sync_out.eq(1), self.frames_started.eq(self.frames_started + 1)]
-            with m.If((p == self.n_groups - 1) & pdark & last & ~regs.chain):
+                with m.If(show["last"][0]):
+                    m.d.sync += self.ended.eq(1)
+            with m.If((p == self.n_groups - 1) & pdark & last & ~follow):
                 m.d.sync += self.sync_out.eq(0)
 
         # ---- commands of the frame control ----
@@ -252,9 +304,11 @@ class Planner(wiring.Component):
             begin = self.start.payload
             with m.If(begin.take):
                 m.d.comb += self.frames.ready.eq(1)
-            m.d.sync += [next_slot.eq(begin.slot), next_depth.eq(begin.depth)]
+            m.d.sync += [next_slot.eq(begin.slot), next_depth.eq(begin.depth), next_show.eq(begin.showing),
+                         self.ended.eq(0)]
             for g in range(G):
-                m.d.sync += [slot[g].eq(begin.slot), depth[g].eq(begin.depth), pos[g].eq(0), dark[g].eq(0)]
+                m.d.sync += [slot[g].eq(begin.slot), depth[g].eq(begin.depth), pos[g].eq(0), dark[g].eq(0),
+                             *set_show(g, begin.showing)]
         with m.If(self.queue_first.valid):
             m.d.comb += [self.jobs.valid.eq(1), job.group.eq(self.queue_first.payload),
                          job.slot.eq(next_slot), job.depth.eq(next_depth), job.pos.eq(0), job.clear.eq(0)]
@@ -263,11 +317,13 @@ class Planner(wiring.Component):
             lead = self.retake.payload.lead
             with m.If(newer):
                 m.d.comb += self.frames.ready.eq(1)
+                m.d.sync += self.ended.eq(0)
             r_slot = Mux(newer, self.frames.payload.slot, next_slot)
             r_depth = Mux(newer, depth_in, next_depth)
-            m.d.sync += [next_slot.eq(r_slot), next_depth.eq(r_depth)]
+            r_show = Showing(Mux(newer, self.frames.payload.showing.as_value(), next_show.as_value()))
+            m.d.sync += [next_slot.eq(r_slot), next_depth.eq(r_depth), next_show.eq(r_show)]
             for g in range(G):
-                m.d.sync += [slot[g].eq(r_slot), depth[g].eq(r_depth), loaded[g].eq(0),
+                m.d.sync += [slot[g].eq(r_slot), depth[g].eq(r_depth), loaded[g].eq(0), *set_show(g, r_show),
                              writable[g].eq(Mux(diff(writable[g], lead) < 0, lead, writable[g]))]
                 with m.If(self.retake.payload.abandon):
                     m.d.sync += [pending[g].eq(0), pos[g].eq(0), dark[g].eq(0)]

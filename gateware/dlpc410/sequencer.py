@@ -90,6 +90,8 @@ class Sequencer(wiring.Component):
         The newest complete frame; taken when a new frame is due (else the last one repeats),
         or, triggered and not chained, as soon as every group waits loaded for a trigger: the
         first plane is then loaded again from the new frame (a trigger meanwhile is an overrun).
+        Each is shown as its sequence entry says (``showing``: exposure, dark time, follow,
+        camera, last; all zero: as the registers say).
     requests : Out(stream.Signature(PlaneRequest))
         Rows to read, one block of one plane per request, in load order.
     words : In(stream.Signature(64 * store_words))
@@ -195,6 +197,7 @@ class Sequencer(wiring.Component):
             control.offer.eq(planner.offer),
             control.all_ready.eq(planner.all_ready),
             control.playing.eq(planner.playing),
+            control.ended.eq(planner.ended),
         ]
         for name in ("start", "retake", "trigger", "queue_first"):
             wiring.connect(m, getattr(control, name), getattr(planner, name))
@@ -233,8 +236,9 @@ class Sequencer(wiring.Component):
 
         # ---- outputs and counters ----
         m.d.comb += [
-            camera.frame_start.eq(planner.frame_start),
+            camera.frame_start.eq(planner.camera_start),
             period_watch.frame_start.eq(planner.frame_start), period_watch.depth.eq(planner.depth),
+            period_watch.lsb.eq(planner.lsb),
             self.camera_out.eq(camera.out),
             self.sync_out.eq(planner.sync_out),
             self.status.frames.eq(planner.frames_started),
@@ -249,6 +253,7 @@ class Sequencer(wiring.Component):
             self.status.overruns.eq(control.overruns),
             self.status.early.eq(control.early),
             self.status.held.eq(control.held),
+            self.status.after_end.eq(control.after_end),
             self.status.underruns.eq(bus.underruns),
         ]
 

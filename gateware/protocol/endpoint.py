@@ -16,7 +16,7 @@ from ..net.stack import Stack
 from ..registers import Registers
 from ..wire import layout
 from .layouts import pixel_layout
-from .parser import CONFIG_LAYOUT, Parser, config_init
+from .parser import CONFIG_LAYOUT, ENTRY_LAYOUT, Parser, config_init
 from .rows import RowAssembler
 from .status import StatusReply
 
@@ -59,6 +59,10 @@ class Endpoint(wiring.Component):
         Software trigger pulse.
     registers : Out(stream.Signature(Registers))
         The sequencer's register set of each valid sequencer record.
+    entries : Out(stream.Signature(ENTRY_LAYOUT))
+        Each valid sequence entry record, for the store's entry table.
+    sequence_start : Out(1)
+        Pulse: play the sequence's entries from the first.
     status : In(Status)
         Figures from the rest of the system, reported in status replies.
     net_counters : Out(layout(records.NET_COUNTERS))
@@ -78,6 +82,8 @@ class Endpoint(wiring.Component):
             "settings": Out(Config, init=self._config),
             "trigger": Out(1),
             "registers": Out(stream.Signature(Registers)),
+            "entries": Out(stream.Signature(ENTRY_LAYOUT)),
+            "sequence_start": Out(1),
             "status": In(Status),
             "net_counters": Out(layout(records.NET_COUNTERS)),
             "app_counters": Out(layout(records.APP_COUNTERS)),
@@ -97,6 +103,7 @@ class Endpoint(wiring.Component):
         connect(m, rows.pixels, wiring.flipped(self.pixels))
         connect(m, parser.queries, reply.queries)
         connect(m, parser.registers, wiring.flipped(self.registers))
+        connect(m, parser.entries, wiring.flipped(self.entries))
         connect(m, reply.request, stack.reply_request)
         connect(m, reply.body, stack.reply_body)
         m.d.comb += [
@@ -105,6 +112,7 @@ class Endpoint(wiring.Component):
             stack.port.eq(parser.settings.port),
             self.settings.eq(parser.settings),
             self.trigger.eq(parser.trigger),
+            self.sequence_start.eq(parser.sequence_start),
             reply.net.eq(stack.counters),
             reply.app.eq(self.app_counters),
             reply.system.eq(self.status),

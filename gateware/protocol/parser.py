@@ -5,7 +5,8 @@ header and the type's own header, checks them all against each other, against th
 length and against the DMD geometry, and only then acts: an image record's rows go to the
 row assembler (:class:`~gateware.protocol.rows.RowAssembler`) as pixels with their position in
 the frame, a control record updates :attr:`Parser.settings`, a sequencer record's register set
-leaves whole on :attr:`Parser.registers`, a status query asks
+leaves whole on :attr:`Parser.registers`, a sequence entry record on :attr:`Parser.entries`, a
+status query asks
 :class:`~gateware.protocol.status.StatusReply` for an answer. A record that fails a check is
 consumed and counted under its cause and has no other effect.
 """
@@ -23,14 +24,17 @@ from ..registers import Registers, wire_registers
 from ..wire import byte_slice, layout
 from .layouts import piece_layout
 
-__all__ = ["Parser", "Query", "config_init", "CONFIG_LAYOUT"]
+__all__ = ["Parser", "Query", "config_init", "CONFIG_LAYOUT", "ENTRY_LAYOUT"]
 
 CONFIG_LAYOUT = layout(records.CONFIG)
+#: A sequence entry record's fields, as the store's entry table takes them.
+ENTRY_LAYOUT = layout(records.ENTRY)
 _HEADER = wire.size(records.HEADER)
 _IMAGE_END = _HEADER + wire.size(records.IMAGE)
 _CONTROL_END = _HEADER + wire.size(records.CONTROL)
 _SEQUENCER_END = _HEADER + wire.size(records.SEQUENCER)
-_CAPTURED = max(_IMAGE_END, _CONTROL_END, _SEQUENCER_END)
+_ENTRY_END = _HEADER + wire.size(records.ENTRY)
+_CAPTURED = max(_IMAGE_END, _CONTROL_END, _SEQUENCER_END, _ENTRY_END)
 _SEQUENCE_BITS = dict(records.HEADER)["sequence"]
 
 
@@ -42,7 +46,7 @@ class Query(data.Struct):
 
 def config_init(*, mac, ip, port, bit_depth=8, armed=False):
     """The configuration the gateware starts with (build parameters)."""
-    return {"bit_depth": bit_depth, "armed": int(armed), "sequence_length": 1,
+    return {"bit_depth": bit_depth, "armed": int(armed), "sequence_length": 1, "entries": 0, "loop": 1,
             "mac": mac, "ip": ip, "port": port}
 
 
@@ -72,6 +76,11 @@ class Parser(wiring.Component):
         waits for it to be taken).
     trigger : Out(1)
         One-cycle pulse for a control record with the software-trigger action.
+    entries : Out(stream.Signature(ENTRY_LAYOUT))
+        Each valid sequence entry record, one transfer per record (the parser waits for it).
+    sequence_start : Out(1)
+        One-cycle pulse for a control record with the sequence-start action (after its fields
+        are applied).
     queries : Out(stream.Signature(Query))
         Valid status queries, for the status reply.
     counters : Out(layout(records.RECORD_COUNTERS))
@@ -86,6 +95,8 @@ class Parser(wiring.Component):
             "settings": Out(CONFIG_LAYOUT, init=config),
             "trigger": Out(1),
             "registers": Out(stream.Signature(Registers)),
+            "entries": Out(stream.Signature(ENTRY_LAYOUT)),
+            "sequence_start": Out(1),
             "queries": Out(stream.Signature(Query)),
             "counters": Out(layout(records.RECORD_COUNTERS)),
         })
@@ -93,7 +104,7 @@ class Parser(wiring.Component):
     #: Why a record is dropped, in the order the checks are made (``drop_app_<cause>``).
     _CAUSES = ["magic", "version", "type", "empty", "length", "rows", "value"]
 
-    def _cause(self, m, header, image, control, sequencer, length, needed):
+    def _cause(self, m, header, image, control, sequencer, entry, length, needed):
         """The first check the record in ``captured`` fails: 1 + its index in :attr:`_CAUSES`,
         or 0 when it passes every one."""
         dmd = self._dmd
@@ -108,8 +119,9 @@ class Parser(wiring.Component):
             m.d.comb += cause.eq(1 + causes.index("magic"))
         with m.Elif(header.version != records.VERSION):
             m.d.comb += cause.eq(1 + causes.index("version"))
-        with m.Elif((header.type != RecordType.IMAGE) & (header.type != RecordType.CONTROL)
-                    & (header.type != RecordType.STATUS_QUERY) & (header.type != RecordType.SEQUENCER)):
+        with m.Elif(Cat(header.type == kind for kind in (RecordType.IMAGE, RecordType.CONTROL,
+                                                         RecordType.STATUS_QUERY, RecordType.SEQUENCER,
+                                                         RecordType.ENTRY)).any() == 0):
             m.d.comb += cause.eq(1 + causes.index("type"))
         with m.Elif(length < needed):
             m.d.comb += cause.eq(1 + causes.index("length"))
@@ -119,10 +131,10 @@ class Parser(wiring.Component):
             m.d.comb += cause.eq(1 + causes.index("length"))
         with m.Elif(is_image & (image.offset + (length - _IMAGE_END) > dmd.rows * dmd.columns)):
             m.d.comb += cause.eq(1 + causes.index("rows"))
-        with m.Elif((header.type == RecordType.CONTROL)
-                    & ((applies("bit_depth") & ((control.bit_depth == 0) | (control.bit_depth > 8)))
-                       | (applies("armed") & (control.armed > 1))
-                       | (applies("sequence_length") & (control.sequence_length == 0)))):
+        with m.Elif((header.type == RecordType.CONTROL) & Cat(records.config_faults(control, applies).values()).any()):
+            m.d.comb += cause.eq(1 + causes.index("value"))
+        with m.Elif((header.type == RecordType.ENTRY)
+                    & Cat(records.entry_faults(entry, self.settings.sequence_length).values()).any()):
             m.d.comb += cause.eq(1 + causes.index("value"))
         with m.Elif((header.type == RecordType.SEQUENCER)
                     & Cat(records.register_faults(sequencer, row_cycles(dmd, self._beats),
@@ -147,7 +159,8 @@ class Parser(wiring.Component):
         image = part(records.IMAGE, _HEADER)
         control = part(records.CONTROL, _HEADER)
         sequencer = part(records.SEQUENCER, _HEADER)
-        m.d.comb += self.registers.payload.eq(wire_registers(sequencer))
+        entry = part(records.ENTRY, _HEADER)
+        m.d.comb += [self.registers.payload.eq(wire_registers(sequencer)), self.entries.payload.eq(entry)]
         peer = Signal(Peer)
         length = Signal(OFFSET_BITS)
 
@@ -172,6 +185,8 @@ class Parser(wiring.Component):
                 m.d.comb += needed.eq(_CONTROL_END)
             with m.Case(RecordType.SEQUENCER):
                 m.d.comb += needed.eq(_SEQUENCER_END)
+            with m.Case(RecordType.ENTRY):
+                m.d.comb += needed.eq(_ENTRY_END)
             with m.Default():
                 m.d.comb += needed.eq(_HEADER)
         # one past the image record's last pixel
@@ -182,7 +197,7 @@ class Parser(wiring.Component):
         rows = self._dmd.rows
         m.d.comb += carried.eq(Mux(image.carried > rows, rows + 1, image.carried))
 
-        cause = self._cause(m, header, image, control, sequencer, length, needed)
+        cause = self._cause(m, header, image, control, sequencer, entry, length, needed)
         causes = self._CAUSES
 
         sequence_seen = Signal()
@@ -193,7 +208,7 @@ class Parser(wiring.Component):
         def bump(name, by=1):
             m.d.sync += counters[name].eq(counters[name] + by)
 
-        m.d.sync += self.trigger.eq(0)
+        m.d.sync += [self.trigger.eq(0), self.sequence_start.eq(0)]
         with m.FSM():
             with m.State("HEAD"):
                 m.d.comb += self.datagrams.ready.eq(1)
@@ -220,12 +235,16 @@ class Parser(wiring.Component):
                             for i, (name, _) in enumerate(records.CONFIG):
                                 with m.If(control.apply[i]):
                                     m.d.sync += self.settings[name].eq(control[name])
-                            m.d.sync += self.trigger.eq(
-                                (control.action & records.Action.SOFTWARE_TRIGGER) != 0)
+                            m.d.sync += [
+                                self.trigger.eq((control.action & records.Action.SOFTWARE_TRIGGER) != 0),
+                                self.sequence_start.eq((control.action & records.Action.SEQUENCE_START) != 0)]
                             m.next = "DISCARD"
                         with m.Case(RecordType.SEQUENCER):
                             bump("records_sequencer")
                             m.next = "REGISTERS"
+                        with m.Case(RecordType.ENTRY):
+                            bump("records_entry")
+                            m.next = "ENTRY"
                         with m.Default():
                             bump("records_status")
                             m.next = "QUERY"
@@ -250,6 +269,10 @@ class Parser(wiring.Component):
             with m.State("REGISTERS"):
                 m.d.comb += self.registers.valid.eq(1)
                 with m.If(self.registers.ready):
+                    m.next = "DISCARD"
+            with m.State("ENTRY"):
+                m.d.comb += self.entries.valid.eq(1)
+                with m.If(self.entries.ready):
                     m.next = "DISCARD"
             with m.State("QUERY"):
                 m.d.comb += [

@@ -48,7 +48,7 @@ class EthernetPort(wiring.Component):
         Frames dropped whole because the receive FIFO had no room (``sync`` fell behind).
     tx_underruns : Out(32)
         Frames aborted on the transmit pins because their bytes came late.
-    pixels, settings, trigger, registers, status, net_counters, app_counters
+    pixels, settings, trigger, registers, entries, sequence_start, status, net_counters, app_counters
         The endpoint's members of these names, in ``sync`` (an image record's first pixel leaves
         only after its frame passed every check, FCS included).
     """

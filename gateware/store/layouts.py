@@ -29,7 +29,8 @@ sequencer, so reading it from another clock domain is safe for every slot the se
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-__all__ = ["COUNTER_BITS", "SLOT_BITS", "BLOCK_BITS", "PlaneRequest", "FrameInfo", "OccupancySignature"]
+__all__ = ["COUNTER_BITS", "SLOT_BITS", "BLOCK_BITS", "SHOW_BITS", "PlaneRequest", "Showing", "FrameInfo",
+           "OccupancySignature"]
 
 #: Frame slots are numbered in this many bits (16 slots; sequence mode spans slots).
 #: Width of every event counter: that of the status reply's fields, so that none wraps inside
@@ -48,14 +49,29 @@ class PlaneRequest(data.Struct):
     row_count: 11
 
 
+#: Width of a sequence entry's times (``dmd`` cycles: 84 ms).
+SHOW_BITS = 24
+
+
+class Showing(data.Struct):
+    """How a sequence entry shows its frame; all zero: as the sequencer's registers say."""
+    lsb: SHOW_BITS    # the least significant plane's time, even (0: the register's)
+    dark: SHOW_BITS   # at least this long dark after the frame before a frame that follows it
+    follow: 1         # starts as soon as the frame before it ends (its dark time), no trigger
+    camera_off: 1     # no camera trigger for it
+    last: 1           # the last entry of a sequence played once: nothing follows it, and
+                      # triggers after it starts are ignored (counted)
+
+
 class FrameInfo(data.Struct):
     """A complete frame the sequencer may show. A frame of a stored sequence (``sequence``) is
     the next one to show, in order; a streamed one is the newest, which replaces a frame
-    waiting for its trigger."""
+    waiting for its trigger. ``showing``: its sequence entry's settings."""
     slot: SLOT_BITS
     frame_id: 16
     bit_depth: 4      # 1..8 planes stored, most significant first: planes 8-bit_depth..7
     sequence: 1
+    showing: Showing
 
 
 class OccupancySignature(wiring.Signature):

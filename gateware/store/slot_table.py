@@ -16,12 +16,22 @@ Delta frames: a frame that carries only some rows names a whole frame as its bas
 is placed only if that base is held (being written, complete, shown or kept) and not stale, else
 refused (``NO_BASE``). A slot that would be freed while a delta held uses it as its base is KEPT
 instead (its words stay, it is never given out) and freed once no delta uses it.
+
+A sequence with entries (``entries`` > 0) gives out the frame of each entry of the entry table
+(:mod:`gateware.store.entries`) in turn instead of its slots in order, with the entry's settings;
+an entry's slot may be shown already (the same frame twice in a row). Played once (``loop``
+low), the last entry's answer says so and no answer follows until ``sequence_start`` (or a
+change of mode) plays the entries from the first again. An entry whose slot is outside the
+sequence is skipped and counted.
 """
 
 from amaranth import Array, Cat, Module, Mux, Signal
 from amaranth.lib import data, enum, stream, wiring
 from amaranth.lib.wiring import In, Out
 
+from spec.records import ENTRIES
+
+from .entries import ENTRY_BITS, Entry
 from .layouts import COUNTER_BITS, SLOT_BITS, FrameInfo
 
 __all__ = ["SlotTable", "SlotState", "Placement", "PlacementSignature", "opening_layout", "TableCounters"]
@@ -103,6 +113,7 @@ class TableCounters(data.Struct):
     bad_releases: COUNTER_BITS
     calibration_losses: COUNTER_BITS
     frames_lost: COUNTER_BITS
+    entries_skipped: COUNTER_BITS
 
 
 class SlotTable(wiring.Component):
@@ -127,6 +138,11 @@ class SlotTable(wiring.Component):
         From the writer: the completing row of this slot is in memory.
     sequence_length : In(5)
         0: streaming; N: sequence of N frames in slots 0..N-1 (at most ``slots``).
+    entries, loop, sequence_start : In(range(ENTRIES + 1)), In(1), In(1)
+        A sequence's entries played (0: its slots in order); in a loop or once; a pulse that
+        plays them from the first again.
+    entry_index : Out(ENTRY_BITS); entry : In(Entry)
+        The entry table's read port: the entry at the play position, the same cycle.
     asks : In(stream.Signature(0))
         Each transfer asks for one frame; an ask waits until a frame can be given.
     releases : In(stream.Signature(SLOT_BITS))
@@ -148,6 +164,11 @@ class SlotTable(wiring.Component):
             "completed": In(stream.Signature(SLOT_BITS, always_ready=True)),
             "written": In(stream.Signature(SLOT_BITS)),
             "sequence_length": In(5),
+            "entries": In(range(ENTRIES + 1)),
+            "loop": In(1),
+            "sequence_start": In(1),
+            "entry_index": Out(ENTRY_BITS),
+            "entry": In(Entry),
             "asks": In(stream.Signature(0)),
             "releases": In(stream.Signature(SLOT_BITS)),
             "answers": Out(stream.Signature(FrameInfo)),
@@ -196,24 +217,49 @@ class SlotTable(wiring.Component):
 
         # -- the answer to an ask
         ready_found, ready_slot = _first_of(m, n_slots, lambda s: (state[s] == SlotState.READY) & ~in_sequence[s])
-        play = Signal(SLOT_BITS)
+        play = Signal(ENTRY_BITS)      # the slot, or the entry, given out next
+        finished = Signal()            # played once: the last entry given out
         loaded = Signal()
         m.d.comb += loaded.eq(1)
         for s in range(n_slots):
             with m.If((s < seq_len) & ~((state[s] == SlotState.READY) | (state[s] == SlotState.SHOWN))):
                 m.d.comb += loaded.eq(0)
+        entry = self.entry
+        by_entry = sequence & (self.entries != 0)
+        last_entry = play + 1 >= self.entries
+        skip = by_entry & ~finished & (entry.slot >= seq_len)
+        m.d.comb += self.entry_index.eq(play)
         answer_slot = Signal(SLOT_BITS)
         can_answer = Signal()
-        with m.If(sequence):
+        with m.If(by_entry):
+            # (an entry may show the frame shown now: the sequencer holds a slot once)
+            m.d.comb += [answer_slot.eq(entry.slot),
+                         can_answer.eq(loaded & ~finished & ~skip & ((state[entry.slot] == SlotState.READY)
+                                                                | (state[entry.slot] == SlotState.SHOWN)))]
+        with m.Elif(sequence):
             m.d.comb += [answer_slot.eq(play), can_answer.eq(loaded & (state[play] == SlotState.READY))]
         with m.Else():
             m.d.comb += [answer_slot.eq(ready_slot), can_answer.eq(ready_found)]
+        answer = self.answers.payload
         m.d.comb += [
-            self.answers.payload.slot.eq(answer_slot),
-            self.answers.payload.frame_id.eq(frame_id[answer_slot]),
-            self.answers.payload.bit_depth.eq(depth[answer_slot]),
-            self.answers.payload.sequence.eq(sequence),
+            answer.slot.eq(answer_slot),
+            answer.frame_id.eq(frame_id[answer_slot]),
+            answer.bit_depth.eq(depth[answer_slot]),
+            answer.sequence.eq(sequence),
         ]
+        with m.If(by_entry):
+            m.d.comb += [answer.showing.lsb.eq(entry.lsb), answer.showing.dark.eq(entry.dark),
+                         answer.showing.follow.eq(entry.follow), answer.showing.camera_off.eq(entry.camera_off),
+                         answer.showing.last.eq(~self.loop & last_entry)]
+
+        def advance():
+            """The play position after the entry (or slot) given out or skipped."""
+            with m.If(by_entry):
+                m.d.sync += play.eq(Mux(last_entry, 0, play + 1))
+                with m.If(last_entry & ~self.loop):
+                    m.d.sync += finished.eq(1)
+            with m.Else():
+                m.d.sync += play.eq(Mux(play + 1 >= seq_len, 0, play + 1))
 
         # -- a base no delta uses any more is freed (housekeeping below never changes a KEPT slot
         # but to FREE)
@@ -247,7 +293,8 @@ class SlotTable(wiring.Component):
                 with m.Else():
                     m.d.sync += state[s].eq(SlotState.FREE)
         with m.Elif(mode_pending & self.placement.between_rows & ~offered):
-            m.d.sync += [seq_len.eq(wanted_len), play.eq(0), t.recv_active.eq(0), t.last_valid.eq(0)]
+            m.d.sync += [seq_len.eq(wanted_len), play.eq(0), finished.eq(0), t.recv_active.eq(0),
+                         t.last_valid.eq(0)]
             for s in range(n_slots):
                 with m.If(state[s] != SlotState.SHOWN):
                     m.d.sync += retire(s)
@@ -279,9 +326,13 @@ class SlotTable(wiring.Component):
                 m.d.comb += self.asks.ready.eq(1)
                 m.d.sync += state[answer_slot].eq(SlotState.SHOWN)
                 with m.If(sequence):
-                    m.d.sync += play.eq(play + 1)
-                    with m.If(play == seq_len - 1):
-                        m.d.sync += play.eq(0)
+                    advance()
+        with m.Elif(skip & ~offered & ~self.lose):
+            advance()
+            m.d.sync += count.entries_skipped.eq(count.entries_skipped + 1)
+        # last: from the first entry again (over an answer given out this cycle)
+        with m.If(self.sequence_start):
+            m.d.sync += [play.eq(0), finished.eq(0)]
         return m
 
     def _place(self, m, t, seq_len, mode_pending, sequence):

@@ -46,6 +46,7 @@ from amaranth.lib import data, wiring
 from amaranth.lib.wiring import Out
 
 from ..compose import forward, members
+from .entries import EntryTable
 from .layouts import BLOCK_BITS, COUNTER_BITS, SLOT_BITS
 from .row_ingest import RowIngest
 from .slot_crossing import SlotCrossing
@@ -69,16 +70,18 @@ class SlotCounters(data.Struct):
     bad_releases: COUNTER_BITS        # release of a slot that was not shown
     calibration_losses: COUNTER_BITS  # the memory lost its calibration: every frame forgotten
     frames_lost: COUNTER_BITS         # frames (held or not) forgotten when the memory was lost
+    entries_skipped: COUNTER_BITS     # sequence entries skipped: their slot is outside the sequence
 
 
 class FrameSlots(wiring.Component):
     """Frame slots, row bookkeeping and the occupancy map of the store.
 
-    Four parts: the row ingest (:class:`~gateware.store.row_ingest.RowIngest`) admits or drops each
+    Five parts: the row ingest (:class:`~gateware.store.row_ingest.RowIngest`) admits or drops each
     row, in the slot the slot table (:class:`~gateware.store.slot_table.SlotTable`) places it in;
     the maps (:class:`~gateware.store.slot_maps.SlotMaps`) hold the row bitmap and the occupancy
     map; the crossing (:class:`~gateware.store.slot_crossing.SlotCrossing`) carries the
-    sequencer's asks, releases and answers between ``dmd`` and ``sync``.
+    sequencer's asks, releases and answers between ``dmd`` and ``sync``; the entry table
+    (:class:`~gateware.store.entries.EntryTable`) holds a sequence's entries.
 
     Parameters
     ----------
@@ -93,9 +96,12 @@ class FrameSlots(wiring.Component):
     words, rows, store, bit_depth
         The row ingest's (``sync``): the serialiser's words and row flags in, the accepted words
         to the writer out, the bit depth of frames that start from now on.
-    written, sequence_length, lose, forgotten
-        The slot table's (``sync``): slots the writer has written, the mode, and the memory's
-        loss (:mod:`gateware.store.recovery`).
+    written, sequence_length, entries, loop, sequence_start, lose, forgotten
+        The slot table's (``sync``): slots the writer has written, the mode, the sequence's
+        entries played, and the memory's loss (:mod:`gateware.store.recovery`).
+    entry_writes
+        The entry table's (``sync``): entry records to write
+        (:class:`~gateware.store.entries.EntryTable`).
     counters : Out(SlotCounters)
         (``sync``).
     ask, frames, release
@@ -108,7 +114,8 @@ class FrameSlots(wiring.Component):
     #: The ports each part gives the whole.
     _PORTS = {
         "ingest": ("words", "rows", "store", "bit_depth"),
-        "table": ("written", "sequence_length", "lose", "forgotten"),
+        "table": ("written", "sequence_length", "entries", "loop", "sequence_start", "lose", "forgotten"),
+        "entries": ("entry_writes",),
         "crossing": ("ask", "frames", "release"),
         "maps": ("occupancy", "sources"),
     }
@@ -124,6 +131,7 @@ class FrameSlots(wiring.Component):
             "table": SlotTable(slots=slots, frame_bits=frame_bits),
             "crossing": SlotCrossing(),
             "maps": SlotMaps(dmd, slots=slots),
+            "entries": EntryTable(),
         }
         ports = {}
         for part, names in self._PORTS.items():
@@ -147,6 +155,8 @@ class FrameSlots(wiring.Component):
         wiring.connect(m, crossing.asks, table.asks)
         wiring.connect(m, crossing.releases, table.releases)
         wiring.connect(m, table.answers, crossing.answers)
+        entries = self._parts["entries"]
+        m.d.comb += [entries.index.eq(table.entry_index), table.entry.eq(entries.entry)]
         for part in self._COUNTING:
             counters = self._parts[part].counters
             for name in _counter_names(self._parts[part]):

@@ -46,7 +46,8 @@ class Store(wiring.Component):
 
     Members
     -------
-    words, rows, bit_depth, sequence_length, counters, ask, frames, release, occupancy
+    words, rows, bit_depth, sequence_length, entries, loop, sequence_start, entry_writes, counters, ask,
+    frames, release, occupancy
         The ports of :class:`~gateware.store.slots.FrameSlots` but those to the writer: the
         serialiser's words and row flags, control and counters (``sync``), the sequencer's asks,
         answers, releases and occupancy lookups (``dmd``).

@@ -159,7 +159,11 @@ class Projector(wiring.Component):
         m.d.comb += [
             store.bit_depth.eq(ethernet.settings.bit_depth),
             store.sequence_length.eq(Mux(seq_len > 1, seq_len, 0)),
+            store.entries.eq(ethernet.settings.entries),
+            store.loop.eq(ethernet.settings.loop[0]),
+            store.sequence_start.eq(ethernet.sequence_start),
         ]
+        wiring.connect(m, ethernet.entries, store.entry_writes)
         wiring.connect(m, store.mcb_write, wiring.flipped(self.mcb_write))
         wiring.connect(m, store.mcb_read, wiring.flipped(self.mcb_read))
 
@@ -220,6 +224,7 @@ class Projector(wiring.Component):
                              ("dlpc410_restarts", seq.status.restarts),
                              ("rst_active_cycles_max", seq.status.rst_longest),
                              ("frames_period_short", seq.status.period_short),
+                             ("triggers_after_end", seq.status.after_end),
                              ("pulses_late", seq.status.late), ("row_underruns", seq.status.underruns),
                              ("frames_bad_depth", seq.status.bad_frames),
                              ("registers_applied", registers.applied)):
@@ -240,6 +245,7 @@ class Projector(wiring.Component):
             status.store_rows_refused.eq(sum(store_counts[name] for name in (
                 "rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot", "rows_no_base"))),
             status.store_rows_no_base.eq(store_counts.rows_no_base),
+            status.sequence_entries_skipped.eq(store_counts.entries_skipped),
         ]
         # dlpc410_state: bit 0 INIT_ACTIVE, 1 RST_ACTIVE, 2 ECP2_FINISHED, 3 DDR2 calibrated,
         # 4 Ethernet link up, 5-6 link speed (2 = 1000 Mb/s)

@@ -53,6 +53,12 @@ PLAN = schedule.plan(DMD, 200e6, t_rst_s=200e-9, t_settle_s=300e-9, reset_mode=R
 GOOD_WIRE = records.register_wire(PLAN.params.registers(DMD))
 
 
+def entry_record(sequence=0, **fields):
+    """A sequence entry record as it is (the projector's checks are what is under test)."""
+    values = {"index": 0, "slot": 0, "lsb": 0, "dark": 0, "follow": 0, "camera_off": 0, **fields}
+    return _record(records.RecordType.ENTRY, body=wire.pack(records.ENTRY, values), sequence=sequence)
+
+
 def sequencer_record(sequence=0, **changes):
     return codec.sequencer_record({**GOOD_WIRE, **changes}, sequence)
 
@@ -91,6 +97,15 @@ BAD_RECORDS = {
                             "drop_app_length"),
     **{f"sequencer_{name}": (sequencer_record(**changes), "drop_app_value")
        for name, changes in BAD_REGISTERS.items()},
+    "entries_beyond_table": (codec.control_record(entries=257), "drop_app_value"),
+    "loop_not_a_bit": (codec.control_record(loop=2), "drop_app_value"),
+    "entry_index_beyond_table": (entry_record(index=256), "drop_app_value"),
+    "entry_slot_outside_sequence": (entry_record(slot=255), "drop_app_value"),
+    "entry_lsb_odd": (entry_record(lsb=3), "drop_app_value"),
+    "entry_dark_odd": (entry_record(dark=1), "drop_app_value"),
+    "entry_follow_not_a_bit": (entry_record(follow=2), "drop_app_value"),
+    "entry_camera_off_not_a_bit": (entry_record(camera_off=2), "drop_app_value"),
+    "entry_too_long": (entry_record() + b"\0", "drop_app_length"),
 }
 
 _PAYLOAD = codec.image_record(1, 0, IMAGE[0].tobytes())
@@ -134,13 +149,20 @@ def randomized_mix(count=260, seed=11):
         elif roll < 0.69:
             control = codec.control_record(seq, bit_depth=rng.randrange(0, 10),
                                            sequence_length=rng.randrange(0, 3),
-                                           software_trigger=rng.random() < 0.7)
+                                           software_trigger=rng.random() < 0.7, sequence_start=rng.random() < 0.6)
             raw, bad = frames.udp(A, control), False
             seq += 1
         elif roll < 0.74:
             changes = rng.choice([{"lsb": 2 * rng.randrange(GOOD_WIRE["lsb"] // 2, 1 << 20)},
                                   rng.choice(list(BAD_REGISTERS.values()))])
             raw, bad = frames.udp(A, sequencer_record(seq, **changes)), False
+            seq += 1
+        elif roll < 0.78:
+            # entries, mostly good: the slot against the sequence in force, odd times, flags
+            entry = entry_record(seq, index=rng.choice([0, 7, 255, 256]), slot=rng.choice([0, 0, 1, 2]),
+                                 lsb=2 * rng.randrange(5) + (rng.random() < 0.2), dark=2 * rng.randrange(4),
+                                 follow=rng.choice([0, 1, 0, 1, 2]))
+            raw, bad = frames.udp(A, entry), False
             seq += 1
         else:
             raw, bad, _ = rng.choice(bad_cases)

@@ -42,7 +42,9 @@ class Model:
     replies: list = field(default_factory=list)     # ("arp"|"icmp"|"status", details)
     config: dict = field(default_factory=dict)
     triggers: int = 0
+    sequence_starts: int = 0                         # control records with the sequence-start action
     registers: list = field(default_factory=list)   # sequencer register sets passed on (wire dicts)
+    entries: list = field(default_factory=list)     # sequence entry records passed on (wire dicts)
     _sequence: int | None = None
 
     def __post_init__(self):
@@ -143,6 +145,7 @@ class Model:
         sizes = {RecordType.IMAGE: records.IMAGE_HEADER,
                  RecordType.CONTROL: header_size + wire.size(records.CONTROL),
                  RecordType.SEQUENCER: header_size + wire.size(records.SEQUENCER),
+                 RecordType.ENTRY: header_size + wire.size(records.ENTRY),
                  RecordType.STATUS_QUERY: header_size}
         padded = data + bytes(max(0, max(sizes.values()) - len(data)))
         head = wire.unpack(records.HEADER, padded)
@@ -172,7 +175,15 @@ class Model:
                 return control["apply"] >> names.index(name) & 1
             if ((applies("bit_depth") and not 1 <= control["bit_depth"] <= 8)
                     or (applies("armed") and control["armed"] > 1)
-                    or (applies("sequence_length") and control["sequence_length"] == 0)):
+                    or (applies("sequence_length") and control["sequence_length"] == 0)
+                    or (applies("entries") and control["entries"] > 256)
+                    or (applies("loop") and control["loop"] > 1)):
+                return "drop_app_value"
+        if kind == RecordType.ENTRY:
+            # (the protocol page's rules, written out here, not the parser's shared function)
+            entry = wire.unpack(records.ENTRY, data[header_size:])
+            if (entry["index"] > 255 or entry["slot"] >= self.config["sequence_length"] or entry["lsb"] % 2
+                    or entry["dark"] % 2 or entry["follow"] > 1 or entry["camera_off"] > 1):
                 return "drop_app_value"
         if kind == RecordType.SEQUENCER:
             registers = wire.unpack(records.SEQUENCER, data[header_size:])
@@ -195,8 +206,13 @@ class Model:
                 if control["apply"] >> i & 1:
                     self.config[name] = control[name]
             self.triggers += control["action"] & 1
+            self.sequence_starts += control["action"] >> 1 & 1
             self.count("records_control")
             return "control"
+        if kind == RecordType.ENTRY:
+            self.entries.append(entry)
+            self.count("records_entry")
+            return "entry"
         if kind == RecordType.SEQUENCER:
             self.registers.append(registers)
             self.count("records_sequencer")

@@ -36,6 +36,7 @@ async def reset(dut):
     dut.rst.value = 1
     dut.status.value = 0
     dut.registers__ready.value = 1
+    dut.entries__ready.value = 1
     await ClockCycles(dut.clk, 3)
     dut.rst.value = 0
 
@@ -64,19 +65,23 @@ class TxCollector:
 
 
 class RegisterCollector:
-    """Every register set the block hands on (its consumer is always ready), and the trigger
-    pulses it gives."""
+    """Every register set and sequence entry the block hands on (its consumers are always
+    ready), and the trigger and sequence-start pulses it gives."""
 
     def __init__(self, dut):
-        self.dut, self.sets, self.triggers = dut, [], 0
+        self.dut, self.sets, self.entries, self.triggers, self.starts = dut, [], [], 0, 0
         cocotb.start_soon(self._run())
 
     async def _run(self):
+        entry = layout(records.ENTRY)
         while True:
             await RisingEdge(self.dut.clk)
             if self.dut.registers__valid.value:
                 self.sets.append(self.dut.registers__payload.value.to_unsigned())
+            if self.dut.entries__valid.value:
+                self.entries.append(unpack(entry, self.dut.entries__payload.value.to_unsigned()))
             self.triggers += int(self.dut.trigger.value)
+            self.starts += int(self.dut.sequence_start.value)
 
 
 def control_traffic(dmd):
@@ -237,6 +242,8 @@ async def randomized_mix_ledger(dut):
     assert strobes.triggers == model.triggers > 0
     assert unpack(layout(records.CONFIG), dut.settings.value.to_unsigned()) == model.config
     assert strobes.sets == [records.registers_bits(wire) for wire in model.registers] and model.registers
+    assert strobes.entries == model.entries and model.entries
+    assert strobes.starts == model.sequence_starts > 0
     # Status replies and ARP/ICMP replies come from two sources that take turns: the kinds
     # match one for one, the order between the two sources may differ.
     sent = sorted("arp" if ARP in Ether(raw) else "icmp" if ICMP in Ether(raw) else "status" for raw in tx.frames)

@@ -65,7 +65,8 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
     a = addresses or Addresses()
     dut = Endpoint(dmd, mac=a.mac, ip=a.ip, port=a.port, buffer_depth=buffer_depth)
     rng = random.Random(seed)
-    out = {"pixels": [], "tx": [], "triggers": 0, "registers": [], "cycle": 0, "activity": 0, "last_in": [],
+    out = {"pixels": [], "tx": [], "triggers": 0, "registers": [], "entries": [], "sequence_starts": 0, "cycle": 0,
+           "activity": 0, "last_in": [],
            "first_pixel": [], "snapshots": [], "rx_stalls": 0}
 
     async def clock(ctx):
@@ -100,7 +101,8 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
                 "app": plain(ctx.get(dut.app_counters), records.APP_COUNTERS),
                 "config": plain(ctx.get(dut.settings), records.CONFIG),
                 "pixel_count": len(out["pixels"]), "tx_count": len(out["tx"]),
-                "triggers": out["triggers"], "register_count": len(out["registers"])}
+                "triggers": out["triggers"], "register_count": len(out["registers"]),
+                "entry_count": len(out["entries"])}
 
     def took(p):
         out["activity"] = out["cycle"]
@@ -116,11 +118,16 @@ def run(frames, *, name, dmd=TEST_DMD, addresses=None, gap=(12, 12), seed=0, pix
             ready = not (tx_stall and trng.random() < tx_stall)
             ctx.set(dut.tx.ready, ready)
             ctx.set(dut.registers.ready, 1)
-            _, _, valid, beat, trigger, regs_valid, regs = await ctx.tick().sample(
-                dut.tx.valid, dut.tx.payload, dut.trigger, dut.registers.valid, dut.registers.payload)
+            ctx.set(dut.entries.ready, 1)
+            _, _, valid, beat, trigger, regs_valid, regs, entry_valid, entry, start = await ctx.tick().sample(
+                dut.tx.valid, dut.tx.payload, dut.trigger, dut.registers.valid, dut.registers.payload,
+                dut.entries.valid, dut.entries.payload, dut.sequence_start)
             out["triggers"] += trigger
+            out["sequence_starts"] += start
             if regs_valid:
                 out["registers"].append(regs.as_value().value)
+            if entry_valid:
+                out["entries"].append({name: int(getattr(entry, name)) for name, _ in records.ENTRY})
             if valid and ready:
                 current.append(beat.data)
                 out["activity"] = out["cycle"]

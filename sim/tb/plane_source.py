@@ -19,7 +19,7 @@ from amaranth.utils import ceil_log2
 
 from gateware.compose import forward, members
 from gateware.dlpc410.sequencer import Sequencer
-from gateware.store.layouts import SLOT_BITS, FrameInfo, PlaneRequest
+from gateware.store.layouts import SLOT_BITS, FrameInfo, PlaneRequest, Showing
 from sim.models import bitplane
 from spec.registers import TIME_BITS
 
@@ -54,12 +54,13 @@ class TableSignature(wiring.Signature):
 class OfferedFrame(data.Struct):
     """An entry of the frame table: offer a frame of ``bit_depth`` planes in ``slot`` once the
     sequencer's time base reaches ``ready`` (``sequence``: as the next frame of a stored
-    sequence); entries after the last have ``valid`` low."""
+    sequence), shown as ``showing`` says; entries after the last have ``valid`` low."""
     valid: 1
     slot: SLOT_BITS
     bit_depth: 4
     ready: TIME_BITS
     sequence: 1
+    showing: Showing
 
 
 @dataclass
@@ -73,8 +74,9 @@ class Contents:
 
 
 def contents(dmd, frames, images=None, store_words=1):
-    """The tables for ``frames`` (list of (slot, bit depth), (slot, bit depth, ready) or (slot,
-    bit depth, ready, sequence)) and
+    """The tables for ``frames`` (list of (slot, bit depth), (slot, bit depth, ready), (slot,
+    bit depth, ready, sequence) or (slot, bit depth, ready, sequence, showing): ``showing`` a
+    dict of :class:`~gateware.store.layouts.Showing`'s fields) and
     ``images`` ({slot: 8-bit image}; None: :func:`ramp_image` in every slot with every block
     marked occupied, whatever the image holds); the planes ``store_words`` words an entry."""
     assert len(frames) <= MAX_FRAMES, f"at most {MAX_FRAMES} frames"
@@ -87,7 +89,8 @@ def contents(dmd, frames, images=None, store_words=1):
         occupancy[slot] = [255] * dmd.blocks if images is None else \
             [int(x) for x in bitplane.occupancy(image, dmd.rows_per_block)]
     offered = [OfferedFrame.const({"valid": 1, "slot": f[0], "bit_depth": f[1], "ready": f[2] if len(f) > 2 else 0,
-                                   "sequence": f[3] if len(f) > 3 else 0}).as_value().value for f in frames]
+                                   "sequence": f[3] if len(f) > 3 else 0,
+                                   "showing": f[4] if len(f) > 4 else {}}).as_value().value for f in frames]
     words = planes.ravel()
     if store_words > 1:
         words = [sum(int(w) << (64 * i) for i, w in enumerate(words[k:k + store_words]))
@@ -158,6 +161,7 @@ class PlaneSource(wiring.Component):
                      self.frames.valid.eq((index < MAX_FRAMES) & entry.valid & (self.now >= entry.ready)),
                      self.frames.payload.slot.eq(entry.slot), self.frames.payload.bit_depth.eq(entry.bit_depth),
                      self.frames.payload.sequence.eq(entry.sequence),
+                     self.frames.payload.showing.eq(entry.showing),
                      self.frames.payload.frame_id.eq(index)]
         with m.If(self.frames.valid & self.frames.ready):
             m.d.sync += index.eq(index + 1)

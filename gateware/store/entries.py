@@ -1,0 +1,67 @@
+"""The sequence's entry table: which stored frame each step of a sequence shows, and how.
+
+A stored sequence plays its slots in order unless the control record names a number of entries:
+then it plays entries ``0 .. entries - 1`` of this table, each the frame of a slot (any slot of
+the sequence, as often as wanted) with its own least significant plane's time, dark time,
+trigger (wait for one, or follow the frame before) and camera trigger
+(:class:`~gateware.store.layouts.Showing`). The table is written one entry record at a time
+(:data:`spec.records.ENTRY`) and read by the slot table at its play position, in the same cycle.
+"""
+
+from amaranth import Module
+from amaranth.lib import data, memory, stream, wiring
+from amaranth.lib.wiring import In, Out
+
+from spec.records import ENTRIES, ENTRY
+
+from ..wire import layout
+from .layouts import SHOW_BITS, SLOT_BITS
+
+__all__ = ["Entry", "EntryTable", "ENTRY_BITS"]
+
+#: Bits of an entry's index.
+ENTRY_BITS = (ENTRIES - 1).bit_length()
+
+
+class Entry(data.Struct):
+    """One step of a sequence: the slot it shows and how (the entry record's fields)."""
+    slot: SLOT_BITS
+    lsb: SHOW_BITS
+    dark: SHOW_BITS
+    follow: 1
+    camera_off: 1
+
+
+class EntryTable(wiring.Component):
+    """:data:`spec.records.ENTRIES` entries (``sync``).
+
+    Members
+    -------
+    entry_writes : In(stream.Signature(layout(ENTRY)))
+        Checked entry records (:class:`~gateware.protocol.parser.Parser`): each writes its entry.
+    index : In(ENTRY_BITS)
+        The entry to read.
+    entry : Out(Entry)
+        Entry ``index``, this cycle (a table written never shows a half-written entry: a write
+        takes one cycle).
+    """
+
+    entry_writes: In(stream.Signature(layout(ENTRY)))
+    index: In(ENTRY_BITS)
+    entry: Out(Entry)
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.table = table = memory.Memory(shape=Entry, depth=ENTRIES, init=[])
+        write = table.write_port()
+        read = table.read_port(domain="comb")
+        record = self.entry_writes.payload
+        m.d.comb += [
+            self.entry_writes.ready.eq(1),
+            write.en.eq(self.entry_writes.valid),
+            write.addr.eq(record.index),
+            *(write.data[name].eq(record[name]) for name, _ in data.Layout.cast(Entry)),
+            read.addr.eq(self.index),
+            self.entry.eq(read.data),
+        ]
+        return m
