@@ -34,7 +34,12 @@ from gateware.store.broker import FrameBroker
 from gateware.store.layouts import FrameInfo
 from gateware.store.store import Store
 
-__all__ = ["Projector", "ShownFrame"]
+__all__ = ["Projector", "ShownFrame", "SLOTS"]
+
+#: Frame slots the projector keeps in DDR2: every slot the frame tags and the sequencer's slot
+#: numbers can name (``SLOT_BITS``), 12 MiB of XGA 8-bit frames, 35 MiB of DLP9500 ones, in the
+#: Atlys's 128 MiB. A stored sequence holds up to this many frames (128 bit-planes).
+SLOTS = 16
 
 FRAME_BITS = 16
 
@@ -66,7 +71,8 @@ class Projector(wiring.Component):
     sync_hz : float
         ``sync`` frequency (status replies report it; the PHY management derives MDC from it).
     slots : int
-        Frame slots in DDR2.
+        Frame slots in DDR2 (default :data:`SLOTS`): a stored sequence holds up to this many
+        frames.
     beats : int
         DCLK cycles per ``dmd`` cycle: 2 for DCLK 400 MHz (the platform's 4:1 serialisers), 1
         for 200 MHz.
@@ -98,14 +104,14 @@ class Projector(wiring.Component):
         The frame shown last (``dmd``); its id also reaches the status reply (``shown_frame``).
     """
 
-    def __init__(self, dmd, *, mac, ip, port, regs, armed=True, sync_hz=125e6, slots=4, mdio_cycles=None,
+    def __init__(self, dmd, *, mac, ip, port, regs, armed=True, sync_hz=125e6, slots=None, mdio_cycles=None,
                  beats=1):
         self._dmd = dmd
         self._addresses = dict(mac=mac, ip=ip, port=port)
         self._regs = regs
         self._armed = armed
         self._sync_hz = sync_hz
-        self._slots = slots
+        self._slots = SLOTS if slots is None else slots
         self._mdio_cycles = mdio_cycles or (None, None)
         self._beats = beats
         super().__init__({

@@ -445,20 +445,22 @@ async def frames_over_gmii_are_shown_exactly(dut):
 
 @cocotb.test()
 async def sequence_entries_play_as_their_table_says(dut):
-    """A stored sequence of two frames played by an entry table, once, configured over GMII as a
-    host does it (sequence mode, three entry records, the control record that plays them, then
-    the frames): one trigger shows the three entries back to back (the second at twice the
-    exposure, the others following with no trigger), every pixel's light is each entry's frame
-    at its own exposure, and a trigger after the last entry is ignored and counted."""
+    """A stored sequence of seven 8-bit frames (56 bit-planes, more than a DLPC350's 48) played
+    by an entry table of eight, once, configured over GMII as a host does it (sequence mode, the
+    entry records, the control record that plays them, then the frames): one trigger shows the
+    eight entries back to back (one at twice the exposure, one without a camera trigger, all but
+    the first following with no trigger), every pixel's light is each entry's frame at its own
+    exposure, and a trigger after the last entry is ignored and counted."""
     system = await System.started(dut)
     p, dmd, plan = system.p, system.dmd, system.plan
     rng = np.random.default_rng(p["seed"] + 7)
-    images = [rng.integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8) for _ in range(2)]
+    images = [rng.integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8) for _ in range(7)]
     lsb = plan.params.lsb
-    # (slot, lsb, follow, camera): entry 0 waits for the trigger, 1 and 2 follow
-    table = [(1, 0, False, True), (0, 2 * lsb, True, False), (1, 0, True, True)]
+    # (slot, lsb, follow, camera): entry 0 waits for the trigger, the others follow
+    table = [(6, 0, False, True), (0, 2 * lsb, True, False), *[(slot, 0, True, True) for slot in (1, 2, 3, 4, 5, 6)]]
     await system.records([codec.sequencer_record(plan.params.registers(dmd), system.next_sequence(), dmd=dmd),
-                          codec.control_record(system.next_sequence(), bit_depth=8, sequence_length=2, armed=1)])
+                          codec.control_record(system.next_sequence(), bit_depth=8, sequence_length=len(images),
+                                               armed=1)])
     entries = [codec.entry_record(k, slot, system.next_sequence(), lsb=entry_lsb, follow=follow, camera=camera)
                for k, (slot, entry_lsb, follow, camera) in enumerate(table)]
     await system.records([*entries, codec.control_record(system.next_sequence(), entries=len(table), loop=0,
@@ -468,7 +470,7 @@ async def sequence_entries_play_as_their_table_says(dut):
     # the sequence's first entry is loaded once the store holds both frames: then one trigger
     await system.dmd_clock.cycles(2 * plan.frame_cycles)
     pin = await system.trigger()
-    span = sum((entry_lsb or lsb) * 255 for _, entry_lsb, _, _ in table) + 3 * plan.frame_cycles
+    span = sum((entry_lsb or lsb) * 255 for _, entry_lsb, _, _ in table) + len(table) * plan.frame_cycles
     await system.dmd_clock.cycles(span)
     pulses = system.pulses_after(pin)
     assert pulses, "the trigger produced no clocking pulse"
@@ -479,7 +481,8 @@ async def sequence_entries_play_as_their_table_says(dut):
     expect = sum(images[slot].astype(np.int64) * (entry_lsb or lsb) for slot, entry_lsb, _, _ in table)
     assert np.array_equal(light, expect), f"max error {np.abs(light - expect).max() / lsb:.3g} LSB"
     status = await system.status()
-    assert status["records_entry"] == 3 and status["drop_app_value"] == 0, status
-    assert status["frames_shown"] == 3 and status["triggers"] == 1 and status["triggers_after_end"] == 1, status
+    assert status["records_entry"] == len(table) and status["drop_app_value"] == 0, status
+    assert status["frames_shown"] == len(table) and status["triggers"] == 1, status
+    assert status["triggers_after_end"] == 1 and status["store_frames_complete"] == len(images), status
     assert status["sequence_entries_skipped"] == 0 and status["pulses_late"] == 0, status
     Path(p["report"]).write_text(json.dumps({"latency_cycles": pulses[0].cycle - pin, "status": status}))
