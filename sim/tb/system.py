@@ -446,18 +446,18 @@ async def frames_over_gmii_are_shown_exactly(dut):
 @cocotb.test()
 async def sequence_entries_play_as_their_table_says(dut):
     """A stored sequence of seven 8-bit frames (56 bit-planes, more than a DLPC350's 48) played
-    by an entry table of eight, once, configured over GMII as a host does it (sequence mode, the
-    entry records, the control record that plays them, then the frames): one trigger shows the
-    eight entries back to back (one at twice the exposure, one without a camera trigger, all but
-    the first following with no trigger), every pixel's light is each entry's frame at its own
-    exposure, and a trigger after the last entry is ignored and counted."""
+    by an entry table of three of them, once, configured over GMII as a host does it (sequence
+    mode, the entry records, the control record that plays them, then the frames): one trigger
+    shows the three entries back to back (one at twice the exposure and without a camera
+    trigger, the last two following with no trigger), every pixel's light is each entry's frame
+    at its own exposure, and a trigger after the last entry is ignored and counted."""
     system = await System.started(dut)
     p, dmd, plan = system.p, system.dmd, system.plan
     rng = np.random.default_rng(p["seed"] + 7)
     images = [rng.integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8) for _ in range(7)]
     lsb = plan.params.lsb
     # (slot, lsb, follow, camera): entry 0 waits for the trigger, the others follow
-    table = [(6, 0, False, True), (0, 2 * lsb, True, False), *[(slot, 0, True, True) for slot in (1, 2, 3, 4, 5, 6)]]
+    table = [(6, 0, False, True), (0, 2 * lsb, True, False), (3, 0, True, True)]
     await system.records([codec.sequencer_record(plan.params.registers(dmd), system.next_sequence(), dmd=dmd),
                           codec.control_record(system.next_sequence(), bit_depth=8, sequence_length=len(images),
                                                armed=1)])
