@@ -27,7 +27,7 @@ from spec.registers import PlaneOrder, ResetMode
     # full 1080p, four buses, two beats a cycle, rows at the row cycle (four store words a cycle)
     ("dlp9500", "GLOBAL", True, "MSB_FIRST", 8, 400e6, 4, "ti"),
     # the four-DMD paper's settle reading: loads while the mirrors settle, pulses a settle apart
-    ("test4_400", "GLOBAL", True, "MSB_FIRST", 8, 400e6, 4, "paper"),
+    ("test4_400", "GLOBAL", True, "MSB_FIRST", 8, 400e6, 2, "paper"),
 ])
 def test_sequencer_verilog_xga(dmd, mode, strict, order, depth, dclk, words, reading, test_name):
     dmd = DMDS[dmd]
