@@ -25,6 +25,8 @@ change of mode) plays the entries from the first again. An entry whose slot is o
 sequence is skipped and counted.
 """
 
+from types import SimpleNamespace
+
 from amaranth import Array, Cat, Module, Mux, Signal
 from amaranth.lib import data, enum, stream, wiring
 from amaranth.lib.wiring import In, Out
@@ -216,50 +218,9 @@ class SlotTable(wiring.Component):
                 m.d.sync += t.recv_active.eq(0)
 
         # -- the answer to an ask
-        ready_found, ready_slot = _first_of(m, n_slots, lambda s: (state[s] == SlotState.READY) & ~in_sequence[s])
-        play = Signal(ENTRY_BITS)      # the slot, or the entry, given out next
-        finished = Signal()            # played once: the last entry given out
-        loaded = Signal()
-        m.d.comb += loaded.eq(1)
-        for s in range(n_slots):
-            with m.If((s < seq_len) & ~((state[s] == SlotState.READY) | (state[s] == SlotState.SHOWN))):
-                m.d.comb += loaded.eq(0)
-        entry = self.entry
-        by_entry = sequence & (self.entries != 0)
-        last_entry = play + 1 >= self.entries
-        skip = by_entry & ~finished & (entry.slot >= seq_len)
-        m.d.comb += self.entry_index.eq(play)
-        answer_slot = Signal(SLOT_BITS)
-        can_answer = Signal()
-        with m.If(by_entry):
-            # (an entry may show the frame shown now: the sequencer holds a slot once)
-            m.d.comb += [answer_slot.eq(entry.slot),
-                         can_answer.eq(loaded & ~finished & ~skip & ((state[entry.slot] == SlotState.READY)
-                                                                | (state[entry.slot] == SlotState.SHOWN)))]
-        with m.Elif(sequence):
-            m.d.comb += [answer_slot.eq(play), can_answer.eq(loaded & (state[play] == SlotState.READY))]
-        with m.Else():
-            m.d.comb += [answer_slot.eq(ready_slot), can_answer.eq(ready_found)]
-        answer = self.answers.payload
-        m.d.comb += [
-            answer.slot.eq(answer_slot),
-            answer.frame_id.eq(frame_id[answer_slot]),
-            answer.bit_depth.eq(depth[answer_slot]),
-            answer.sequence.eq(sequence),
-        ]
-        with m.If(by_entry):
-            m.d.comb += [answer.showing.lsb.eq(entry.lsb), answer.showing.dark.eq(entry.dark),
-                         answer.showing.follow.eq(entry.follow), answer.showing.camera_off.eq(entry.camera_off),
-                         answer.showing.last.eq(~self.loop & last_entry)]
-
-        def advance():
-            """The play position after the entry (or slot) given out or skipped."""
-            with m.If(by_entry):
-                m.d.sync += play.eq(Mux(last_entry, 0, play + 1))
-                with m.If(last_entry & ~self.loop):
-                    m.d.sync += finished.eq(1)
-            with m.Else():
-                m.d.sync += play.eq(Mux(play + 1 >= seq_len, 0, play + 1))
+        answer = self._answer(m, t, seq_len, sequence)
+        play, finished, advance = answer.play, answer.finished, answer.advance
+        answer_slot, can_answer, skip = answer.slot, answer.can_answer, answer.skip
 
         # -- a base no delta uses any more is freed (housekeeping below never changes a KEPT slot
         # but to FREE)
@@ -334,6 +295,60 @@ class SlotTable(wiring.Component):
         with m.If(self.sequence_start):
             m.d.sync += [play.eq(0), finished.eq(0)]
         return m
+
+    def _answer(self, m, t, seq_len, sequence):
+        """Drive ``answers``: which frame an ask is given (streaming: the newest ready; a
+        sequence: its slots in order, or its table's entries with their settings), and the
+        play position's registers. Returns them with ``advance()`` (the play position after a
+        frame given out or skipped)."""
+        n_slots = self._slots
+        state, frame_id, depth, in_sequence = t.state, t.frame_id, t.depth, t.in_sequence
+        ready_found, ready_slot = _first_of(m, n_slots, lambda s: (state[s] == SlotState.READY) & ~in_sequence[s])
+        play = Signal(ENTRY_BITS)      # the slot, or the entry, given out next
+        finished = Signal()            # played once: the last entry given out
+        loaded = Signal()
+        m.d.comb += loaded.eq(1)
+        for s in range(n_slots):
+            with m.If((s < seq_len) & ~((state[s] == SlotState.READY) | (state[s] == SlotState.SHOWN))):
+                m.d.comb += loaded.eq(0)
+        entry = self.entry
+        by_entry = sequence & (self.entries != 0)
+        last_entry = play + 1 >= self.entries
+        skip = by_entry & ~finished & (entry.slot >= seq_len)
+        m.d.comb += self.entry_index.eq(play)
+        answer_slot = Signal(SLOT_BITS)
+        can_answer = Signal()
+        with m.If(by_entry):
+            # (an entry may show the frame shown now: the sequencer holds a slot once)
+            m.d.comb += [answer_slot.eq(entry.slot),
+                         can_answer.eq(loaded & ~finished & ~skip & ((state[entry.slot] == SlotState.READY)
+                                                                | (state[entry.slot] == SlotState.SHOWN)))]
+        with m.Elif(sequence):
+            m.d.comb += [answer_slot.eq(play), can_answer.eq(loaded & (state[play] == SlotState.READY))]
+        with m.Else():
+            m.d.comb += [answer_slot.eq(ready_slot), can_answer.eq(ready_found)]
+        answer = self.answers.payload
+        m.d.comb += [
+            answer.slot.eq(answer_slot),
+            answer.frame_id.eq(frame_id[answer_slot]),
+            answer.bit_depth.eq(depth[answer_slot]),
+            answer.sequence.eq(sequence),
+        ]
+        with m.If(by_entry):
+            m.d.comb += [answer.showing.lsb.eq(entry.lsb), answer.showing.dark.eq(entry.dark),
+                         answer.showing.follow.eq(entry.follow), answer.showing.camera_off.eq(entry.camera_off),
+                         answer.showing.last.eq(~self.loop & last_entry)]
+
+        def advance():
+            """The play position after the entry (or slot) given out or skipped."""
+            with m.If(by_entry):
+                m.d.sync += play.eq(Mux(last_entry, 0, play + 1))
+                with m.If(last_entry & ~self.loop):
+                    m.d.sync += finished.eq(1)
+            with m.Else():
+                m.d.sync += play.eq(Mux(play + 1 >= seq_len, 0, play + 1))
+        return SimpleNamespace(play=play, finished=finished, advance=advance, slot=answer_slot,
+                               can_answer=can_answer, skip=skip)
 
     def _place(self, m, t, seq_len, mode_pending, sequence):
         """Drive ``placement``: where a row of ``placement.frame`` goes, from the registers ``t``."""
