@@ -137,15 +137,27 @@ def test_sequencer_rst_active_rule():
     assert "a clocking pulse while RST_ACTIVE was high" in failure.value.result.failed
 
 
+def _first_failure(check, build, depth):
+    """The failure of ``check`` with the property ``build`` makes (a claim stronger than the
+    check's), within ``depth`` steps."""
+    with pytest.raises(FormalFailure) as failure:
+        run(dataclasses.replace(check, block=f"{check.block}-stronger", build=build), depth=depth)
+    return failure.value.result
+
+
+# A claim one cycle stronger than the sequencer keeps fails, so the check is not vacuous; and as a
+# bounded check stops at the first step where any assertion fails, and the stronger claim fails
+# wherever the real one does, the step it fails at (on its strengthened assertion only) shows the
+# real claim holding at every step before it.
+
 def test_sequencer_settle_rule():
     """Checked to the suite's depth (a pulse comes at step 15, the loads after it from step 23);
-    and not vacuous: claimed one cycle longer after a pulse than the sequencer waits, it fails."""
+    and not vacuous: claimed one cycle longer after a pulse than the sequencer waits, it fails
+    (at step 26)."""
     check = _sequencer_check("no load within the settle time after a pulse and after RST_ACTIVE fell")
     assert run(check, depth=check.quick).status == "checked"
-    with pytest.raises(FormalFailure) as failure:
-        run(dataclasses.replace(check, block="Sequencer-settle-one-more", build=lambda: sequencer.settle_top(extra=1)),
-            depth=check.quick)
-    assert "a load sooner than t_rst + t_settle after a pulse" in failure.value.result.failed
+    result = _first_failure(check, lambda: sequencer.settle_top(extra=1), check.quick)
+    assert result.failed == ["a load sooner than t_rst + t_settle after a pulse"] and result.step == 26
 
 
 @pytest.mark.parametrize("dmd", [sequencer.DMD, sequencer.DMD_1080P_CLEAR], ids=["one-row-clear", "1080p-clear"])
@@ -163,12 +175,10 @@ def test_sequencer_clear_rule(dmd):
 
 
 def test_sequencer_phased_settle_rule():
-    """Checked to the suite's depth (a group's first pulse at step 22); and not vacuous: claimed
-    one cycle longer after a pulse than the sequencer waits, it fails (a quad pulse at step 22, a
-    clear of one of its blocks at step 30), which also shows the claim holds to step 29."""
+    """The real claim holds at every step before 30 (a group's first pulse at step 22, past the
+    suite's depth of the check): claimed one cycle longer after a pulse than the sequencer waits,
+    it fails at step 30 (a quad pulse at step 22, a clear of one of its blocks at step 30)."""
     check = _sequencer_check("no load of a pulsed group within its settle time, phased modes")
-    assert run(check, depth=check.quick).status == "checked"
-    with pytest.raises(FormalFailure) as failure:
-        run(dataclasses.replace(check, block="Sequencer-phased-settle-one-more",
-                                build=lambda: sequencer.phased_settle_top(extra=1)), depth=31)
-    assert failure.value.result.failed == ["a load sooner than t_rst + t_settle after a pulse"]
+    result = _first_failure(check, lambda: sequencer.phased_settle_top(extra=1), 31)
+    assert result.failed == ["a load sooner than t_rst + t_settle after a pulse"]
+    assert result.step == 30 and result.step > check.quick, result.step

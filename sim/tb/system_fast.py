@@ -10,8 +10,8 @@ Sequence: a control record makes the store keep the frames as a sequence; the fr
 ``one_by_one`` frames are triggered, each once the one before has been shown and the next one
 loaded, at a different phase of the trigger against the clock; then ``back_to_back`` triggers
 come faster than frames can be shown (every ``fast_period_cycles``): each is held until the
-sequencer is ready. At the end a status query is sent and the reply is recorded on the transmit
-pins.
+sequencer is ready. Once the last frame has ended, a status query is sent and the reply is
+recorded on the transmit pins.
 
 With ``window`` (``{"after_us": ..}``), the first frame's last datagram (``held``) is sent in
 the one-by-one phase: every signal is dumped from the moment it starts, through its last byte,
@@ -103,6 +103,13 @@ class Run:
         await Timer(round(at_ns - self.now_ns()), "ns")
         self.events["wall"][name] = time.monotonic() - self.wall0
 
+    async def count_frames(self):
+        """Counts the frames started: sync out rises at each frame's first pulse."""
+        self.frames_started = 0
+        while True:
+            await RisingEdge(self.dut.sync_out)
+            self.frames_started += 1
+
     async def progress(self, every_us):
         while True:
             await Timer(every_us, "us")
@@ -119,6 +126,7 @@ async def stream_frames(dut):
     run = Run(dut, p)
     await run.start()
     cocotb.start_soon(run.progress(p["progress_us"]))
+    cocotb.start_soon(run.count_frames())
     period_ns = p["period_cycles"] * DMD_NS
     window = p.get("window")
     if window:
@@ -156,7 +164,14 @@ async def stream_frames(dut):
         shown += 1
         run.log(f"frame {shown} triggered, back to back")
         await Timer(round(start + fast_ns - run.now_ns()), "ns")
-    await Timer(round(2 * period_ns + p["margin_us"] * 1e3), "ns")
+    # the held frames play one after another: the last ends its back-to-back lag after the loop
+    # (sync out falls after its last group's final dark pulse); a memory that stalls may make it
+    # later, so wait for it, two frames at most
+    give_up = run.now_ns() + p["back_to_back"] * (period_ns - fast_ns) + 2 * period_ns
+    while (run.frames_started < p["one_by_one"] + p["back_to_back"] or dut.sync_out.value) \
+            and run.now_ns() < give_up:
+        await Timer(10, "us")
+    await Timer(p["margin_us"], "us")
     run.check_memory()
     await run.send(p["status_query"], "status query", "query")
     await Timer(p["reply_us"], "us")
