@@ -26,7 +26,7 @@ from spec import schedule
 from spec.facts import DMDS
 from spec.registers import PlaneOrder, ResetMode
 
-__all__ = ["main", "run", "core", "plan", "power_up_plan", "PARAMS", "XGA_FRAMES"]
+__all__ = ["main", "run", "core", "plan", "power_up_plan", "PARAMS", "XGA_FRAMES", "XGA_ENTRIES"]
 
 MAC, IP, PORT = 0x02_00_00_00_00_01, 0x0A_00_00_02, 5000
 DMD_NS = 5.0
@@ -35,6 +35,9 @@ DMD_NS = 5.0
 XGA_FRAMES = 3
 XGA_ONE_BY_ONE = 3
 XGA_BACK_TO_BACK = 6
+#: The entry table ``make sim`` plays its stored frames by (the slot of each entry, in a loop):
+#: in order, the second twice (a frame shown again is not read from the network again).
+XGA_ENTRIES = (0, 1, 1, 2)
 
 #: The small-geometry system run's parameters (the testbench's ``params()``).
 PARAMS = {"dmd": "test", "mac": "02:00:00:00:00:01", "ip": "10.0.0.2", "port": PORT,
@@ -99,10 +102,10 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=False, dmd="dlp70
           f"sent over GMII from a replay file ("
           + ("every one whole, the first last, its last datagram held back for the wave window"
              if window else "the first whole, the others as deltas of it") + ") and stored as a "
-          f"sequence, {XGA_ONE_BY_ONE} triggered one by "
-          f"one, then {XGA_BACK_TO_BACK} back to back; Verilog MCB model on both memory ports; DLPC410 pins "
-          f"recorded and checked afterwards by the rule-checking DLPC410 model and the camera model; TI "
-          f"timing (only INIT_ACTIVE shortened)")
+          f"sequence played by an entry table (slots {list(XGA_ENTRIES)}, in a loop), {XGA_ONE_BY_ONE} "
+          f"triggered one by one, then {XGA_BACK_TO_BACK} back to back; Verilog MCB model on both memory "
+          f"ports; DLPC410 pins recorded and checked afterwards by the rule-checking DLPC410 model and the "
+          f"camera model; TI timing (only INIT_ACTIVE shortened)")
     f = xga.FAULTS[faults] if faults else {}
     if "mcb_stall_permille" in f:
         print(f"faults: {f['mcb_stall_permille']} in 1000 memory commands stall up to {f['mcb_stall_max_ns']} ns "
@@ -114,7 +117,7 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=False, dmd="dlp70
     key = "-".join(["scene", *([name] if name != "dlp7000" else []), *([faults] if faults else []),
                     *(["window"] if window else [])])
     r = xga.run(key, frames=frames, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK, dclk_hz=dclk_hz,
-                faults=faults, window=window, dmd=dmd)
+                faults=faults, window=window, dmd=dmd, entries=XGA_ENTRIES)
     shown, status = r["frames"], r["status"]
     ns = 1e9 / xga.DMD_HZ
     typical, worst = latency(shown)
@@ -123,7 +126,8 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=False, dmd="dlp70
     measured = sorted(periods)[len(periods) // 2]
     print()
     print(f"DCLK: {r['dclk_hz'] / 1e6:g} MHz ({r['dclk_hz'] / xga.DMD_HZ:g} beats per {xga.DMD_HZ / 1e6:g} MHz cycle)")
-    print(f"frames shown: {len(shown)}")
+    print(f"frames shown: {len(shown)} (slots {r['slots_played']}, each its entry's; entry records "
+          f"{status['records_entry']}, entries skipped {status['sequence_entries_skipped']})")
     print(f"trigger pin to first clocking pulse: typical {typical} cycles ({typical * ns:.0f} ns), "
           f"worst {worst} cycles ({worst * ns:.0f} ns)")
     print(f"trigger pin to the optical change (+ {optical} cycles, pulse to mirror motion, facts "

@@ -113,9 +113,11 @@ def _datagrams(payloads, port=PORT):
                   / Raw(payload)) for payload in payloads]
 
 
-def _replay_files(directory, images, hold_last=False):
+def _replay_files(directory, images, hold_last=False, entries=None):
     """GMII replay files, as the sends the testbench makes in order (``path``, ``what``,
-    ``kind``): a control record that makes the store keep the frames as a sequence, then one per
+    ``kind``): a control record that makes the store keep the frames as a sequence (with
+    ``entries``, a tuple of slots: then the entry table's records, and a control record that
+    plays the sequence by them, in a loop), then one per
     frame (its image records, then the first record again addressed to another UDP port, which
     the stack must drop and count); and one with a status query. The first frame goes whole; each
     later one, as a user streams a moving target, goes as a delta of it: only the rows in which it
@@ -124,9 +126,15 @@ def _replay_files(directory, images, hold_last=False):
     Returns (sends, held, query, datagrams)."""
     sends, held, sequence = [], None, 0
     setup = directory / "sequence.bin"
-    gmii.replay_file(setup, _datagrams([codec.control_record(sequence, sequence_length=len(images))]))
-    sequence, datagrams = 1, 1
-    sends.append({"path": str(setup), "what": "sequence of stored frames (control record)", "kind": "control"})
+    setup_records = [codec.control_record(sequence, sequence_length=len(images))]
+    what = "sequence of stored frames (control record)"
+    if entries:
+        setup_records += [codec.entry_record(k, slot, 1 + k) for k, slot in enumerate(entries)]
+        setup_records.append(codec.control_record(1 + len(entries), entries=len(entries), loop=1))
+        what = f"sequence of stored frames played by {len(entries)} entries {list(entries)} (records)"
+    gmii.replay_file(setup, _datagrams(setup_records))
+    sequence, datagrams = len(setup_records), len(setup_records)
+    sends.append({"path": str(setup), "what": what, "kind": "control"})
     order = list(range(len(images)))
     if hold_last:
         order = order[1:] + order[:1]
@@ -164,9 +172,10 @@ def _status(tx_trace):
 
 
 def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, faults=None, log=print,
-        calibrated=True, window=False, dmd=DMD):
+        calibrated=True, window=False, dmd=DMD, entries=None):
     """Build and run the XGA system simulation on ``frames`` frames of the default scene, stored
-    as a sequence; ``one_by_one`` frames triggered each when the sequencer is ready, then
+    as a sequence (played in slot order, or by ``entries``: the slot of each entry of its entry
+    table, in a loop); ``one_by_one`` frames triggered each when the sequencer is ready, then
     ``back_to_back`` frames triggered faster than they can be shown. Returns the report (dict).
     Raises on a broken DLPC410 or memory rule, a responder mismatch, back-to-back frames that
     start other than the schedule model's (unless the memory stalls), or a missing status reply;
@@ -185,7 +194,7 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
     directory = build_dir("system", key)
     t0 = time.monotonic()
     images = default_scene(frames, dmd.rows, dmd.columns)
-    sends, held, query, datagrams = _replay_files(directory, images, hold_last=window)
+    sends, held, query, datagrams = _replay_files(directory, images, hold_last=window, entries=entries)
     log(f"scene encoded: {frames} frames, {datagrams} datagrams ({time.monotonic() - t0:.1f} s)")
     files = {name: directory / f"{name}.txt" for name in ("pins", "tx")}
     report_path = directory / "stimulus.json"
@@ -216,7 +225,7 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
     log(f"simulation done: build and run {time.monotonic() - t_build:.0f} s, of which the run {sim_wall:.0f} s; "
         f"checking the pins")
     report = analyse(the_plan, images, stimulus, files, one_by_one=one_by_one, back_to_back=back_to_back,
-                     build=build, faults=faults, dmd=dmd, window=window)
+                     build=build, faults=faults, dmd=dmd, window=window, entries=entries)
     report["t_rst_cycles"], report["t_rst_measured"] = the_plan.params.t_rst, t_rst_cycles is not None
     if window:
         report["window"] = _window(directory / "window.vcd", stimulus, report)
@@ -254,13 +263,14 @@ def _frames_shown(pins, layout, pulses):
     return frames
 
 
-def _model_back_to_back(dmd, the_plan, images, first, strobes):
-    """The schedule model's frame starts for the stored frames ``first, first + 1, ..`` of the
-    sequence triggered at ``strobes`` (relative cycles, the first when every group is ready)."""
+def _model_back_to_back(dmd, the_plan, images, order, first, strobes):
+    """The schedule model's frame starts for the frames ``first, first + 1, ..`` the sequence
+    plays (``order``: the slot of each, in a loop), triggered at ``strobes`` (relative cycles, the
+    first when every group is ready)."""
     p = the_plan.params
     occupancy = [tuple(int(x) for x in bitplane.occupancy(image, dmd.rows_per_block)) for image in images]
-    frames = [schedule.Frame(k % len(images), 8, occupancy[k % len(images)], sequence=True)
-              for k in range(first, first + len(strobes))]
+    slots = [order[k % len(order)] for k in range(first, first + len(strobes))]
+    frames = [schedule.Frame(slot, 8, occupancy[slot], sequence=True) for slot in slots]
     ready = schedule.ready_cycle(dmd, p, frames[0])
     r = schedule.simulate(dmd, p, frames, [ready + s for s in strobes])
     assert r.late == 0 and r.overruns == 0, (r.late, r.overruns)
@@ -268,8 +278,9 @@ def _model_back_to_back(dmd, the_plan, images, first, strobes):
 
 
 def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, build=None, faults=None, dmd=DMD,
-            window=False):
+            window=False, entries=None):
     t0 = time.monotonic()
+    order = list(entries) if entries else list(range(len(images)))     # the slot of each frame played
     p = the_plan.params
     layout = pin_layout(dmd.buses, p.beats)
     pins = trace.read(files["pins"])
@@ -285,7 +296,7 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
     assert len(frames) == len(triggers) == one_by_one + back_to_back, (len(frames), len(triggers))
     shown = []
     for index, (first, last) in enumerate(frames):
-        image = images[index % len(images)]
+        image = images[order[index % len(order)]]
         light = to_lsb(camera.image(first, first + period), lsb)
         # (the camera sees the visible columns: the DLP9500's 1920 of the 2048 sent)
         error = np.abs(light - image[:, :light.shape[1]].astype(np.float64))
@@ -298,7 +309,7 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
     # triggers (the first one found every group ready, the others were held)
     fast = shown[one_by_one:]
     starts = [f["start_cycle"] - fast[0]["start_cycle"] for f in fast]
-    want = _model_back_to_back(dmd, the_plan, images, one_by_one,
+    want = _model_back_to_back(dmd, the_plan, images, order, one_by_one,
                                [f["trigger_cycle"] - fast[0]["trigger_cycle"] for f in fast])
     # memory stalls delay rows and pulses; a controller's own RST_ACTIVE time is in the plan
     compared = "mcb_stall_permille" not in FAULTS.get(faults, {})
@@ -316,6 +327,7 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
     scene = _scene_rate(images, sends, status)
     return {
         "frames": shown,
+        "slots_played": [order[k % len(order)] for k in range(len(shown))],
         "dclk_hz": DMD_HZ * p.beats,
         "period_cycles": period,
         "periods_measured": periods,

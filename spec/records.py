@@ -33,7 +33,7 @@ from .wire import size
 MAGIC = 0x444D
 #: Protocol version this tree speaks; records with any other version are dropped and counted.
 #: ``magic`` and ``version`` keep their places in every version, so that a projector can tell.
-VERSION = 5
+VERSION = 6
 #: IPv4 and UDP headers around a record: a record fills an MTU less these.
 UDP_IP_OVERHEAD = 28
 #: Largest record: a UDP payload inside a 9000-byte IP MTU (9000 - 20 IPv4 - 8 UDP).
@@ -111,6 +111,7 @@ ENTRY = [
     ("dark", 24),
     ("follow", 8),
     ("camera_off", 8),
+    ("depth", 8),
 ]
 
 #: Counters kept by the network stack (frames, by outcome).
@@ -270,7 +271,7 @@ def register_faults(wire, row_cycles, clear_row_cycles):
 def entry_faults(wire, sequence_length):
     """Why an entry record cannot be written (``{check: condition}``, as
     :func:`register_faults`): its index beyond the table, a slot outside the sequence in force
-    (``sequence_length``), an odd time, a flag other than 0 or 1."""
+    (``sequence_length``), an odd time, a flag other than 0 or 1, a bit depth over 8."""
     return {
         "index": wire["index"] >= ENTRIES,
         "slot": wire["slot"] >= sequence_length,
@@ -278,6 +279,7 @@ def entry_faults(wire, sequence_length):
         "dark_even": (wire["dark"] & 1) != 0,
         "follow": wire["follow"] > 1,
         "camera_off": wire["camera_off"] > 1,
+        "depth": wire["depth"] > 8,
     }
 
 

@@ -408,17 +408,20 @@ def test_play_sequence_sends_the_table_then_the_frames(projector):
     the projector would drop are refused before anything is sent."""
     rng = np.random.default_rng(5)
     images = [rng.integers(0, 256, SHAPE, dtype=np.uint8) for _ in range(2)]
-    entries = [{"slot": 1}, {"slot": 0, "lsb": 400, "follow": True, "camera": False}, {"slot": 1, "dark": 90 * 2}]
+    entries = [{"slot": 1}, {"slot": 0, "lsb": 400, "follow": True, "camera": False},
+               {"slot": 1, "dark": 90 * 2, "depth": 3}]
     with Client("127.0.0.1", projector.port, timeout=1.0, rate=50e6, mtu=1500) as client:
         with pytest.raises(ClientError, match="outside the sequence"):
             client.play_sequence(images, [{"slot": 2}])
         with pytest.raises(ClientError, match="entry 0: .*lsb_even"):
             client.play_sequence(images, [{"slot": 0, "lsb": 3}])
+        with pytest.raises(ClientError, match="entry 1: .*depth"):
+            client.play_sequence(images, [{"slot": 0}, {"slot": 1, "depth": 9}])
         assert projector.received == []
         sent = client.play_sequence(images, entries, loop=False, depth=8)
     model = projector.model
-    assert [(e["slot"], e["lsb"], e["dark"], e["follow"], e["camera_off"]) for e in model.entries] == \
-        [(1, 0, 0, 0, 0), (0, 400, 0, 1, 1), (1, 0, 180, 0, 0)]
+    assert [(e["slot"], e["lsb"], e["dark"], e["follow"], e["camera_off"], e["depth"]) for e in model.entries] == \
+        [(1, 0, 0, 0, 0, 0), (0, 400, 0, 1, 1, 0), (1, 0, 180, 0, 0, 3)]
     assert model.counters["records_entry"] == 3 and model.counters["drop_app_value"] == 0
     assert model.config["sequence_length"] == 2 and model.config["entries"] == 3 and model.config["loop"] == 0
     assert model.sequence_starts == 1

@@ -51,10 +51,10 @@ class Bench:
         await stream_feed(ctx, self.dut.pixels, store_stim.frame_beats(image, frame_id, rows=rows, base=base,
                                                                         carried=carried), idle=idle)
 
-    async def feed_sequence(self, ctx, images, order):
-        """Sequence mode of ``len(images)`` frames at depth 1, then the frames in ``order``."""
+    async def feed_sequence(self, ctx, images, order, depth=1):
+        """Sequence mode of ``len(images)`` frames at ``depth``, then the frames in ``order``."""
         ctx.set(self.dut.sequence_length, len(images))
-        ctx.set(self.dut.bit_depth, 1)
+        ctx.set(self.dut.bit_depth, depth)
         for _ in range(3):
             await ctx.tick()
         for f in order:
@@ -857,30 +857,33 @@ def test_calibration_loss_mid_burst(moment, test_name):
 
 
 def test_sequence_entries(test_name):
-    """A sequence of 3 frames played by an entry table, once: the entries' slots in the table's
-    order (the same slot twice in a row too), each answer with its entry's settings, an entry
-    whose slot is outside the sequence skipped and counted, the last entry's answer marked last
-    and no answer after it, until ``sequence_start`` plays the entries from the first again;
-    played in a loop, the entries wrap round."""
+    """A sequence of 3 frames (6 bits) played by an entry table, once: the entries' slots in the
+    table's order (the same slot twice in a row too), each answer with its entry's settings and
+    bit depth (the frame's own for 0 or more than it has), an entry whose slot is outside the
+    sequence skipped and counted, the last entry's answer marked last and no answer after it,
+    until ``sequence_start`` plays the entries from the first again; played in a loop, the
+    entries wrap round."""
     bench = Bench(SHORT_DMD)
     dut = bench.dut
     images = {f: store_stim.random_image(SHORT_DMD, 1300 + f) for f in range(3)}
-    table = [(2, 100, 0, 0, 0), (0, 0, 40, 1, 1), (0, 0, 0, 1, 0), (5, 0, 0, 0, 0), (1, 60, 0, 1, 0)]
+    # (slot, lsb, dark, follow, camera_off, depth)
+    table = [(2, 100, 0, 0, 0, 0), (0, 0, 40, 1, 1, 3), (0, 0, 0, 1, 0, 8), (5, 0, 0, 0, 0, 1), (1, 60, 0, 1, 0, 6)]
     got = []
 
     async def producer(ctx):
-        for index, (slot, lsb, dark, follow, camera_off) in enumerate(table):
+        for index, (slot, lsb, dark, follow, camera_off, depth) in enumerate(table):
             ctx.set(dut.entry_writes.payload, {"index": index, "slot": slot, "lsb": lsb, "dark": dark,
-                                                "follow": follow, "camera_off": camera_off})
+                                                "follow": follow, "camera_off": camera_off, "depth": depth})
             ctx.set(dut.entry_writes.valid, 1)
             await ctx.tick()
         ctx.set(dut.entry_writes.valid, 0)
         ctx.set(dut.entries, len(table))
         ctx.set(dut.loop, 0)
-        await bench.feed_sequence(ctx, images, (0, 1, 2))
+        await bench.feed_sequence(ctx, images, (0, 1, 2), depth=6)
 
     async def answer(ctx, wait=None):
-        """The next answer's (slot, frame id, showing), or None if none comes in ``wait`` cycles."""
+        """The next answer's (slot, frame id, showing and bit depth), or None if none comes in
+        ``wait`` cycles."""
         ctx.set(dut.ask.valid, 1)
         ctx.set(dut.frames.ready, 1)
         for _ in range(wait or 100_000):
@@ -892,7 +895,7 @@ def test_sequence_entries(test_name):
                 ctx.set(dut.frames.ready, 0)
                 s = payload.showing
                 return (int(payload.slot), int(payload.frame_id),
-                        tuple(int(x) for x in (s.lsb, s.dark, s.follow, s.camera_off, s.last)))
+                        tuple(int(x) for x in (s.lsb, s.dark, s.follow, s.camera_off, s.last, payload.bit_depth)))
         ctx.set(dut.ask.valid, 0)
         ctx.set(dut.frames.ready, 0)
         return None
@@ -915,10 +918,11 @@ def test_sequence_entries(test_name):
         ctx.set(dut.loop, 1)
         for _ in range(4):
             slot, _, showing = await answer(ctx)
-            got.append((slot, showing[-1]))
+            got.append((slot, showing[4]))
         assert bench.counters(ctx)["bad_releases"] == 0
 
     bench.run([producer, consumer], test_name, deadline=8e-4)
-    assert got[:4] == [(2, (100, 0, 0, 0, 0)), (0, (0, 40, 1, 1, 0)), (0, (0, 0, 1, 0, 0)), (1, (60, 0, 1, 0, 1))]
+    assert got[:4] == [(2, (100, 0, 0, 0, 0, 6)), (0, (0, 40, 1, 1, 0, 3)), (0, (0, 0, 1, 0, 0, 6)),
+                       (1, (60, 0, 1, 0, 1, 6))]
     # started again: entry 0; in a loop: entries 1, 2, (3 skipped) 4, 0, none marked last
     assert got[4:] == [(2, None), (0, 0), (0, 0), (1, 0), (2, 0)]

@@ -1,9 +1,10 @@
 """The projector's core on full XGA (DLP7000, TI timing, DCLK 400 MHz), end to end on its
 generated Verilog: two frames of the default scene over GMII (the second as a delta of the first),
-stored as a sequence, then three triggers faster than frames can be shown: the first finds the
-sequencer ready, the others are held and played back to back at the frame starts of the schedule
-model; every DLPC410 rule checked on the recorded pins, the image the camera sees exact. Shares
-its Verilator build with ``make sim``."""
+stored as a sequence played by an entry table (the second frame, then the first twice), then
+three triggers faster than frames can be shown: the first finds the sequencer ready, the others
+are held and played back to back at the frame starts of the schedule model; every DLPC410 rule
+checked on the recorded pins, the image the camera sees exact. Shares its Verilator build with
+``make sim``."""
 
 import pytest
 
@@ -12,10 +13,12 @@ from sim import xga
 
 @pytest.mark.verilog
 def test_xga_frames_end_to_end():
-    r = xga.run("test", frames=2, one_by_one=0, back_to_back=3)
+    entries = (1, 0, 0)
+    r = xga.run("test", frames=2, one_by_one=0, back_to_back=3, entries=entries)
     assert r["dclk_hz"] == 400e6
     shown = r["frames"]
     assert len(shown) == 3
+    # each frame is the image of its entry's slot, exact (the two frames differ where the target moved)
     for frame in shown:
         assert frame["max_error_lsb"] == 0, f"{frame['wrong_pixels']} pixels wrong"
         assert frame["span_cycles"] == r["model_span_cycles"], "the frame's pulses are the schedule model's"
@@ -31,14 +34,16 @@ def test_xga_frames_end_to_end():
     assert status["rows"] == rows + delta_rows and 0 < delta_rows < rows // 4
     assert status["store_frames_complete"] == 2 and status["store_rows_refused"] == 0
     # every datagram reached the stack; the one per frame to another UDP port was dropped and counted
-    assert status["frames"] == status["records_image"] + 2 + 2
+    setup = 2 + len(entries)           # two control records and the entries
+    assert status["frames"] == status["records_image"] + setup + 2 + 1
     assert status["drop_udp_port"] == 2
-    assert status["accepted"] == status["records_image"] + 2     # the control record, the status query
+    assert status["accepted"] == status["records_image"] + setup + 1     # and the status query
+    assert status["records_entry"] == len(entries) and status["sequence_entries_skipped"] == 0
     drops = {k: v for k, v in status.items() if k.startswith("drop") and k != "drop_udp_port" and v}
     assert not drops, drops
     assert status["triggers"] == 3 and status["trigger_overruns"] == 0 and status["triggers_held"] == 2
-    # the sequence of two frames plays on: the last frame shown is the first again
-    assert status["shown_frame"] == (len(shown) - 1) % 2 and status["newest_frame"] == 1
+    # the last entry shows slot 0 (each frame's image was checked against its entry's slot above)
+    assert status["shown_frame"] == 0 and status["newest_frame"] == 1
     assert status["rows_incomplete"] == 0
 
 

@@ -3,9 +3,10 @@
 A stored sequence plays its slots in order unless the control record names a number of entries:
 then it plays entries ``0 .. entries - 1`` of this table, each the frame of a slot (any slot of
 the sequence, as often as wanted) with its own least significant plane's time, dark time,
-trigger (wait for one, or follow the frame before) and camera trigger
-(:class:`~gateware.store.layouts.Showing`). The table is written one entry record at a time
-(:data:`spec.records.ENTRY`) and read by the slot table at its play position, in the same cycle.
+trigger (wait for one, or follow the frame before), camera trigger
+(:class:`~gateware.store.layouts.Showing`) and bit depth (its frame's most significant planes).
+The table is written one entry record at a time (:data:`spec.records.ENTRY`) and read by the
+slot table at its play position, in the same cycle.
 """
 
 from amaranth import Module
@@ -24,12 +25,14 @@ ENTRY_BITS = (ENTRIES - 1).bit_length()
 
 
 class Entry(data.Struct):
-    """One step of a sequence: the slot it shows and how (the entry record's fields)."""
+    """One step of a sequence: the slot it shows and how (the entry record's fields; ``depth``:
+    its frame's most significant planes shown, 0 or more than the frame has: all)."""
     slot: SLOT_BITS
     lsb: SHOW_BITS
     dark: SHOW_BITS
     follow: 1
     camera_off: 1
+    depth: 4
 
 
 class EntryTable(wiring.Component):

@@ -19,7 +19,8 @@ instead (its words stay, it is never given out) and freed once no delta uses it.
 
 A sequence with entries (``entries`` > 0) gives out the frame of each entry of the entry table
 (:mod:`gateware.store.entries`) in turn instead of its slots in order, with the entry's settings;
-an entry's slot may be shown already (the same frame twice in a row). Played once (``loop``
+an entry's slot may be shown already (the same frame twice in a row), at the entry's bit depth
+(its frame's most significant planes) when that is smaller. Played once (``loop``
 low), the last entry's answer says so and no answer follows until ``sequence_start`` (or a
 change of mode) plays the entries from the first again. An entry whose slot is outside the
 sequence is skipped and counted.
@@ -335,6 +336,10 @@ class SlotTable(wiring.Component):
             answer.sequence.eq(sequence),
         ]
         with m.If(by_entry):
+            # an entry's depth: its frame's most significant planes (the reader takes planes
+            # 8 - depth .. 7 of a slot, the frame's own included)
+            with m.If((entry.depth != 0) & (entry.depth < depth[answer_slot])):
+                m.d.comb += answer.bit_depth.eq(entry.depth)
             m.d.comb += [answer.showing.lsb.eq(entry.lsb), answer.showing.dark.eq(entry.dark),
                          answer.showing.follow.eq(entry.follow), answer.showing.camera_off.eq(entry.camera_off),
                          answer.showing.last.eq(~self.loop & last_entry)]

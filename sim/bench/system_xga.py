@@ -1,14 +1,14 @@
 """System figures of the full-XGA run (:mod:`sim.xga`, what ``make sim`` runs): DLP7000, TI
-timing, DCLK 400 MHz, the default scene stored as a sequence and played one by one then back to
-back: DCLK, the frame period measured on the pins, latency, grey error, simulation speed."""
+timing, DCLK 400 MHz, the default scene stored as a sequence played by an entry table, one by one
+then back to back: DCLK, the frame period measured on the pins, latency, grey error, simulation speed."""
 
 from sim import xga
-from sim.system import XGA_BACK_TO_BACK, XGA_FRAMES, XGA_ONE_BY_ONE, latency
+from sim.system import XGA_BACK_TO_BACK, XGA_ENTRIES, XGA_FRAMES, XGA_ONE_BY_ONE, latency
 
 
 def run():
     r = xga.run("bench", frames=XGA_FRAMES, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK,
-                log=lambda _text: None)
+                entries=XGA_ENTRIES, log=lambda _text: None)
     assert all(f["max_error_lsb"] == 0 for f in r["frames"]), "the XGA run showed a wrong image"
     typical, worst = latency(r["frames"])
     period = _median_period(r)

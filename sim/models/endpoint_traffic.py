@@ -55,7 +55,7 @@ GOOD_WIRE = records.register_wire(PLAN.params.registers(DMD))
 
 def entry_record(sequence=0, **fields):
     """A sequence entry record as it is (the projector's checks are what is under test)."""
-    values = {"index": 0, "slot": 0, "lsb": 0, "dark": 0, "follow": 0, "camera_off": 0, **fields}
+    values = {"index": 0, "slot": 0, "lsb": 0, "dark": 0, "follow": 0, "camera_off": 0, "depth": 0, **fields}
     return _record(records.RecordType.ENTRY, body=wire.pack(records.ENTRY, values), sequence=sequence)
 
 
@@ -105,6 +105,7 @@ BAD_RECORDS = {
     "entry_dark_odd": (entry_record(dark=1), "drop_app_value"),
     "entry_follow_not_a_bit": (entry_record(follow=2), "drop_app_value"),
     "entry_camera_off_not_a_bit": (entry_record(camera_off=2), "drop_app_value"),
+    "entry_depth_over_8": (entry_record(depth=9), "drop_app_value"),
     "entry_too_long": (entry_record() + b"\0", "drop_app_length"),
 }
 
