@@ -1,27 +1,30 @@
 """The planner: every pulse group's timeline, and what each group must be loaded with next.
 
 Each group (:func:`spec.registers.group_size` blocks pulsed together) keeps its place in the
-frame (display position, dark or not), the frame slot and bit depth it shows, and four times:
-when its next pulse falls due, when its memory may change again (``t_rst + t_settle`` after its
-last pulse, and no sooner than ``t_settle`` after RST_ACTIVE fell: :mod:`.reset_watch`), when
-RST_ACTIVE allows its next pulse, and whether it is loaded. When the bus makes
-a pulse, the planner sets the group's next pulse time and queues its next load job: the next
-plane (a plane long enough to hide the load, ``hide``), or clears ended by a dark pulse. At the
-last plane of a frame group 0 takes the newest complete frame, if one is offered (else the frame
-repeats). The frame control starts, reloads and triggers the groups through command events.
+frame (display position, dark or not), whether it is loaded and plays, the frame it shows (slot,
+bit depth, entry settings: :mod:`.group_frames`) and its times (:mod:`.group_times`): when its
+next pulse falls due, when its memory may change again (``t_rst + t_settle`` after its last
+pulse, and no sooner than ``t_settle`` after RST_ACTIVE fell: :mod:`.reset_watch`) and when
+RST_ACTIVE allows its next pulse. When the bus makes a pulse, the planner decides what follows
+it: the group's next pulse time and its next load job, the next plane (a plane long enough to
+hide the load, ``hide``) or clears ended by a dark pulse. At the last plane of a frame group 0
+takes the newest complete frame, if one is offered (else the frame repeats). The frame control
+starts, reloads and triggers the groups through command events.
 """
 
-from amaranth import Array, Cat, Module, Mux, Shape, Signal
+from amaranth import Array, Cat, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from spec.schedule import INIT_TO_DVALID, row_cycles
+from spec.schedule import row_cycles
 
 from ..registers import LSB_BITS, TIME_BITS, Registers, Source
 from ..store.layouts import SLOT_BITS, FrameInfo, Showing
+from .group_frames import GroupFrames
+from .group_times import GroupTimes
 from .layouts import COUNTER_BITS, event, group_bits, load_job
 from .reset_watch import ResetWatch
-from .timebase import diff, exponent
+from .timebase import exponent
 
 __all__ = ["Planner", "Offer"]
 
@@ -35,14 +38,6 @@ class Offer(data.Struct):
     depth: 4
     sequence: 1
     showing: Showing
-
-
-#: The entry settings each group keeps of its frame.
-_PER_GROUP = ("lsb", "dark", "camera_off", "last")
-
-
-def _width(name):
-    return Shape.cast(data.Layout.cast(Showing)[name].shape).width
 
 
 #: What the frame control's ``start`` begins: a frame, and whether it is the one offered.
@@ -173,30 +168,15 @@ class Planner(wiring.Component):
             return Array(Signal(shape, name=f"{name}{g}", init=init) for g in range(G))
         pending = per_group(1, "pending")
         loaded = per_group(1, "loaded")
-        pulse_at = per_group(TIME_BITS, "pulse_at")
-        writable = per_group(TIME_BITS, "writable", INIT_TO_DVALID)
-        rst_free = per_group(TIME_BITS, "rst_free")
         pos = per_group(3, "pos")
         dark = per_group(1, "dark")
-        slot = per_group(SLOT_BITS, "slot")
-        depth = per_group(4, "depth")
-        # the entry settings of each group's frame (its follow flag is only read of the frame
-        # taken next)
-        show = {name: per_group(_width(name), f"show_{name}") for name in _PER_GROUP}
-        rst_any = Signal(TIME_BITS)
-        next_slot = Signal(SLOT_BITS)          # the newest frame taken
-        next_depth = Signal(4)
-        next_show = Signal(Showing)
-        m.d.comb += self.depth.eq(depth[0])
+        m.submodules.frames = frames = GroupFrames(dmd)
 
-        def lsb_of(g):
-            """The least significant plane's time of group ``g``'s frame."""
-            return Mux(show["lsb"][g] != 0, show["lsb"][g], regs.lsb)
-        m.d.comb += self.lsb.eq(lsb_of(0))
-
-        def set_show(g, value):
-            return [show[name][g].eq(value[name]) for name in _PER_GROUP]
-        active = [Signal(name=f"active{g}") for g in range(G)]
+        def lsb_of(frame):
+            """The least significant plane's time of ``frame``."""
+            return Mux(frame.showing.lsb != 0, frame.showing.lsb, regs.lsb)
+        m.d.comb += [self.depth.eq(frames.first.depth), self.lsb.eq(lsb_of(frames.first))]
+        active = Signal(G)
         for g in range(G):
             m.d.comb += active[g].eq(g < self.n_groups)
 
@@ -205,22 +185,27 @@ class Planner(wiring.Component):
                      watch.pulse.valid.eq(self.pulse.valid), watch.pulse.payload.eq(self.pulse.payload),
                      self.rst_late.eq(watch.late), self.rst_faults.eq(watch.faults),
                      self.rst_longest.eq(watch.longest)]
+        m.submodules.times = times = GroupTimes(dmd, soon=R, soon_clear=dmd.clear_row_cycles * R)
+        m.d.comb += [times.regs.eq(regs), times.now.eq(now), times.active.eq(active),
+                     times.trigger.valid.eq(self.trigger.valid), times.trigger.payload.eq(self.trigger.payload),
+                     times.retake.valid.eq(self.retake.valid), times.retake.payload.eq(self.retake.payload.lead),
+                     times.fell.valid.eq(watch.fell.valid), times.fell.payload.groups.eq(watch.fell.payload.groups),
+                     times.fell.payload.settled.eq(watch.fell.payload.settled)]
         # ---- what the bus may do ----
         armed = [Signal(name=f"armed{g}") for g in range(G)]
         for g in range(G):
             # strict: no pulse while RST_ACTIVE may be high, by the plan or at the pin; loose: a
             # group's own reset only (RST_ACTIVE at the pin may be another group's; a group whose
             # reset has not ended is kept unloaded by the RST_ACTIVE watch, so it cannot pulse)
-            rst_ok = Mux(regs.strict_rst, (diff(rst_any, now) <= 0) & ~self.rst_active, diff(rst_free[g], now) <= 0)
+            rst_ok = Mux(regs.strict_rst, times.rst_over_any & ~self.rst_active, times.rst_over[g])
             m.d.comb += [
                 armed[g].eq(active[g] & pending[g] & loaded[g]),
-                self.due[g].eq(armed[g] & (diff(pulse_at[g], now) <= 0) & rst_ok),
-                self.writable[g].eq((diff(writable[g], now) <= 0) & ~watch.waiting[g]),
+                self.due[g].eq(armed[g] & times.due[g] & rst_ok),
+                self.writable[g].eq(times.memory_free[g] & ~watch.waiting[g]),
             ]
-        clear_len = dmd.clear_row_cycles * R
         m.d.comb += [
-            self.imminent.eq(Cat(armed[g] & (diff(pulse_at[g], now) < R) for g in range(G)).any()),
-            self.imminent_clear.eq(Cat(armed[g] & (diff(pulse_at[g], now) < clear_len) for g in range(G)).any()),
+            self.imminent.eq(Cat(armed[g] & times.soon[g] for g in range(G)).any()),
+            self.imminent_clear.eq(Cat(armed[g] & times.soon_clear[g] for g in range(G)).any()),
             self.all_ready.eq(Cat(~active[g] | (~pending[g] & loaded[g]) for g in range(G)).all()),
             self.playing.eq(Cat(active[g] & pending[g] for g in range(G)).any()),
         ]
@@ -242,49 +227,43 @@ class Planner(wiring.Component):
 
         # ---- a pulse: what follows it ----
         p = self.pulse.payload
-        pj, pdark, pdepth = pos[p], dark[p], depth[p]
+        mine = frames.frame                    # the pulsed group's frame
+        m.d.comb += [frames.group.eq(p), frames.offered.slot.eq(self.frames.payload.slot),
+                     frames.offered.depth.eq(depth_in), frames.offered.showing.eq(self.frames.payload.showing)]
+        pj, pdark, pdepth = pos[p], dark[p], mine.depth
         pe = exponent(m, regs, pj, pdepth, "pulse_exp")
         last = pj == pdepth - 1
         plane_len = Signal.like(regs.hide)
-        m.d.comb += plane_len.eq(lsb_of(p) << pe)
+        m.d.comb += plane_len.eq(lsb_of(mine) << pe)
         # the frame after this one starts without a trigger: chained, or it follows (group 0
         # takes the one offered, if any); never after a sequence's last frame, nor hidden behind
         # a frame that wants dark time after it
         offered = (p == 0) & self.offer.valid & ~use_prng
         follow = Signal()
-        m.d.comb += follow.eq((regs.chain | Mux(offered, self.offer.showing.follow, next_show.follow))
-                              & ~show["last"][p])
-        pdark_time = show["dark"][p]
+        m.d.comb += follow.eq((regs.chain | Mux(offered, self.offer.showing.follow, frames.next.showing.follow))
+                              & ~mine.showing.last)
+        pdark_time = mine.showing.dark
         hidden = ~pdark & (plane_len >= regs.hide) & (~last | (follow & (pdark_time == 0)))
         new_frame = last & (pdark | hidden)
-        take = Signal()
-        n_slot = Mux(take, self.frames.payload.slot, next_slot)
-        n_depth = Mux(take, depth_in, next_depth)
-        n_show = Mux(take, self.frames.payload.showing.as_value(), next_show.as_value())
+        take = frames.take
         m.d.comb += take.eq(self.pulse.valid & new_frame & (p == 0) & self.offer.valid & ~use_prng)
         with m.If(take):
             m.d.comb += self.frames.ready.eq(1)
         job = self.jobs.payload
+        m.d.comb += [times.pulse.valid.eq(self.pulse.valid), times.pulse.payload.group.eq(p),
+                     times.pulse.payload.delay.eq(
+                         Mux(pdark, Mux(last & (pdark_time > regs.dark_gap), pdark_time, regs.dark_gap), plane_len))]
         with m.If(self.pulse.valid):
-            with m.If(diff(pulse_at[p], now) < 0):
+            with m.If(times.late):
                 m.d.sync += self.late.eq(self.late + 1)
-            m.d.sync += [
-                writable[p].eq(now + regs.t_rst + regs.t_settle),
-                rst_free[p].eq(now + regs.t_rst),
-                rst_any.eq(now + regs.t_rst),
-                loaded[p].eq(0),
-                pulse_at[p].eq(now + Mux(pdark, Mux(last & (pdark_time > regs.dark_gap), pdark_time, regs.dark_gap),
-                                         plane_len)),
-            ]
-            with m.If(p == 0):
-                m.d.sync += [next_slot.eq(n_slot), next_depth.eq(n_depth), next_show.eq(n_show)]
-            m.d.comb += [self.jobs.valid.eq(1), job.group.eq(p), job.slot.eq(slot[p]),
+            m.d.sync += loaded[p].eq(0)
+            m.d.comb += [self.jobs.valid.eq(1), job.group.eq(p), job.slot.eq(mine.slot),
                          job.depth.eq(pdepth), job.pos.eq(pj + 1)]
             with m.If(pdark | hidden):
                 m.d.sync += [dark[p].eq(0), pos[p].eq(Mux(last, 0, pj + 1))]
                 with m.If(last):
-                    m.d.sync += [slot[p].eq(n_slot), depth[p].eq(n_depth), *set_show(p, Showing(n_show))]
-                    m.d.comb += [job.slot.eq(n_slot), job.depth.eq(n_depth), job.pos.eq(0)]
+                    m.d.comb += [frames.advance.valid.eq(1), frames.advance.payload.eq(p),
+                                 job.slot.eq(frames.coming.slot), job.depth.eq(frames.coming.depth), job.pos.eq(0)]
                     with m.If(pdark & ~follow):
                         m.d.sync += pending[p].eq(0)
             with m.Else():
@@ -292,39 +271,36 @@ class Planner(wiring.Component):
                 m.d.comb += job.clear.eq(1)
             # frame boundaries: sync out, the frame counter
             with m.If((p == 0) & ~pdark & (pj == 0)):
-                m.d.comb += [self.frame_start.eq(1), self.camera_start.eq(~show["camera_off"][0])]
+                m.d.comb += [self.frame_start.eq(1), self.camera_start.eq(~frames.first.showing.camera_off)]
                 m.d.sync += [self.sync_out.eq(1), self.frames_started.eq(self.frames_started + 1)]
-                with m.If(show["last"][0]):
+                with m.If(frames.first.showing.last):
                     m.d.sync += self.ended.eq(1)
             with m.If((p == self.n_groups - 1) & pdark & last & ~follow):
                 m.d.sync += self.sync_out.eq(0)
 
-        # ---- commands of the frame control ----
+        # ---- commands of the frame control (a retake's frame over a start's) ----
+        every = frames.every
         with m.If(self.start.valid):
             begin = self.start.payload
             with m.If(begin.take):
                 m.d.comb += self.frames.ready.eq(1)
-            m.d.sync += [next_slot.eq(begin.slot), next_depth.eq(begin.depth), next_show.eq(begin.showing),
-                         self.ended.eq(0)]
+            m.d.comb += [every.valid.eq(1), every.payload.slot.eq(begin.slot), every.payload.depth.eq(begin.depth),
+                         every.payload.showing.eq(begin.showing)]
+            m.d.sync += self.ended.eq(0)
             for g in range(G):
-                m.d.sync += [slot[g].eq(begin.slot), depth[g].eq(begin.depth), pos[g].eq(0), dark[g].eq(0),
-                             *set_show(g, begin.showing)]
+                m.d.sync += [pos[g].eq(0), dark[g].eq(0)]
         with m.If(self.queue_first.valid):
             m.d.comb += [self.jobs.valid.eq(1), job.group.eq(self.queue_first.payload),
-                         job.slot.eq(next_slot), job.depth.eq(next_depth), job.pos.eq(0), job.clear.eq(0)]
+                         job.slot.eq(frames.next.slot), job.depth.eq(frames.next.depth), job.pos.eq(0), job.clear.eq(0)]
         with m.If(self.retake.valid):
             newer = self.retake.payload.newer
-            lead = self.retake.payload.lead
             with m.If(newer):
                 m.d.comb += self.frames.ready.eq(1)
                 m.d.sync += self.ended.eq(0)
-            r_slot = Mux(newer, self.frames.payload.slot, next_slot)
-            r_depth = Mux(newer, depth_in, next_depth)
-            r_show = Showing(Mux(newer, self.frames.payload.showing.as_value(), next_show.as_value()))
-            m.d.sync += [next_slot.eq(r_slot), next_depth.eq(r_depth), next_show.eq(r_show)]
+            m.d.comb += [every.valid.eq(1),
+                         every.payload.eq(Mux(newer, frames.offered.as_value(), frames.next.as_value()))]
             for g in range(G):
-                m.d.sync += [slot[g].eq(r_slot), depth[g].eq(r_depth), loaded[g].eq(0), *set_show(g, r_show),
-                             writable[g].eq(Mux(diff(writable[g], lead) < 0, lead, writable[g]))]
+                m.d.sync += loaded[g].eq(0)
                 with m.If(self.retake.payload.abandon):
                     m.d.sync += [pending[g].eq(0), pos[g].eq(0), dark[g].eq(0)]
             with m.If(self.retake.payload.abandon):
@@ -332,13 +308,5 @@ class Planner(wiring.Component):
         with m.If(self.trigger.valid):
             for g in range(G):
                 with m.If(active[g]):
-                    m.d.sync += [pending[g].eq(1), pulse_at[g].eq(self.trigger.payload + regs.stagger * g)]
-
-        # ---- RST_ACTIVE fell: no change before its settle time (last: it may meet a retake) ----
-        settled = watch.fell.payload.settled
-        for g in range(G):
-            base = Mux(self.retake.valid & (diff(writable[g], self.retake.payload.lead) < 0),
-                       self.retake.payload.lead, writable[g])
-            with m.If(watch.fell.valid & watch.fell.payload.groups[g] & (diff(base, settled) < 0)):
-                m.d.sync += writable[g].eq(settled)
+                    m.d.sync += pending[g].eq(1)
         return m

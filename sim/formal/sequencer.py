@@ -264,16 +264,16 @@ def _sequencer_top(prop, watch=None, *, init_to_dvalid=None, dmd=DMD):
     member ``member`` of its part ``part`` for ``watch = (part, member)`` (:func:`_watched`);
     ``init_to_dvalid``: a shorter wait before the first load than the facts' 64 clocks, so that a
     bounded check reaches a pulse within a few tens of steps (15 with 2)."""
-    from gateware.dlpc410 import planner
+    from gateware.dlpc410 import group_times
     from gateware.dlpc410.sequencer import Sequencer
     watched = Signal()
-    original = planner.INIT_TO_DVALID
-    planner.INIT_TO_DVALID = original if init_to_dvalid is None else init_to_dvalid
+    original = group_times.INIT_TO_DVALID
+    group_times.INIT_TO_DVALID = original if init_to_dvalid is None else init_to_dvalid
     try:
         with _watched(*watch, watched) if watch else nullcontext():
             return Fragment.get(FormalTop(Sequencer(dmd, beats=1, store_words=1), [prop(watched)]), None)
     finally:
-        planner.INIT_TO_DVALID = original
+        group_times.INIT_TO_DVALID = original
 
 
 def _init_top():

@@ -1,0 +1,95 @@
+"""The frame each pulse group shows: its slot, bit depth and entry settings, and the newest frame
+taken, which a group takes next.
+
+Group 0 takes the frame offered (``take``) when it moves on to a new frame; the others take the
+newest one taken when they move on (``advance``); a start or a retake gives every group, and the
+next frame, one frame (``every``).
+"""
+
+from amaranth import Array, Module, Mux, Shape, Signal
+from amaranth.lib import data, wiring
+from amaranth.lib.wiring import In, Out
+
+from ..store.layouts import SLOT_BITS, Showing
+from .layouts import event, group_bits
+
+__all__ = ["GroupFrames", "FRAME"]
+
+#: A frame as a group shows it.
+FRAME = data.StructLayout({"slot": SLOT_BITS, "depth": 4, "showing": Showing})
+
+#: The entry settings each group keeps of its frame (its follow flag is only read of the frame
+#: taken next).
+_KEPT = ("lsb", "dark", "camera_off", "last")
+
+
+class GroupFrames(wiring.Component):
+    """Per-group frames (``sync``).
+
+    Parameters
+    ----------
+    dmd : :class:`spec.facts.DmdType`
+
+    Members
+    -------
+    group : In(group)
+        The group whose frame ``frame`` is.
+    frame, first : Out(FRAME)
+        The frame of group ``group``, of group 0 (their ``showing.follow`` is 0: not kept).
+    next : Out(FRAME)
+        The newest frame taken.
+    offered : In(FRAME); take : In(1)
+        The frame offered; it is taken now (the next frame from the next cycle).
+    coming : Out(FRAME)
+        The frame a group moving on now takes: the one offered if it is taken, else ``next``.
+    advance : In(event(group))
+        The group moves on to ``coming``.
+    every : In(event(FRAME))
+        Every group, and the next frame, take this frame (after ``advance`` and ``take``).
+    """
+
+    def __init__(self, dmd):
+        self._dmd = dmd
+        super().__init__({
+            "group": In(group_bits(dmd)),
+            "frame": Out(FRAME),
+            "first": Out(FRAME),
+            "next": Out(FRAME),
+            "offered": In(FRAME),
+            "take": In(1),
+            "coming": Out(FRAME),
+            "advance": In(event(group_bits(dmd))),
+            "every": In(event(FRAME)),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        G = self._dmd.blocks
+
+        def per_group(shape, name):
+            return Array(Signal(shape, name=f"{name}{g}") for g in range(G))
+        slot, depth = per_group(SLOT_BITS, "slot"), per_group(4, "depth")
+        showing = data.Layout.cast(Showing)
+        show = {name: per_group(Shape.cast(showing[name].shape), f"show_{name}") for name in _KEPT}
+        next_frame = Signal(FRAME)
+
+        def read(g, port):
+            m.d.comb += [port.slot.eq(slot[g]), port.depth.eq(depth[g]),
+                         *(port.showing[name].eq(show[name][g]) for name in _KEPT)]
+        read(self.group, self.frame)
+        read(0, self.first)
+        m.d.comb += [self.next.eq(next_frame),
+                     self.coming.eq(Mux(self.take, self.offered.as_value(), next_frame.as_value()))]
+
+        def give(g, frame):
+            return [slot[g].eq(frame.slot), depth[g].eq(frame.depth),
+                    *(show[name][g].eq(frame.showing[name]) for name in _KEPT)]
+        with m.If(self.advance.valid):
+            m.d.sync += give(self.advance.payload, self.coming)
+        with m.If(self.take):
+            m.d.sync += next_frame.eq(self.offered)
+        with m.If(self.every.valid):
+            m.d.sync += next_frame.eq(self.every.payload)
+            for g in range(G):
+                m.d.sync += give(g, self.every.payload)
+        return m
