@@ -263,13 +263,11 @@ def _frames_shown(pins, layout, pulses):
     return frames
 
 
-def _model_back_to_back(dmd, the_plan, images, order, first, strobes):
-    """The schedule model's frame starts for the frames ``first, first + 1, ..`` the sequence
-    plays (``order``: the slot of each, in a loop), triggered at ``strobes`` (relative cycles, the
-    first when every group is ready)."""
+def _model_back_to_back(dmd, the_plan, images, slots, strobes):
+    """The schedule model's frame starts for the stored frames of ``slots`` played in turn,
+    triggered at ``strobes`` (relative cycles, the first when every group is ready)."""
     p = the_plan.params
     occupancy = [tuple(int(x) for x in bitplane.occupancy(image, dmd.rows_per_block)) for image in images]
-    slots = [order[k % len(order)] for k in range(first, first + len(strobes))]
     frames = [schedule.Frame(slot, 8, occupancy[slot], sequence=True) for slot in slots]
     ready = schedule.ready_cycle(dmd, p, frames[0])
     r = schedule.simulate(dmd, p, frames, [ready + s for s in strobes])
@@ -280,7 +278,6 @@ def _model_back_to_back(dmd, the_plan, images, order, first, strobes):
 def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, build=None, faults=None, dmd=DMD,
             window=False, entries=None):
     t0 = time.monotonic()
-    order = list(entries) if entries else list(range(len(images)))     # the slot of each frame played
     p = the_plan.params
     layout = pin_layout(dmd.buses, p.beats)
     pins = trace.read(files["pins"])
@@ -294,9 +291,12 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
     camera = Camera(model, ramp_cycles=0)
     frames = _frames_shown(pins, layout, pulses)
     assert len(frames) == len(triggers) == one_by_one + back_to_back, (len(frames), len(triggers))
+    # the slot of each frame played: the entries' in turn, else the slots in order
+    order = list(entries) if entries else list(range(len(images)))
+    played = [order[k % len(order)] for k in range(len(frames))]
     shown = []
     for index, (first, last) in enumerate(frames):
-        image = images[order[index % len(order)]]
+        image = images[played[index]]
         light = to_lsb(camera.image(first, first + period), lsb)
         # (the camera sees the visible columns: the DLP9500's 1920 of the 2048 sent)
         error = np.abs(light - image[:, :light.shape[1]].astype(np.float64))
@@ -309,7 +309,7 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
     # triggers (the first one found every group ready, the others were held)
     fast = shown[one_by_one:]
     starts = [f["start_cycle"] - fast[0]["start_cycle"] for f in fast]
-    want = _model_back_to_back(dmd, the_plan, images, order, one_by_one,
+    want = _model_back_to_back(dmd, the_plan, images, played[one_by_one:],
                                [f["trigger_cycle"] - fast[0]["trigger_cycle"] for f in fast])
     # memory stalls delay rows and pulses; a controller's own RST_ACTIVE time is in the plan
     compared = "mcb_stall_permille" not in FAULTS.get(faults, {})
@@ -327,7 +327,7 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
     scene = _scene_rate(images, sends, status)
     return {
         "frames": shown,
-        "slots_played": [order[k % len(order)] for k in range(len(shown))],
+        "slots_played": played,
         "dclk_hz": DMD_HZ * p.beats,
         "period_cycles": period,
         "periods_measured": periods,

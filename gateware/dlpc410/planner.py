@@ -246,7 +246,7 @@ class Planner(wiring.Component):
         hidden = ~pdark & (plane_len >= regs.hide) & (~last | (follow & (pdark_time == 0)))
         new_frame = last & (pdark | hidden)
         take = frames.take
-        m.d.comb += take.eq(self.pulse.valid & new_frame & (p == 0) & self.offer.valid & ~use_prng)
+        m.d.comb += take.eq(self.pulse.valid & new_frame & offered)
         with m.If(take):
             m.d.comb += self.frames.ready.eq(1)
         job = self.jobs.payload
