@@ -10,8 +10,10 @@ path is made of.
   separate chains the path goes through.
 
 A path starts at a flip-flop output, a block RAM or DSP output, a shift-register LUT or a top
-input, and ends at a flip-flop, block RAM, DSP or shift-register input; it belongs to the clock
-domain of the cell it ends at. The budget for 200 MHz on a -3 Spartan-6 that the ``dmd`` domain
+input, and ends at a flip-flop, block RAM, DSP or shift-register input, or at a LUT-RAM's write
+side (data, write enable, write address: written on the clock edge); a LUT-RAM read is one LUT
+level from its read address to its output. A path belongs to the clock domain of the cell it
+ends at. The budget for 200 MHz on a -3 Spartan-6 that the ``dmd`` domain
 is pipelined to: at most 4 LUT levels and one carry chain of at most 16 bits on any path.
 
 ``python -m flow timing`` prints the figures and the deepest paths of the projector's core.
@@ -27,8 +29,15 @@ __all__ = ["Depth", "analyse", "netlist", "report", "figures", "BUDGET", "main"]
 #: The ``dmd`` domain's budget: LUT levels, carry bits, carry chains per path.
 BUDGET = {"lut_levels_max": 4, "carry_max": 16, "carry_chains_max": 1}
 
-_LUTS = {f"LUT{n}" for n in range(1, 7)} | {"LUT6_2", "INV", "RAM32M", "RAM64M", "RAM32X1D", "RAM64X1D",
-                                            "RAM128X1D", "RAM32X1S", "RAM64X1S", "RAM128X1S"}
+_LUTS = {f"LUT{n}" for n in range(1, 7)} | {"LUT6_2", "INV"}
+#: LUT-RAM: each read output depends, through one LUT level, on its own read address only; the
+#: write side (data, write enable, write address) is sampled on the write clock like a
+#: flip-flop's D input, so a path ends there.
+_LUTRAM_READS = {
+    **{kind: {f"DO{p}": f"ADDR{p}" for p in "ABCD"} for kind in ("RAM32M", "RAM64M")},
+    **{kind: {"SPO": "A", "DPO": "DPRA"} for kind in ("RAM32X1D", "RAM64X1D", "RAM128X1D")},
+    **{kind: {"O": "A"} for kind in ("RAM32X1S", "RAM64X1S", "RAM128X1S")},
+}
 _FREE = {"MUXF7", "MUXF8", "BUFG", "BUF", "IBUF", "OBUF", "VCC", "GND"}
 #: Cells whose outputs are registered: a path ends at their inputs and starts at their outputs.
 _SEQUENTIAL_PREFIXES = ("FD", "LD", "RAMB", "SRL", "DSP48A1_REGISTERED")
@@ -38,8 +47,6 @@ _DSP_LEVELS = 3
 _DSP_REGISTERS = ("A0REG", "A1REG", "B0REG", "B1REG", "CREG", "DREG", "MREG", "PREG")
 #: Clock pins of the sequential cells.
 _CLOCK_PINS = ("C", "CLK", "CLKA", "CLKB", "CLKAWRCLK", "CLKBRDCLK", "WCLK")
-#: LUT-RAM write ports: registered inputs.
-_LUTRAM_WRITE = {"WE", "WCLK"}
 
 
 @dataclass
@@ -99,15 +106,28 @@ def analyse(module, *, keep=5):
 
     def inputs(cell):
         return [(pin, bit) for pin, d in cell["port_directions"].items()
-                if d == "input" and pin not in _LUTRAM_WRITE and pin not in _CLOCK_PINS
-                for bit in cell["connections"][pin]]
+                if d == "input" and pin not in _CLOCK_PINS for bit in cell["connections"][pin]]
+
+    def reads(cell):
+        """A LUT-RAM's read ports: ``{output pin: [its read address bits]}``."""
+        ports = _LUTRAM_READS[cell["type"]]
+        return {out: [bit for pin, bits in cell["connections"].items()
+                      if pin.rstrip("0123456789") == addr for bit in bits]
+                for out, addr in ports.items() if out in cell["connections"]}
+
+    def comb_inputs(cell):
+        """The inputs an output of a combinational cell depends on (a LUT-RAM's: its read
+        addresses)."""
+        if cell["type"] in _LUTRAM_READS:
+            return [(out, bit) for out, bits in reads(cell).items() for bit in bits]
+        return inputs(cell)
 
     # combinational cells in topological order
     for cell in cells.values():
         if _registered_dsp(cell):
             cell["type"] = "DSP48A1_REGISTERED"
     comb = [c for c, cell in cells.items() if not _sequential(cell["type"])]
-    deps = {c: {drivers[b] for _, b in inputs(cells[c]) if isinstance(b, int) and b in drivers
+    deps = {c: {drivers[b] for _, b in comb_inputs(cells[c]) if isinstance(b, int) and b in drivers
                 and not _sequential(cells[drivers[b]]["type"])} for c in comb}
     users = {c: [] for c in comb}
     for c, ds in deps.items():
@@ -130,9 +150,22 @@ def analyse(module, *, keep=5):
             return state[bit]
         return Depth(start=names.get(bit, "input") if isinstance(bit, int) else "constant")
 
+    def settle(bits, out):
+        for bit in bits:
+            if isinstance(bit, int):
+                state[bit] = out
+
     for cname in order:
         cell = cells[cname]
         kind = cell["type"]
+        if kind in _LUTRAM_READS:
+            for out_pin, addr in reads(cell).items():
+                ds = [of(b) for b in addr]
+                deepest = max(ds, key=lambda d: d.luts, default=Depth(start=cname))
+                settle(cell["connections"][out_pin],
+                       Depth(deepest.luts + 1, max((d.carry for d in ds), default=0),
+                             max((d.chains for d in ds), default=0), 0, deepest.start))
+            continue
         ins = [(pin, of(bit)) for pin, bit in inputs(cell)]
         deepest = max((d for _, d in ins), key=lambda d: d.luts, default=Depth(start=cname))
         luts = deepest.luts + (1 if kind in _LUTS else _DSP_LEVELS if kind == "DSP48A1" else 0)
@@ -148,13 +181,14 @@ def analyse(module, *, keep=5):
         out = Depth(luts, carry, chains, run, deepest.start)
         for pin, direction in cell["port_directions"].items():
             if direction == "output":
-                for bit in cell["connections"][pin]:
-                    if isinstance(bit, int):
-                        state[bit] = out
+                settle(cell["connections"][pin], out)
 
     domains = {}
     for cname, cell in cells.items():
-        if not _sequential(cell["type"]):
+        # a path ends at a flip-flop, block RAM, DSP or shift register input, and at a LUT-RAM's
+        # write side (its read addresses too: those paths go on through the read, and are
+        # counted there as well)
+        if not (_sequential(cell["type"]) or cell["type"] in _LUTRAM_READS):
             continue
         clocks = [cell["connections"][p][0] for p in _CLOCK_PINS if p in cell["connections"]]
         domain = names.get(clocks[0], "?") if clocks else "?"
