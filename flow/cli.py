@@ -11,7 +11,10 @@ def main(argv=None):
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("verilog", help="write the Spartan-6 ISE tree and every block's Verilog to build/spartan6")
     sub.add_parser("resources", help="Yosys synth_xilinx -family xc6s: LUT/FF/BRAM/DSP per block and in total")
-    sub.add_parser("timing", help="logic depth between flip-flops per clock domain (Yosys, xc6s)")
+    timing = sub.add_parser("timing", help="logic depth between flip-flops per clock domain (Yosys, xc6s)")
+    timing.add_argument("--block", default=None, help="one block of flow.blocks instead of the core")
+    timing.add_argument("--over", action="append", default=[], metavar="DOMAIN",
+                        help="list every register a path over the budget ends at, in this domain (repeatable)")
     formal = sub.add_parser("formal", help="prove or check every formal property (SymbiYosys)")
     formal.add_argument("--quick", action="store_true", help="BMC to the test suite's depths, no proofs")
     formal.add_argument("--only", action="append", help="only this block (repeatable)")
@@ -43,7 +46,7 @@ def main(argv=None):
         return run()
     if args.command == "timing":
         from flow.timing import main as run
-        return run()
+        return run(block=args.block, over=args.over)
     if args.command == "formal":
         from flow.formal import main as run
         return run(quick=args.quick, only=args.only)

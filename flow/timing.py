@@ -202,6 +202,7 @@ def analyse(module, *, keep=5):
             entry["carry_chains_max"] = max(entry["carry_chains_max"], d.chains)
             entry["paths"].append((d.luts, d.carry, d.chains, d.start, end))
     for entry in domains.values():
+        entry["over"] = over_budget(entry["paths"])
         seen, paths = set(), []
         for path in sorted(entry["paths"], key=lambda p: (p[0], p[1], p[2]), reverse=True):
             if (path[3], path[4]) not in seen:
@@ -211,6 +212,28 @@ def analyse(module, *, keep=5):
                 break
         entry["paths"] = paths
     return domains
+
+
+def _within(path):
+    luts, carry, chains = path[:3]
+    return (luts <= BUDGET["lut_levels_max"] and carry <= BUDGET["carry_max"]
+            and chains <= BUDGET["carry_chains_max"])
+
+
+def over_budget(paths):
+    """The registers with a path over :data:`BUDGET` ending at them, the bits of a vector (and
+    registers that differ only in an index) taken together: ``[(name, paths over, deepest path)]``,
+    deepest first."""
+    groups = {}
+    for path in paths:
+        if _within(path):
+            continue
+        parts = path[4].split(".")
+        name = ".".join(parts[:-1] + [parts[-1].rstrip("0123456789")])
+        count, worst = groups.get(name, (0, path))
+        groups[name] = (count + 1, max(worst, path, key=lambda p: p[:3]))
+    return sorted(((name, count, worst) for name, (count, worst) in groups.items()),
+                  key=lambda item: item[2][:3], reverse=True)
 
 
 def _domain_of(net):
@@ -235,10 +258,13 @@ def figures(result):
         for key in ("lut_levels_max", "carry_max", "carry_chains_max"):
             out[f"timing.{domain}.{key}"] = (entry[key], "LUT levels" if key == "lut_levels_max" else
                                              "bits" if key == "carry_max" else "chains")
+        out[f"timing.{domain}.registers_over_budget"] = (len(entry["over"]), "registers")
     return out
 
 
-def print_report(result):
+def print_report(result, *, over=()):
+    """The figures and deepest paths of each domain; for the domains in ``over``, every register
+    a path over the budget ends at."""
     for domain in sorted(result):
         entry = result[domain]
         budget = " (budget: 4 LUT levels, one carry chain of 16 bits)" if domain == "dmd" else ""
@@ -246,9 +272,18 @@ def print_report(result):
               f"{entry['carry_chains_max']} chain(s) on a path{budget}")
         for luts, carry, chains, start, end in entry["paths"]:
             print(f"    {luts} LUT, carry {carry} bits ({chains} chain(s)): {start} -> {end}")
+        if domain in over:
+            print(f"  registers with a path over the budget: {len(entry['over'])}")
+            for name, count, (luts, carry, chains, start, _end) in entry["over"]:
+                print(f"    {luts:3d} LUT {carry:3d} bits {chains} chain(s) {count:5d} path(s): {name} <- {start}")
 
 
-def main():
-    result = report()
-    print_report(result)
+def main(*, block=None, over=()):
+    """``block``: one block of :data:`flow.blocks.BLOCKS` instead of the projector's core."""
+    if block is None:
+        result = report()
+    else:
+        from flow.blocks import BLOCKS
+        result = report(BLOCKS[block](), name=block, workdir=f"build/timing/{block}")
+    print_report(result, over=over)
     return 0
