@@ -1,19 +1,21 @@
 """The segmented countdown timer against a plain model of its definition: loaded with ``v`` at
-cycle ``c``, its time is ``T = c + v``; ``done`` is ``t >= T``, ``late`` is ``t > T``,
+cycle ``c``, its time is ``T = c + v - lag``; ``done`` is ``t >= T``, ``late`` is ``t > T + slack``,
 ``within[k]`` is ``T - t < k``. Random loads of values of every size, including ones that make
 each limb borrow and wrap, and long runs to zero."""
 
 import random
 
+import pytest
 from amaranth.sim import Simulator
 
 from gateware.countdown import Countdown
 
 
-def test_flags_follow_the_definition():
+@pytest.mark.parametrize("lag,slack", [(0, 0), (1, 1), (2, 1), (3, 0)])
+def test_flags_follow_the_definition(lag, slack):
     width = 40
     ks = (3, 17, 300)
-    dut = Countdown(width, within=ks)
+    dut = Countdown(width, within=ks, lag=lag, slack=slack)
     rng = random.Random(11)
     checked = [0]
 
@@ -30,14 +32,14 @@ def test_flags_follow_the_definition():
             await ctx.tick()
             ctx.set(dut.load, 0)
             if load:
-                target = t + v
+                target = t + v - lag
             t += 1
             done, late, within = ctx.get(dut.done), ctx.get(dut.late), ctx.get(dut.within)
             if target is None:
                 assert done and late
             else:
                 assert done == (t >= target), (t, target)
-                assert late == (t > target), (t, target)
+                assert late == (t > target + slack), (t, target)
                 for i, k in enumerate(ks):
                     assert bool(within >> i & 1) == (target - t < k), (t, target, k)
             checked[0] += 1
