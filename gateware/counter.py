@@ -24,18 +24,22 @@ class Counter(wiring.Component):
         Bits of the count.
     limb_bits : int
         Bits of a limb (the longest carry chain).
+    restart_value : int
+        The count after ``restart``.
 
     Members
     -------
     inc : In(1)
         Count one this cycle.
+    restart : In(1)
+        Start again from ``restart_value`` (over ``inc``).
     count : Out(width)
         The events counted before this cycle, modulo ``2**width``.
     """
 
-    def __init__(self, width, *, limb_bits=LIMB_BITS):
-        self._width, self._limb_bits = width, limb_bits
-        super().__init__({"inc": In(1), "count": Out(width)})
+    def __init__(self, width, *, limb_bits=LIMB_BITS, restart_value=0):
+        self._width, self._limb_bits, self._restart = width, limb_bits, restart_value % (1 << width)
+        super().__init__({"inc": In(1), "restart": In(1), "count": Out(width)})
 
     def elaborate(self, platform):
         m = Module()
@@ -44,8 +48,11 @@ class Counter(wiring.Component):
         limbs = [self.count[lo:hi] for lo, hi in bounds]
         full = [Signal(name=f"full{i}") for i in range(len(limbs))]
         below = Const(1)                       # every limb below this one is at its top
-        for limb, at_top, z in zip(limbs, top, full, strict=True):
-            with m.If(self.inc & below):
+        for (lo, _hi), limb, at_top, z in zip(bounds, limbs, top, full, strict=True):
+            start = (self._restart >> lo) & at_top
+            with m.If(self.restart):
+                m.d.sync += [limb.eq(start), z.eq(start == at_top)]
+            with m.Elif(self.inc & below):
                 # it steps: at its top next if it is one below now (else it wraps, or climbs)
                 m.d.sync += [limb.eq(limb + 1), z.eq(limb == at_top - 1)]
             below = below & z

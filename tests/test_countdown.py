@@ -1,7 +1,7 @@
 """The segmented countdown timer against a plain model of its definition: loaded with ``v`` at
 cycle ``c``, its time is ``T = c + v - lag``; ``done`` is ``t >= T``, ``late`` is ``t > T + slack``,
-``within[k]`` is ``T - t < k``. Random loads of values of every size, including ones that make
-each limb borrow and wrap, and long runs to zero."""
+``within[k]`` is ``T - t < k``, ``ends`` is ``t == T + lag``. Random loads of values of every
+size, including ones that make each limb borrow and wrap, and long runs to zero."""
 
 import random
 
@@ -11,11 +11,13 @@ from amaranth.sim import Simulator
 from gateware.countdown import Countdown
 
 
-@pytest.mark.parametrize("lag,slack", [(0, 0), (1, 1), (2, 1), (3, 0)])
-def test_flags_follow_the_definition(lag, slack):
+@pytest.mark.parametrize("lag,slack,flags", [(0, 0, "value"), (1, 1, "value"), (2, 1, "value"), (3, 0, "value"),
+                                              (1, 1, "settled"), (0, 0, "settled")])
+def test_flags_follow_the_definition(lag, slack, flags):
+    """(``settled``: the value is set the cycle before its load, and held through it.)"""
     width = 40
     ks = (3, 17, 300)
-    dut = Countdown(width, within=ks, lag=lag, slack=slack)
+    dut = Countdown(width, within=ks, lag=lag, slack=slack, flags=flags)
     rng = random.Random(11)
     checked = [0]
 
@@ -27,8 +29,13 @@ def test_flags_follow_the_definition(lag, slack):
             load = rng.random() < 0.03 or step < 30
             if load:
                 v = rng.choice(values) if rng.random() < 0.7 else rng.randrange(0, 1 << rng.choice((4, 12, 17, 20)))
-                ctx.set(dut.load, 1)
                 ctx.set(dut.value, v)
+                if flags == "settled":
+                    await ctx.tick()
+                    t += 1
+                    if target is not None:
+                        assert ctx.get(dut.done) == (t >= target)
+                ctx.set(dut.load, 1)
             await ctx.tick()
             ctx.set(dut.load, 0)
             if load:
@@ -40,6 +47,7 @@ def test_flags_follow_the_definition(lag, slack):
             else:
                 assert done == (t >= target), (t, target)
                 assert late == (t > target + slack), (t, target)
+                assert ctx.get(dut.ends) == (t == target + lag), (t, target)
                 for i, k in enumerate(ks):
                     assert bool(within >> i & 1) == (target - t < k), (t, target, k)
             checked[0] += 1

@@ -1,5 +1,6 @@
-"""The limbed event counter against a plain count: random increments, with limbs small enough
-that every limb wraps many times, a limb of the counter's whole width, and the count's own wrap."""
+"""The limbed event counter against a plain count: random increments and restarts (to a value
+just below the wrap), with limbs small enough that every limb wraps many times, a limb of the
+counter's whole width, and the count's own wrap."""
 
 import random
 
@@ -11,7 +12,8 @@ from gateware.counter import Counter
 
 @pytest.mark.parametrize("width,limb_bits", [(10, 3), (9, 4), (11, 5), (5, 5)])
 def test_count_is_exact_every_cycle(width, limb_bits, seed):
-    dut = Counter(width, limb_bits=limb_bits)
+    restart_value = (1 << width) - 2
+    dut = Counter(width, limb_bits=limb_bits, restart_value=restart_value)
     rng = random.Random(seed)
     steps = 3 * (1 << min(width, 11))
     checked = [0]
@@ -20,9 +22,11 @@ def test_count_is_exact_every_cycle(width, limb_bits, seed):
         count = 0
         for _ in range(steps):
             inc = rng.random() < 0.8
+            restart = rng.random() < 0.01
             ctx.set(dut.inc, inc)
+            ctx.set(dut.restart, restart)
             await ctx.tick()
-            count = (count + inc) % (1 << width)
+            count = restart_value if restart else (count + inc) % (1 << width)
             assert ctx.get(dut.count) == count
             checked[0] += 1
 
