@@ -71,7 +71,7 @@ def _plan(args):
         plan = schedule.plan(dmd, args.dclk, reset_mode=ResetMode[args.reset_mode], order=PlaneOrder[args.order],
                              **common)
     trigger = TriggerMode[args.trigger.upper()]
-    period = round(args.period * schedule.FABRIC_HZ) if args.period else plan.frame_cycles
+    period = round(args.period * schedule.FABRIC_HZ) if args.period else plan.trigger_cycles
     params = dataclasses.replace(plan.params, trigger=trigger,
                                  period=period if trigger == TriggerMode.PERIODIC else plan.params.period)
     plan = dataclasses.replace(plan, params=params)

@@ -72,15 +72,16 @@ _WHY = {
 
 def period_fault(plan):
     """Why a :func:`spec.schedule.plan` with a periodic trigger cannot keep its period (``None``
-    when it can): a period shorter than the plan's frame period for the bit depth planned. The
-    projector takes such a period (it knows a frame's depth only when the frame comes); each
-    frame then outlasts it, the strobe that comes meanwhile is held or lost, and
-    ``frames_period_short`` counts the frames."""
+    when it can): a period shorter than the plan's shortest trigger period for the bit depth
+    planned (its frame period, and a cycle for a trigger on an odd cycle). The projector takes
+    such a period (it knows a frame's depth only when the frame comes); each frame then outlasts
+    it, the strobe that comes meanwhile is held or lost, and ``frames_period_short`` counts the
+    frames."""
     p = plan.params
-    if p.trigger != TriggerMode.PERIODIC or p.period >= plan.frame_cycles:
+    if p.trigger != TriggerMode.PERIODIC or p.period >= plan.trigger_cycles:
         return None
-    return (f"a periodic trigger every {p.period} cycles is shorter than the plan's frame period of "
-            f"{plan.frame_cycles} cycles ({plan.rate_hz:.1f} frames/s): every frame would outlast it")
+    return (f"a periodic trigger every {p.period} cycles is shorter than the plan's trigger period of "
+            f"{plan.trigger_cycles} cycles ({plan.rate_hz:.1f} frames/s): every frame would outlast it")
 
 
 class ClientError(RuntimeError):

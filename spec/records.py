@@ -251,7 +251,14 @@ def register_faults(wire, row_cycles, clear_row_cycles):
 
     ``period_keepable``: a periodic trigger's period is at least the least significant plane, the
     shortest a frame (one plane) can last; frames of more planes that outlast it are counted
-    when they start (``frames_period_short``)."""
+    when they start (``frames_period_short``).
+
+    ``settle_keepable``: the sequencer's settle countdown starts when its RST_ACTIVE countdown
+    ends, so it keeps settle times of :data:`spec.registers.MIN_SETTLE` cycles or more exactly.
+
+    ``stagger_keepable``: in a phased mode each group's first pulse is timed from the one before
+    it, so groups a stagger apart keep their times exactly when the stagger is 0 or at least a
+    block clear's row cycles (no load of a clear's length fits between two first pulses)."""
     faults = {}
     for f, (_, wire_width) in zip(_registers.FIELDS, SEQUENCER, strict=True):
         if wire_width > f.bits:
@@ -265,6 +272,9 @@ def register_faults(wire, row_cycles, clear_row_cycles):
     faults["lsb_keepable"] = wire["lsb"] < wire["t_rst"] + wire["t_settle"] + clear_row_cycles * row_cycles
     faults["period_keepable"] = ((wire["trigger"] == _registers.TriggerMode.PERIODIC.value)
                                  & (wire["period"] < wire["lsb"]))
+    faults["settle_keepable"] = wire["t_settle"] < _registers.MIN_SETTLE
+    faults["stagger_keepable"] = ((wire["reset_mode"] != _registers.ResetMode.GLOBAL.value) & (wire["stagger"] != 0)
+                                  & (wire["stagger"] < clear_row_cycles * row_cycles))
     return faults
 
 

@@ -13,7 +13,7 @@ binds.
 import enum
 
 __all__ = ["ResetMode", "PlaneOrder", "TriggerMode", "Source", "FIELDS", "Field",
-           "TIME_BITS", "LSB_BITS", "DURATION_BITS", "group_size", "layout_bits", "pack", "unpack"]
+           "TIME_BITS", "LSB_BITS", "DURATION_BITS", "MIN_SETTLE", "group_size", "layout_bits", "pack", "unpack"]
 
 #: Width of the free-running time base. Comparisons are made on differences, so the base may
 #: wrap (every 8 days at 400 MHz) without harm; every wait is shorter than 2**(TIME_BITS-1).
@@ -22,6 +22,9 @@ TIME_BITS = 48
 LSB_BITS = 32
 #: Width of any plane duration (LSB shifted by up to 7) and of the other long waits.
 DURATION_BITS = LSB_BITS + 8
+#: The shortest ``t_settle`` the sequencer keeps exactly: its settle countdown starts the cycle
+#: after its RST_ACTIVE countdown ends, and a countdown's flags are registered.
+MIN_SETTLE = 3
 
 
 class ResetMode(enum.IntEnum):

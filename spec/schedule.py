@@ -34,7 +34,9 @@ allows it, and no loaded pulse falls due before the operation ends; else nothing
 cannot be made on time is made late and counted (the plan below never lets that happen).
 
 A trigger strobe at cycle ``s`` is obeyed when every group is loaded and waiting: group ``g``'s
-first pulse is then at ``even(s + 1) + g * stagger``; otherwise it is counted as an overrun.
+first pulse falls due at ``s + 2 + g * stagger`` (the frame control's decision takes a cycle);
+otherwise it is counted as an overrun. A pulse due at ``T`` is made on the first free even cycle
+from ``even(T)`` on, and counts as late when made after ``even(T)``.
 
 Frames: group 0 takes the next offered frame when its last pulse of a frame is made (else the
 frame repeats). Triggered and not chained, a frame offered while no group plays (every group
@@ -51,7 +53,8 @@ before each group's settle time ends, as always). Nothing abandoned is ever puls
 
 Time base: cycle 0 is the first cycle after initialisation (INIT_ACTIVE low); the first loads
 may start at ``init_to_dvalid`` (64 clocks, DLPC910). Command cycles are decision cycles; the
-pins show each command one cycle later.
+pins show each command :data:`DECISION_TO_PINS` cycles later. A frame taken at ``t`` is answered
+to the store on the next cycle, so the frame after it is offered no sooner than ``t + 2``.
 """
 
 import math
@@ -60,12 +63,12 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .facts import SETTLE_READINGS, TIMING, BlockMode
-from .registers import PlaneOrder, ResetMode, Source, TriggerMode, group_size
+from .registers import MIN_SETTLE, PlaneOrder, ResetMode, Source, TriggerMode, group_size
 
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate", "FABRIC_HZ",
            "beats_at", "row_cycles", "row_rate_words",
            "plan", "bound", "paper_eq_rate_hz", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS",
-           "flush_rows", "PAPER_SETTLE_CYCLES", "RST_MARGIN",
+           "flush_rows", "PAPER_SETTLE_CYCLES", "MIN_SETTLE", "RST_MARGIN", "DECISION_TO_PINS", "PACE_LAG",
            "even", "ready_cycle", "reload_bound", "reload_cycles", "on_time", "frame_period"]
 
 #: The ``dmd`` domain's clock: every cycle count of the model and the sequencer is in its cycles.
@@ -116,14 +119,24 @@ def flush_rows(dmd):
 
 
 #: Under the four-DMD paper's settle reading a group's memory may change as soon as RST_ACTIVE
-#: falls; the sequencer learns of the fall through its synchroniser and releases the group this
-#: many cycles after ``t_rst``, so the plan keeps them as its ``t_settle`` (TI's settle covers them).
-PAPER_SETTLE_CYCLES = 2
+#: falls; the sequencer learns of the fall through its synchroniser, and its settle countdown
+#: follows the RST_ACTIVE countdown (:data:`spec.registers.MIN_SETTLE`), so the plan keeps this
+#: as its ``t_settle`` (TI's settle covers it).
+PAPER_SETTLE_CYCLES = MIN_SETTLE
 
-#: Cycles added to the RST_ACTIVE time: the command leaves one cycle after its decision, and the
-#: sequencer sees RST_ACTIVE through a two-flip-flop synchroniser; ``t_rst`` must cover the
-#: pin's high time plus this.
-RST_MARGIN = 4
+#: Cycles from a decision to the command on the pins: the decision is registered, then the
+#: command registers.
+DECISION_TO_PINS = 2
+
+#: Cycles added to the RST_ACTIVE time: the command leaves :data:`DECISION_TO_PINS` cycles after
+#: its decision, RST_ACTIVE rises the cycle after, and the sequencer sees it through a
+#: two-flip-flop synchroniser; ``t_rst`` must cover the pin's high time plus this.
+RST_MARGIN = DECISION_TO_PINS + 3
+
+#: A trigger's pace reaches the frame control's newer-frame guard this many cycles after the
+#: trigger (the guard's thresholds, the interval plus an eighth and the interval less
+#: :func:`reload_bound`, are summed in a pipeline of the gateware).
+PACE_LAG = 6
 
 
 def even(t):
@@ -280,7 +293,7 @@ class _Frames:
             del self.offered[:nxt[0]]
             self.result.bad_frames += nxt[0]
             self.shown.append(self.offered.pop(0))
-            self.offer_from = t + 1
+            self.offer_from = t + 2
         elif not repeat:
             return None
         assert self.shown, "no frame offered before it was needed"
@@ -308,16 +321,18 @@ class _Model:
         self.next_row = 0
         self.rst_any = 0
         self.next_frame = None
-        self.queued_at = self.G + 1         # the first planes are queued one group a cycle
+        self.queued_at = self.G + 2         # the first planes are queued one group a cycle
         self.bus_free = 0
         self.t = 0
         self.holding = False                # a trigger held until every group is ready
         self.ended = False                  # a sequence played once has started its last frame
         self.idle_take = not p.chain and p.source != Source.PRNG
         # the trigger's pace (the guard of take_while_waiting): the periodic timer's is known
-        # from the start (its first strobe comes ``period - 1`` cycles in), a pin's after two
+        # from the start (its first strobe comes ``period - 1`` cycles in), a pin's after two;
+        # each strobe's pace counts from PACE_LAG cycles after it: (from, last strobe, interval)
         periodic = p.trigger == TriggerMode.PERIODIC
         self.last_strobe, self.interval = (-1, p.period) if periodic else (None, 0)
+        self.paces = [(-math.inf, self.last_strobe, self.interval)]
         self.reload_bound = reload_bound(dmd, p)
 
     # -- the planner -------------------------------------------------------------------------
@@ -401,23 +416,34 @@ class _Model:
         played once has ended (a sequence frame otherwise waits for its turn)."""
         return not self.frames.offered[k].sequence or self.ended
 
+    def pace(self, t):
+        """(last strobe, interval) as the frame control knows them at ``t``."""
+        return [(last, interval) for since, last, interval in self.paces if since <= t][-1]
+
     def fits(self, t):
         """A newer frame may replace the waiting one at ``t`` unless the triggers come at a steady
         pace (the periodic timer's, or the last two ``interval`` apart) and the next one is due
         before a reload could end (:func:`reload_bound`): that trigger is not delayed, the newer
         frame is shown at the one after. Once the next trigger is an eighth of an interval
         overdue, the pace counts as broken."""
-        if not self.interval:
+        last, interval = self.pace(t)
+        if not interval:
             return True
-        due = self.last_strobe + self.interval
-        return t > due + (self.interval >> 3) or t + self.reload_bound < due
+        due = last + interval
+        return t > due + (interval >> 3) or t + self.reload_bound < due
 
     def fits_from(self, t):
-        """The first cycle from ``t`` on at which :meth:`fits` holds (it only grows more
-        likely once the next trigger is overdue)."""
-        if self.fits(t):
-            return t
-        return self.last_strobe + self.interval + (self.interval >> 3) + 1
+        """The first cycle from ``t`` on at which :meth:`fits` holds (within one pace it only
+        grows more likely once the next trigger is overdue)."""
+        switches = sorted(since for since, _last, _interval in self.paces if since > t)
+        for start, end in zip([t, *switches], [*switches, None], strict=True):
+            if self.fits(start):
+                return start
+            last, interval = self.pace(start)
+            overdue = last + interval + (interval >> 3) + 1
+            if end is None or overdue < end:
+                return overdue
+        raise AssertionError("unreachable")
 
     def take_while_waiting(self, t):
         """A newer frame offered while no group plays: load its first plane, abandoning the
@@ -425,7 +451,7 @@ class _Model:
         wait = 0 if self.waiting(t) else flush_rows(self.dmd) * self.row_period
         fi = self.next_frame = self.frames.take(t, repeat=False)
         self.ended = False
-        self.queued_at = t + wait + self.G + 1
+        self.queued_at = t + max(wait, 1) + self.G + 1
         self.queue.clear()
         for g in range(self.G):
             self.st[g].pos = ("plane", fi, 0)
@@ -433,12 +459,11 @@ class _Model:
             self.enqueue(g, fi, 0)
 
     def obey(self, t):
-        """Every group's first pulse from ``even(t + 1)``, staggered."""
+        """Every group's first pulse due from ``t + 2``, staggered."""
         self.res.accepted.append(t)
-        start = even(t + 1)
         for g, s in enumerate(self.st):
             s.pending = True
-            s.pulse_at = start + g * self.p.stagger
+            s.pulse_at = t + 2 + g * self.p.stagger
 
     def release_held(self, t):
         """A held trigger is obeyed on the first cycle every group is ready."""
@@ -452,6 +477,7 @@ class _Model:
         if self.last_strobe is not None and self.p.trigger != TriggerMode.PERIODIC:
             self.interval = s_t - self.last_strobe
         self.last_strobe = s_t
+        self.paces.append((s_t + PACE_LAG, self.last_strobe, self.interval))
         if self.ended:
             self.res.ended += 1
         elif self.waiting(s_t):
@@ -480,7 +506,7 @@ class _Model:
         if due:
             g = due[0]
             s = st[g]
-            if s.pulse_at < t:
+            if even(s.pulse_at) < t:
                 res.late += 1
             kind, fi, j = s.pos
             res.commands.append((t, "pulse", tuple(self.grp[g])))
@@ -502,7 +528,7 @@ class _Model:
             op, arg = ops[i]
             length = R if op == "row" else self.dmd.clear_row_cycles * R
             imminent = any(st[h].pending and st[h].loaded_at is not None and st[h].loaded_at <= t
-                           and st[h].pulse_at < t + length for h in range(self.G))
+                           and even(st[h].pulse_at) < t + length for h in range(self.G))
             if t >= st[g].writable and not imminent and (op != "row" or t >= self.next_row):
                 res.commands.append((t, op, arg))
                 for k in range(1, self.dmd.clear_row_cycles if op == "clear" else 1):
@@ -635,6 +661,13 @@ class Plan:
     @property
     def rate_hz(self):
         return FABRIC_HZ / self.frame_cycles
+
+    @property
+    def trigger_cycles(self):
+        """The shortest period of triggers that may come on any cycle: ``frame_cycles`` is for
+        triggers on the even cycles it is measured from (frames back to back); a trigger on an
+        odd cycle is obeyed as one on the even cycle after it."""
+        return self.frame_cycles + (0 if self.params.chain else 1)
 
 
 def _cycles(seconds):
@@ -821,15 +854,16 @@ def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
 
 def reload_bound(dmd, p):
     """Cycles a newer frame taken while the groups wait may need before every group is loaded
-    again, at most: the flush of stale words, the reload lead, queueing the first planes, every
-    row of the first planes at the row period, and a row cycle's slack for the bus's parity."""
+    again, at most: the frame control's decision, the flush of stale words, the reload lead,
+    queueing the first planes, every row of the first planes at the row period, and a row
+    cycle's slack for the bus's parity."""
     return reload_cycles(dmd, p.beats, max(p.row_period, row_cycles(dmd, p.beats)), p.reload_lead)
 
 
 def reload_cycles(dmd, beats, row_period, reload_lead):
     """:func:`reload_bound` of a ``row_period`` of at least a row cycle and a ``reload_lead``:
     operators only, so that the gateware builds the same sum from its registers."""
-    return (flush_rows(dmd) + dmd.rows) * row_period + reload_lead + dmd.blocks + 1 + 2 * row_cycles(dmd, beats)
+    return (flush_rows(dmd) + dmd.rows) * row_period + reload_lead + dmd.blocks + 3 + 2 * row_cycles(dmd, beats)
 
 
 def ready_cycle(dmd, p, fr):
