@@ -42,6 +42,7 @@ from sim.tb.plane_source import TABLES, OfferedFrame, SourcedSequencer, TableSig
 from sim.tb.seq_sim import Run, dlpc410_for
 from spec.facts import DMDS
 from spec.registers import TIME_BITS
+from spec.schedule import DECISION_TO_PINS
 
 __all__ = ["SequencerRig", "EventPlayer", "run_rig", "run_script", "rig_verilog", "analyse", "event_table",
            "rig_layout", "event_layout", "Timing", "SOURCES", "PLUSARGS", "INPUTS", "MAX_EVENTS", "TOPLEVEL"]
@@ -351,6 +352,6 @@ def analyse(model, pins, dmd, *, until_now=None):
             if level != last[name]:
                 getattr(run, name).append((now + offset, level))
                 last[name] = level
-    run.commands = model.commands(shift - 1)
+    run.commands = model.commands(shift - DECISION_TO_PINS)
     return run
 

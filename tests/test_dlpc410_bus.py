@@ -23,13 +23,14 @@ def test_underruns_count_rows_not_cycles(test_name):
         ctx.set(dut.regs.row_period, R)
         ctx.set(dut.running, 1)
         ctx.set(dut.writable, (1 << DMD.blocks) - 1)
-        ctx.set(dut.loads.payload, {"group": 0, "mask": 1, "first": 0, "last": 0})
+        ctx.set(dut.loads.payload, {"group": 0, "mask": 1, "first": 0, "last": 0, "first_row": 0, "first_occupied": 1,
+                                    "single": 0})
         ctx.set(dut.loads.valid, 1)
         ctx.set(dut.beats.valid, 1)
         ctx.set(dut.row_ready, 1)
         now, dark_until = 0, -1
         while len(seen) < rows and now < 200 * rows * R:
-            ctx.set(dut.now, now)
+            ctx.set(dut.even, now % 2 == 0)
             ctx.set(dut.row_ready, int(now >= dark_until))
             await ctx.tick()
             now += 1

@@ -69,8 +69,9 @@ def test_entries_show_each_frame_as_its_entry_says(mode, test_name):
     # pulse to its last (each of these frames ends dark), in the rule model's cycles
     if mode != ResetMode.GLOBAL:
         return
-    windows = [(min(t for t, _g, kind, fi, _e in model.pulses if fi == k and kind == "plane") - run.shift,
-                max(t for t, _g, _kind, fi, _e in model.pulses if fi == k) - run.shift + 1) for k in range(4)]
+    pins = schedule.DECISION_TO_PINS - run.shift       # a decision's cycle to its pins' in the rule model
+    windows = [(min(t for t, _g, kind, fi, _e in model.pulses if fi == k and kind == "plane") + pins - 1,
+                max(t for t, _g, _kind, fi, _e in model.pulses if fi == k) + pins) for k in range(4)]
     for light, (slot, depth, showing) in zip(frame_lights(run.model, windows), frames, strict=True):
         lsb = showing.get("lsb") or p.lsb
         expect = (ramp_image(DMD, slot).astype(np.int64) >> (8 - depth)) * lsb

@@ -43,15 +43,16 @@ def test_ready_line_tells_when_a_trigger_is_obeyed_at_once(test_name):
     run = run_rig(DMD, p, [(0, 8)], pins=[first, second], cycles=end, name=test_name)
     assert run.status["triggers"] == 2 and run.status["held"] == 1 and run.status["overruns"] == 0
     spans = _high_spans(run.ready, end)
-    # the first rise is the cycle the model's groups are all loaded (the same time base)
-    assert spans and spans[0][0] == ready, (spans[:2], ready)
+    # the line is registered: it says, a cycle late, what a trigger would have found
+    # the first rise follows the cycle the model's groups are all loaded (the same time base)
+    assert spans and spans[0][0] == ready + 1, (spans[:2], ready)
     # the first trigger's strobe takes it down; the held one keeps it down until its frame starts
-    assert spans[0][1] == first + PIN_TO_STROBE + 1, (spans[0], first + PIN_TO_STROBE)
+    assert spans[0][1] == first + PIN_TO_STROBE + 2, (spans[0], first + PIN_TO_STROBE)
     assert len(spans) == 2, spans
     # high again once the second frame has played and every group holds the first plane again,
-    # when the model's groups are all loaded after their last pulse; and it stays high
+    # the cycle after the model's groups are all loaded after their last pulse; and it stays high
     again = max(g.loaded_at for g in model.groups)
-    assert spans[1] == (again, end), (spans[1], again)
+    assert spans[1] == (again + 1, end), (spans[1], again)
     # never high while a frame is shown
     shown = _high_spans(run.sync_out, end)
     assert len(shown) == 2

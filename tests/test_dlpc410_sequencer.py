@@ -290,9 +290,12 @@ def test_sync_out_and_camera(offset, width, test_name):
     p.camera_offset, p.camera_width = offset, width
     ready = next_ready(p, model_frames([(0, 8)], None), [])
     run, model = check(p, [(0, 8)], None, [ready], test_name)
+    # both leave with the pulses' commands, DECISION_TO_PINS after their decisions (sync out is
+    # logged on the cycle its register is set)
     pulses = [t for t, k, _a in model.commands if k == "pulse"]
-    assert run.sync_out == [(pulses[0], 1), (pulses[-1], 0)]
-    assert run.camera_out == [(pulses[0] + 1 + offset, 1), (pulses[0] + 1 + offset + width, 0)]
+    pins = schedule.DECISION_TO_PINS
+    assert run.sync_out == [(pulses[0] + pins - 1, 1), (pulses[-1] + pins - 1, 0)]
+    assert run.camera_out == [(pulses[0] + pins + offset, 1), (pulses[0] + pins + offset + width, 0)]
 
 
 @pytest.mark.verilog
@@ -328,7 +331,7 @@ def test_periodic_trigger_faster_than_the_frames_is_counted(short, test_name):
     p = plan.params
     p.trigger = TriggerMode.PERIODIC
     ready = next_ready(p, model_frames([(0, 2)], None), [])
-    p.period = 2 * p.lsb if short else plan.frame_cycles
+    p.period = 2 * p.lsb if short else plan.trigger_cycles
     strobes = [k * p.period - 1 for k in range(1, (ready + 4 * plan.frame_cycles) // p.period + 1)]
     model = schedule.simulate(DMD, p, model_frames([(0, 2)], None), strobes, until=strobes[-1] - 4)
     run = run_rig(DMD, p, [(0, 2)], None, cycles=strobes[-1] - 4, name=test_name)
@@ -445,9 +448,10 @@ def test_rst_active_as_planned_counts_nothing(test_name):
     first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
     run, _model = check(p, [(0, 3)], None, [first], test_name)
     assert run.status["rst_late"] == 0 and run.status["rst_faults"] == 0
-    # the longest RST_ACTIVE, from the decision (the pins show the pulse a cycle later) to the
-    # fall (the cycle after the last high one): the planned t_rst less its two spare cycles
-    assert run.status["rst_longest"] == dlpc410_for(DMD, p).rst_active_cycles + 2 == p.t_rst - 2
+    # the longest RST_ACTIVE, from the decision (the pins show the pulse DECISION_TO_PINS later)
+    # to the fall (the cycle after the last high one): the planned t_rst less its two spare cycles
+    assert run.status["rst_longest"] == dlpc410_for(DMD, p).rst_active_cycles + schedule.DECISION_TO_PINS + 1 \
+        == p.t_rst - 2
 
 
 @pytest.mark.verilog
@@ -467,7 +471,7 @@ def test_rst_active_longer_than_planned(test_name):
     assert len(pulses) == want
     assert run.status["rst_late"] == want and run.status["rst_faults"] == 0
     assert run.status["late"] > 0
-    assert run.status["rst_longest"] == model.rst_active_cycles + 2
+    assert run.status["rst_longest"] == model.rst_active_cycles + schedule.DECISION_TO_PINS + 1
     # planned with the time the projector measured, the same controller keeps every plane on
     # time: every level exact, commands equal to the schedule model's, nothing late
     calibrated = fast_plan(depth=3, t_rst_cycles=run.status["rst_longest"]).params
@@ -513,7 +517,7 @@ def test_binary_chain_from_memory(test_name):
     assert len(pulses) == 5 and set(np.diff(pulses)) == {p.lsb}
     # the last pattern shown: frame 4 (slot 1) while it lasts, then the last frame repeats
     assert np.array_equal(run.model.mirrors, images[1] >> 7)
-    assert run.status["frames"] == 5 and run.sync_out == [(pulses[0], 1)]
+    assert run.status["frames"] == 5 and run.sync_out == [(pulses[0] + schedule.DECISION_TO_PINS - 1, 1)]
 
 
 @pytest.mark.verilog
@@ -653,7 +657,8 @@ def test_controller_restart_mid_frame(ecp2_low, test_name):
 
 @pytest.mark.verilog
 def test_periodic_trigger_at_the_frame_rate_loses_none(seed, test_name):
-    """A periodic trigger exactly at the back-to-back frame rate, trigger_hold on, and newer frames
+    """A periodic trigger at the plan's shortest trigger period (``trigger_cycles``: the
+    back-to-back frame period, and a cycle for strobes on odd cycles), trigger_hold on, and newer frames
     completing at random phases of it (a fresh seed each run, in the messages): no trigger is
     lost, held or delayed. A newer frame that cannot be reloaded before the next trigger is due
     waits for the trigger after (without that rule the same run loses triggers: checked on the
@@ -661,7 +666,7 @@ def test_periodic_trigger_at_the_frame_rate_loses_none(seed, test_name):
     rng = np.random.default_rng(seed)
     plan = fast_plan(depth=3)
     p = plan.params
-    p.trigger, p.trigger_hold, p.period = TriggerMode.PERIODIC, True, plan.frame_cycles
+    p.trigger, p.trigger_hold, p.period = TriggerMode.PERIODIC, True, plan.trigger_cycles
     n = 14
     strobes = [k * p.period - 1 for k in range(1, n)]
     offered = [(0, 3, 0)] + [(k % 2, 3, int((k + rng.random()) * p.period)) for k in range(1, n)]

@@ -370,18 +370,18 @@ def test_sequencer_record_refuses_what_the_projector_would_drop():
 
 def test_a_periodic_trigger_faster_than_the_plans_frames_is_refused(projector, capsys):
     """A period the projector would take (at least one plane) but every frame of the planned
-    depth outlasts: ``configure`` refuses it with the plan's frame period, before sending."""
+    depth outlasts: ``configure`` refuses it with the plan's trigger period, before sending."""
     from spec import schedule
     plan = schedule.plan(TEST_DMD, 200e6, depth=6)
     base = ["--address", "127.0.0.1", "--port", str(projector.port), "configure", "--dmd", "test",
             "--dclk", "200e6", "--depth", "6", "--trigger", "periodic"]
-    short = (plan.frame_cycles - 2) / schedule.FABRIC_HZ
+    short = (plan.trigger_cycles - 1) / schedule.FABRIC_HZ
     assert cli.main(base + ["--period", repr(short)]) == 1
-    assert f"frame period of {plan.frame_cycles} cycles" in capsys.readouterr().err
+    assert f"trigger period of {plan.trigger_cycles} cycles" in capsys.readouterr().err
     assert projector.received == []
-    assert cli.main(base + ["--period", repr(plan.frame_cycles / schedule.FABRIC_HZ)]) == 0
+    assert cli.main(base + ["--period", repr(plan.trigger_cycles / schedule.FABRIC_HZ)]) == 0
     periodic = dataclasses.replace(plan, params=dataclasses.replace(
-        plan.params, trigger=TriggerMode.PERIODIC, period=plan.frame_cycles - 2))
+        plan.params, trigger=TriggerMode.PERIODIC, period=plan.trigger_cycles - 1))
     with Client("127.0.0.1", projector.port) as client, pytest.raises(ClientError, match="outlast"):
         client.configure(periodic, TEST_DMD)
 

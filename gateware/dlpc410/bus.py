@@ -1,28 +1,34 @@
 """The command bus: one decision every even cycle on which no row cycle runs.
 
 The DLPC410 runs at DCLK/2, so idle gaps are even: the bus decides on even cycles only, once the
-row cycle before (and a clear's no-op rows) has ended. It makes, in this order of priority: a
-clocking pulse of a group that is due (the lowest such group), else the next load operation of
-the ready load at the head (a row of an occupied block, ``row_period`` after the last row and
-with a whole row of beats buffered; or a clear of an empty block), if that group's settle time
-is over and no loaded group's pulse falls due before the operation would end; else nothing. A
-load whose row data has not arrived is counted as an underrun (one per row that waits, however
-long).
+row cycle before (and a clear's no-op rows) leaves room for the next on the pins. It makes, in
+this order of priority: a clocking pulse of a group that is due (the lowest such group), if the
+strict RST_ACTIVE reading's pin allows it, else the next load operation of the ready load at the
+head (a row of an occupied block, ``row_period`` after the last row and with a whole row of
+beats buffered; or a clear of an empty block), if that group's memory may change and no loaded
+group's pulse falls due before the operation would end; else nothing. A load whose row data has
+not arrived is counted as an underrun (one per row that waits, however long).
+
+The decision is made from registered flags (the planner's, the bus's own) and registered; the
+cycle after, it is applied: the command registers (the pins show it :data:`DECISION_TO_PINS`
+cycles after the decision), the pulse event, the load's progress. A load's last operation ends
+the group's load on the cycle before the next decision may be made.
 """
 
-from amaranth import Module, Mux, Signal
-from amaranth.lib import stream, wiring
+from amaranth import Array, Cat, Const, Module, Mux, Signal
+from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
 
-from spec.schedule import row_cycles
+from spec.schedule import DECISION_TO_PINS, row_cycles
 
-from ..registers import TIME_BITS, Registers, ResetMode
+from ..countdown import Countdown
+from ..counter import Counter
+from ..registers import Registers, ResetMode
 from .interface import BlockMode, RowMode
-from .layouts import COUNTER_BITS, Command, event, group_bits, ready_load
-from .timebase import diff
+from .layouts import COUNTER_BITS, Command, group_bits, ready_load
 
-__all__ = ["Bus"]
+__all__ = ["Bus", "DECISION_TO_PINS"]
 
 
 class Bus(wiring.Component):
@@ -39,22 +45,31 @@ class Bus(wiring.Component):
     Members
     -------
     regs : In(Registers)
-    now : In(TIME_BITS)
+    even : In(1)
+        An even cycle of the time base.
     running, flushing : In(1)
         From the frame control: no decision before the groups run; ready loads are dropped
         while flushing.
+    hold : In(1)
+        The frame control takes a frame (applied now): no load is started.
     restart : In(1)
         The frame control takes a frame while waiting: the next load starts afresh.
+    rst_active : In(1)
+        RST_ACTIVE, synchronised: with ``strict_rst`` no pulse while it is high.
     due, writable : In(blocks); imminent, imminent_clear : In(1)
-        From the planner.
+        From the planner (registered).
     loads : In(stream.Signature(ready_load))
-        Ready loads from the requester, taken when their last operation is made.
+        Ready loads from the requester, taken when their last operation is applied.
     beats : In(stream.Signature(bits_per_dclk * beats)); row_ready : In(1)
-        Row data, one cycle's beats taken per cycle of a row cycle that loads a row.
-    pulse : Out(event(group))
-        A clocking pulse of this group is made this cycle.
-    loaded : Out(event(group))
-        This group's load ended this cycle (its last operation's last row cycle).
+        Row data, one cycle's beats taken per cycle of a row cycle that loads a row; whether a
+        whole row is buffered.
+    choice : Out(blocks)
+        This cycle's decision: bit g, a clocking pulse of group g.
+    pulsing : Out(1)
+        Some bit of ``choice``.
+    loaded : Out(blocks)
+        Bit g: group g's load ends this cycle (its last operation's last row cycle is on the pins
+        by the next decision).
     dvalid : Out(1); command : Out(Command); beat : Out(bits_per_dclk * beats)
         The registered pins of the row cycles.
     underruns : Out(COUNTER_BITS)
@@ -63,13 +78,14 @@ class Bus(wiring.Component):
 
     def __init__(self, dmd, *, beats=1):
         self._dmd, self._beats = dmd, beats
-        gb = group_bits(dmd)
         super().__init__({
             "regs": In(Registers),
-            "now": In(TIME_BITS),
+            "even": In(1),
             "running": In(1),
             "flushing": In(1),
+            "hold": In(1),
             "restart": In(1),
+            "rst_active": In(1),
             "due": In(dmd.blocks),
             "writable": In(dmd.blocks),
             "imminent": In(1),
@@ -77,8 +93,9 @@ class Bus(wiring.Component):
             "loads": In(stream.Signature(ready_load(dmd))),
             "beats": In(stream.Signature(dmd.bits_per_dclk * beats)),
             "row_ready": In(1),
-            "pulse": Out(event(gb)),
-            "loaded": Out(event(gb)),
+            "choice": Out(dmd.blocks),
+            "pulsing": Out(1),
+            "loaded": Out(dmd.blocks),
             "dvalid": Out(1),
             "command": Out(Command),
             "beat": Out(dmd.bits_per_dclk * beats),
@@ -87,90 +104,141 @@ class Bus(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        dmd, regs, now = self._dmd, self.regs, self.now
+        dmd, regs = self._dmd, self.regs
         R = row_cycles(dmd, self._beats)
         rpb = dmd.rows_per_block
+        G = dmd.blocks
         gb = group_bits(dmd)
+        bb = ceil_log2(G) or 1
+        clear_cycles = dmd.clear_row_cycles * R
 
-        remain = Signal(range(R))              # cycles of the running row cycle after this one
-        noops = Signal(range(dmd.clear_row_cycles))   # no-op rows still owed to a clear
-        free = (remain == 0) & ~now[0] & (noops == 0)
-        op_row = Signal()                      # the running row cycle loads a row
-        finishing = Signal()
-        finish_group = Signal(gb)
+        # after an operation is applied: cycles until the next decision may be made (the next
+        # operation's pins may follow its pins back to back), and the pins' own row cycles
+        remain = Signal(range(clear_cycles))
+        row_left = Signal(range(R))
+        noops = Signal(range(dmd.clear_row_cycles))
+        spent = Signal(init=1)                 # ``remain`` is 0 (registered with it)
+        # a decision on every other cycle: ``even``, and (should the time base stall, as it does
+        # while the controller initialises) never on two cycles running
+        was_free = Signal()
+        free = spent & self.even & self.running & ~was_free
+        m.d.sync += was_free.eq(free)
 
-        # ---- pulses: the lowest due group ----
-        p = Signal(gb)
-        for g in reversed(range(dmd.blocks)):
-            with m.If(self.due[g]):
-                m.d.comb += p.eq(g)
-        do_pulse = Signal()
-        m.d.comb += [do_pulse.eq(self.running & free & self.due.any()),
-                     self.pulse.valid.eq(do_pulse), self.pulse.payload.eq(p)]
+        # ---- pulses: the lowest due group, if the pin allows it ----
+        pin_ok = ~(regs.strict_rst & self.rst_active)
+        due = self.due
+        P = Signal(G)
+        for g in range(G):
+            m.d.comb += P[g].eq(free & pin_ok & due[g] & ~due[:g].any() if g else free & pin_ok & due[0])
+        do_pulse = free & pin_ok & due.any()
+        m.d.comb += [self.choice.eq(P), self.pulsing.eq(do_pulse)]
 
         # ---- loads: the operation at the head ----
+        # (the head's first operation, or the next of a load under way: whether it loads a row
+        # and whether it is the load's last, worked out as the operation before was applied)
         head = self.loads.payload
-        fresh = Signal(init=1)
-        l_block = Signal(ceil_log2(dmd.blocks) or 1)
+        fresh = Signal(init=1)                 # the head's first operation is next
+        l_block = Signal(bb)
         l_row = Signal(range(rpb))
+        l_occupied, l_last = Signal(), Signal()
+        row_at = Signal(11)                    # the next row's address, once not fresh
         cur_block = Mux(fresh, head.first, l_block)
-        cur_row = Mux(fresh, 0, l_row)
-        occupied = head.mask.bit_select(cur_block, 1)
-        next_row_at = Signal(TIME_BITS)
-        can_load = (self.running & ~self.flushing & free & ~do_pulse & self.loads.valid
+        occupied = Mux(fresh, head.first_occupied, l_occupied)
+        last_op = Mux(fresh, head.single, l_last)
+        m.submodules.pace = pace = Countdown(8, lag=1, flags="settled")
+        # (one AND of the flags each: no pulse goes first, the head's group may change, ...)
+        can_load = (free & ~self.flushing & ~self.hold & ~(pin_ok & due.any()) & self.loads.valid
                     & self.writable.bit_select(head.group, 1))
-        row_paced = diff(next_row_at, now) <= 0
-        do_row = Signal()
-        do_clear = Signal()
-        m.d.comb += [
-            do_row.eq(can_load & ~self.imminent & occupied & row_paced & self.row_ready),
-            do_clear.eq(can_load & ~self.imminent_clear & ~occupied),
-        ]
-        last_op = (cur_block == head.last) & (~occupied | (cur_row == rpb - 1))
-        # a row counts once however many cycles it waits for its data
-        waiting = Signal()
-        with m.If(can_load & ~self.imminent & occupied & row_paced & ~self.row_ready):
-            m.d.sync += waiting.eq(1)
-            with m.If(~waiting):
-                m.d.sync += self.underruns.eq(self.underruns + 1)
-        with m.If(do_row):
-            m.d.sync += waiting.eq(0)
+        wants_row = can_load & ~self.imminent & occupied & pace.done
+        do_row = wants_row & self.row_ready
+        do_clear = can_load & ~self.imminent_clear & ~occupied
 
-        with m.If(do_row | do_clear):
-            with m.If(last_op):
+        # ---- the decision, registered ----
+        dec = Signal(data.StructLayout({
+            "pulse": 1, "pulse_group": gb, "row": 1, "clear": 1, "last": 1, "load_group": G, "block": bb,
+            "row_at": 11, "fresh": 1, "starved": 1, "block_last": 1, "following": bb, "following_last": 1,
+            "following_filled": 1}))
+        following = (cur_block + 1)[:bb]
+        m.d.sync += [dec.pulse.eq(do_pulse), dec.pulse_group.eq(_lowest(due)),
+                     dec.row.eq(do_row), dec.clear.eq(do_clear), dec.last.eq(last_op),
+                     dec.load_group.eq(1 << head.group), dec.block.eq(cur_block),
+                     dec.row_at.eq(Mux(fresh, head.first_row, row_at)), dec.fresh.eq(fresh),
+                     dec.starved.eq(wants_row & ~self.row_ready),
+                     # (for the operation after it)
+                     dec.block_last.eq(cur_block == head.last), dec.following.eq(following),
+                     dec.following_last.eq(following == head.last),
+                     dec.following_filled.eq(head.mask.bit_select(following, 1))]
+
+        # ---- applied ----
+        op = dec.row | dec.clear
+        m.d.comb += [pace.load.eq(dec.row), pace.value.eq(regs.row_period)]
+        with m.If(op):
+            with m.If(dec.last):
                 m.d.comb += self.loads.ready.eq(1)
-                m.d.sync += [fresh.eq(1), finishing.eq(1), finish_group.eq(head.group)]
+                m.d.sync += fresh.eq(1)
             with m.Else():
                 m.d.sync += fresh.eq(0)
-                with m.If(occupied & (cur_row != rpb - 1)):
-                    m.d.sync += [l_block.eq(cur_block), l_row.eq(cur_row + 1)]
+                row = Mux(dec.fresh, 0, l_row)
+                with m.If(dec.row & (row != rpb - 1)):
+                    # the block's next row
+                    m.d.sync += [l_block.eq(dec.block), l_row.eq(row + 1), l_occupied.eq(1),
+                                 l_last.eq(dec.block_last & (row == rpb - 2))]
                 with m.Else():
-                    m.d.sync += [l_block.eq(cur_block + 1), l_row.eq(0)]
-        with m.If(do_row):
-            m.d.sync += next_row_at.eq(now + regs.row_period)
-        with m.If(finishing & (remain == 1) & (noops == 0)):
-            m.d.comb += [self.loaded.valid.eq(1), self.loaded.payload.eq(finish_group)]
-            m.d.sync += finishing.eq(0)
+                    # the next block: its rows, or a clear
+                    m.d.sync += [l_block.eq(dec.following), l_row.eq(0), l_occupied.eq(dec.following_filled),
+                                 l_last.eq(dec.following_last & (~dec.following_filled | (rpb == 1)))]
+            # rows are numbered block after block: the next row follows this one, or the next
+            # block's first row follows a cleared block's
+            m.d.sync += row_at.eq(dec.row_at + Mux(dec.row, 1, rpb))
         with m.If(self.flushing):
             m.d.comb += self.loads.ready.eq(1)
         with m.If(self.restart):
-            m.d.sync += [fresh.eq(1), finishing.eq(0)]
+            m.d.sync += fresh.eq(1)
+
+        # a row counts once however many cycles it waits for its data
+        waiting = Signal()
+        with m.If(dec.starved):
+            m.d.sync += waiting.eq(1)
+        with m.If(dec.row):
+            m.d.sync += waiting.eq(0)
+        m.submodules.underruns = underruns = Counter(COUNTER_BITS)
+        m.d.comb += [underruns.inc.eq(dec.starved & ~waiting), self.underruns.eq(underruns.count)]
+
+        # the group's load ends on the cycle before its last operation leaves room for the next
+        # decision: a two-cycle operation's now, a longer one's registered the cycle before
+        length_two = Mux(dec.clear, clear_cycles == 2, R == 2)
+        finishing = Signal(G)                  # this group's load ends at ``remain == 1``
+        ends = Signal(G)                       # the load of this group ends next cycle
+        with m.If(op & dec.last & ~length_two):
+            m.d.sync += finishing.eq(dec.load_group)
+        with m.If(remain == 2):
+            m.d.sync += [finishing.eq(0), ends.eq(finishing)]
+        with m.Else():
+            m.d.sync += ends.eq(0)
+        with m.If(self.restart):
+            m.d.sync += [finishing.eq(0), ends.eq(0)]
+        m.d.comb += self.loaded.eq(ends | Mux(op & dec.last & length_two, dec.load_group, 0))
 
         # ---- the command registers ----
         cmd = self.command
-        reading = do_row | (op_row & (remain != 0))
+        op_row = Signal()                      # the row cycle on the pins loads a row
+        reading = dec.row | (op_row & (row_left != 0))
         m.d.comb += self.beats.ready.eq(reading)
         m.d.sync += self.beat.eq(Mux(reading, self.beats.payload, 0))
-        with m.If(do_pulse | do_row | do_clear):
-            m.d.sync += [self.dvalid.eq(1), remain.eq(R - 1), op_row.eq(do_row),
+        with m.If(remain != 0):
+            m.d.sync += [remain.eq(remain - 1), spent.eq(remain == 1)]
+        with m.If(dec.pulse | op):
+            length = Mux(dec.clear, clear_cycles, R)
+            m.d.sync += [self.dvalid.eq(1), remain.eq(length - 2), spent.eq(length == 2), row_left.eq(R - 1),
+                         op_row.eq(dec.row), noops.eq(Mux(dec.clear, dmd.clear_row_cycles - 1, 0)),
                          cmd.rowmd.eq(RowMode.NOOP), cmd.blkmd.eq(BlockMode.NOOP),
                          cmd.rowad.eq(0), cmd.blkad.eq(0), cmd.rst2blkz.eq(1)]
-            with m.If(do_row):
-                m.d.sync += [cmd.rowmd.eq(RowMode.ADDRESSED), cmd.rowad.eq(cur_block * rpb + cur_row)]
-            with m.Elif(do_clear):
-                m.d.sync += [cmd.blkmd.eq(BlockMode.CLEAR), cmd.blkad.eq(cur_block),
-                             noops.eq(dmd.clear_row_cycles - 1)]
+            with m.If(dec.row):
+                m.d.sync += [cmd.rowmd.eq(RowMode.ADDRESSED), cmd.rowad.eq(dec.row_at)]
+            with m.Elif(dec.clear):
+                m.d.sync += [cmd.blkmd.eq(BlockMode.CLEAR), cmd.blkad.eq(dec.block)]
             with m.Else():
+                p = dec.pulse_group
                 with m.Switch(regs.reset_mode):
                     with m.Case(ResetMode.GLOBAL):
                         m.d.sync += [cmd.blkmd.eq(BlockMode.MULTI), cmd.blkad.eq(0b1000)]
@@ -180,12 +248,28 @@ class Bus(wiring.Component):
                         m.d.sync += [cmd.blkmd.eq(BlockMode.MULTI), cmd.blkad.eq(p), cmd.rst2blkz.eq(0)]
                     with m.Case(ResetMode.SINGLE):
                         m.d.sync += [cmd.blkmd.eq(BlockMode.RESET), cmd.blkad.eq(p)]
-        with m.Elif(remain != 0):
-            m.d.sync += remain.eq(remain - 1)
+        with m.Elif(row_left != 0):
+            m.d.sync += row_left.eq(row_left - 1)
         with m.Elif(noops != 0):
             # the clear's no-op rows follow it back to back (1080p), DVALID high
-            m.d.sync += [remain.eq(R - 1), noops.eq(noops - 1), cmd.blkmd.eq(BlockMode.NOOP), cmd.blkad.eq(0)]
+            m.d.sync += [row_left.eq(R - 1), noops.eq(noops - 1), cmd.blkmd.eq(BlockMode.NOOP), cmd.blkad.eq(0)]
         with m.Else():
             m.d.sync += [self.dvalid.eq(0), op_row.eq(0), cmd.rowmd.eq(RowMode.NOOP),
                          cmd.blkmd.eq(BlockMode.NOOP), cmd.rst2blkz.eq(1)]
         return m
+
+
+def _lowest(bits):
+    """The index of the lowest set bit of ``bits`` (up to 16; 0 when none): in chunks of four,
+    each chunk's lowest bit and whether it has one, then the lowest chunk that has (so a LUT
+    for each, and a four-way choice)."""
+    assert len(bits) <= 16
+    if len(bits) <= 4:
+        index = Const(0, 2)
+        for i in reversed(range(len(bits))):
+            index = Mux(bits[i], i, index)
+        return index
+    chunks = [bits[lo:lo + 4] for lo in range(0, len(bits), 4)]
+    lows = Array(_lowest(chunk) for chunk in chunks)
+    first = _lowest(Cat(chunk.any() for chunk in chunks))
+    return Cat(lows[first], first)

@@ -1,11 +1,15 @@
-"""The camera trigger: a pulse of ``camera_width`` cycles, ``camera_offset`` after a frame starts."""
+"""The camera trigger: a pulse of ``camera_width`` cycles, ``camera_offset`` after a frame starts.
+
+Two countdowns (:mod:`gateware.countdown`), the width's loaded as the offset's ends: the pulse
+starts and ends on their last cycles, with no sum formed.
+"""
 
 from amaranth import Module, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from ..registers import TIME_BITS, Registers
-from .timebase import diff
+from ..countdown import Countdown
+from ..registers import DURATION_BITS, Registers
 
 __all__ = ["CameraTrigger"]
 
@@ -17,30 +21,37 @@ class CameraTrigger(wiring.Component):
     -------
     regs : In(Registers)
         ``camera_offset``, ``camera_width``.
-    now : In(TIME_BITS)
     frame_start : In(1)
-        The bus makes a frame's first clocking pulse this cycle.
+        A frame's first clocking pulse is applied this cycle (its command reaches the pins the
+        next cycle).
     out : Out(1)
         Registered like the command pins: the pulse leaves ``camera_offset`` cycles after the
-        frame's first clocking pulse leaves.
+        frame's first clocking pulse leaves (a frame starting meanwhile starts it again).
     """
 
     regs: In(Registers)
-    now: In(TIME_BITS)
     frame_start: In(1)
     out: Out(1)
 
     def elaborate(self, platform):
         m = Module()
-        regs, now = self.regs, self.now
-        at = Signal(TIME_BITS)
-        armed = Signal()
-        end = at + regs.camera_width
+        regs = self.regs
+        m.submodules.offset = offset = Countdown(DURATION_BITS, flags="settled")
+        m.submodules.width = width = Countdown(16, flags="settled")
+        none = Signal()                        # a pulse of no cycles: nothing to send
+        m.d.sync += none.eq(regs.camera_width == 0)
+        at_once = Signal()
+        m.d.sync += at_once.eq(regs.camera_offset == 0)
+        waiting, pulsing = Signal(), Signal()
+        starts = waiting & offset.ends
+        # (the values hold still: their countdowns' flags are worked out ahead)
+        m.d.comb += [offset.value.eq(regs.camera_offset), width.value.eq(regs.camera_width)]
         with m.If(self.frame_start):
-            m.d.sync += [at.eq(now + regs.camera_offset), armed.eq(1)]
-        with m.Elif(armed & (diff(now, end) >= 0)):
-            m.d.sync += armed.eq(0)
-        # an offset of 0 starts the pulse with the frame, before ``at`` is registered
-        starts_now = self.frame_start & (regs.camera_offset == 0) & (regs.camera_width != 0)
-        m.d.sync += self.out.eq(starts_now | (armed & (diff(now, at) >= 0) & (diff(now, end) < 0)))
+            m.d.comb += [offset.load.eq(~at_once), width.load.eq(at_once)]
+            m.d.sync += [waiting.eq(~at_once), pulsing.eq(at_once & ~none), self.out.eq(at_once & ~none)]
+        with m.Elif(starts):
+            m.d.comb += width.load.eq(1)
+            m.d.sync += [waiting.eq(0), pulsing.eq(~none), self.out.eq(~none)]
+        with m.Elif(pulsing & width.ends):
+            m.d.sync += [pulsing.eq(0), self.out.eq(0)]
         return m

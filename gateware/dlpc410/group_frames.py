@@ -6,12 +6,12 @@ newest one taken when they move on (``advance``); a start or a retake gives ever
 next frame, one frame (``every``).
 """
 
-from amaranth import Array, Module, Mux, Shape, Signal
+from amaranth import Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
 from ..store.layouts import SLOT_BITS, Showing
-from .layouts import event, group_bits
+from .layouts import event
 
 __all__ = ["GroupFrames", "FRAME"]
 
@@ -32,60 +32,47 @@ class GroupFrames(wiring.Component):
 
     Members
     -------
-    group : In(group)
-        The group whose frame ``frame`` is.
-    frame, first : Out(FRAME)
-        The frame of group ``group``, of group 0 (their ``showing.follow`` is 0: not kept).
+    frame : Out(ArrayLayout(FRAME, blocks))
+        Each group's frame (its ``showing.follow`` is 0: not kept).
     next : Out(FRAME)
         The newest frame taken.
     offered : In(FRAME); take : In(1)
         The frame offered; it is taken now (the next frame from the next cycle).
     coming : Out(FRAME)
         The frame a group moving on now takes: the one offered if it is taken, else ``next``.
-    advance : In(event(group))
-        The group moves on to ``coming``.
+    advance : In(blocks)
+        Bit g: group g moves on to ``coming``.
     every : In(event(FRAME))
         Every group, and the next frame, take this frame (after ``advance`` and ``take``).
     """
 
     def __init__(self, dmd):
         self._dmd = dmd
+        G = dmd.blocks
         super().__init__({
-            "group": In(group_bits(dmd)),
-            "frame": Out(FRAME),
-            "first": Out(FRAME),
+            "frame": Out(data.ArrayLayout(FRAME, G)),
             "next": Out(FRAME),
             "offered": In(FRAME),
             "take": In(1),
             "coming": Out(FRAME),
-            "advance": In(event(group_bits(dmd))),
+            "advance": In(G),
             "every": In(event(FRAME)),
         })
 
     def elaborate(self, platform):
         m = Module()
         G = self._dmd.blocks
-
-        def per_group(shape, name):
-            return Array(Signal(shape, name=f"{name}{g}") for g in range(G))
-        slot, depth = per_group(SLOT_BITS, "slot"), per_group(4, "depth")
-        showing = data.Layout.cast(Showing)
-        show = {name: per_group(Shape.cast(showing[name].shape), f"show_{name}") for name in _KEPT}
         next_frame = Signal(FRAME)
-
-        def read(g, port):
-            m.d.comb += [port.slot.eq(slot[g]), port.depth.eq(depth[g]),
-                         *(port.showing[name].eq(show[name][g]) for name in _KEPT)]
-        read(self.group, self.frame)
-        read(0, self.first)
         m.d.comb += [self.next.eq(next_frame),
                      self.coming.eq(Mux(self.take, self.offered.as_value(), next_frame.as_value()))]
 
         def give(g, frame):
-            return [slot[g].eq(frame.slot), depth[g].eq(frame.depth),
-                    *(show[name][g].eq(frame.showing[name]) for name in _KEPT)]
-        with m.If(self.advance.valid):
-            m.d.sync += give(self.advance.payload, self.coming)
+            kept = self.frame[g]
+            return [kept.slot.eq(frame.slot), kept.depth.eq(frame.depth),
+                    *(kept.showing[name].eq(frame.showing[name]) for name in _KEPT)]
+        for g in range(G):
+            with m.If(self.advance[g]):
+                m.d.sync += give(g, self.coming)
         with m.If(self.take):
             m.d.sync += next_frame.eq(self.offered)
         with m.If(self.every.valid):

@@ -1,25 +1,32 @@
-"""Each pulse group's times: when its next pulse falls due, when its memory may change again, and
-when RST_ACTIVE allows its next pulse.
+"""Each pulse group's times, as countdowns (:mod:`gateware.countdown`): when its next pulse falls
+due, when RST_ACTIVE allows its next pulse, and when its memory may change after its pulse.
 
-Times are kept as instants of the time base (:mod:`.timebase`) and answered as flags of this
-cycle, so that the planner decides what a group does and this part only when: a pulse sets the
-group's next pulse ``delay`` cycles on, its memory writable ``t_rst + t_settle`` on and its
-RST_ACTIVE over ``t_rst`` on; a trigger sets every active group's first pulse, ``stagger`` apart;
-a retake keeps every group's memory unchanged until at least ``lead``; RST_ACTIVE's fall keeps a
-group's memory unchanged until its settle time is over (after a retake of the same cycle).
+Every time is loaded by an event of the cycle a decision is applied (one cycle after the bus
+decided, so every countdown here has a lag of one: its time counts from the decision) and is
+answered as registered flags, most of them for the next cycle, so that the planner registers the
+bus's flags (:class:`~gateware.dlpc410.planner.Planner`) from them with little logic:
+
+* a pulse: the group's next pulse ``delay`` on (the planner's per-group delay), RST_ACTIVE over
+  ``t_rst`` on, and its memory free ``t_settle`` after that (the settle countdown starts when
+  the RST_ACTIVE countdown ends, so no sum is formed: timers chain);
+* a trigger obeyed: group 0's first pulse falls due two cycles after the trigger's cycle, and
+  group ``g``'s ``stagger`` after group ``g - 1``'s (each loaded as the one before ends; with
+  ``stagger`` 0 all at once). A group waiting in that chain has no time yet: its flags say not
+  due, and not soon (``stagger`` is 0 or at least a clear's row cycles, so no load that a first
+  pulse could cut short can start meanwhile: :func:`spec.records.register_faults`).
 """
 
-from amaranth import Array, Module, Mux, Signal
+from amaranth import Const, Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from spec.schedule import INIT_TO_DVALID
-
-from ..registers import TIME_BITS, Registers
-from .layouts import event, group_bits
-from .timebase import diff
+from ..countdown import Countdown
+from ..registers import DURATION_BITS, Registers
 
 __all__ = ["GroupTimes"]
+
+#: Every countdown here is loaded one cycle after the decision its time counts from.
+LAG = 1
 
 
 class GroupTimes(wiring.Component):
@@ -29,34 +36,36 @@ class GroupTimes(wiring.Component):
     ----------
     dmd : :class:`spec.facts.DmdType`
     soon, soon_clear : int
-        Distances (cycles) for the ``soon`` and ``soon_clear`` flags.
+        Cycles a row and a clear (with its no-op rows) take on the bus: the ``soon`` flags.
 
     Members
     -------
     regs : In(:class:`~gateware.registers.Registers`)
-    now : In(TIME_BITS)
-        The time base.
-    pulse : In(event(group, delay))
-        The group pulses this cycle; its next pulse falls due ``delay`` cycles on.
-    trigger : In(event(TIME_BITS))
-        Group ``g`` (of those ``active``) pulses first at ``payload + g * stagger``.
+        ``t_rst``, ``t_settle``, ``stagger``, ``strict_rst``.
+    pulse : In(blocks)
+        Bit g: group g's pulse decided last cycle is applied now.
+    pulse_any : In(1)
+        Some bit of ``pulse`` (registered apart, for the flags' depth).
+    delay : In(ArrayLayout(DURATION_BITS, blocks))
+        Per group, the time from its pulse to its next one (set at least three cycles before the
+        pulse that takes it is applied).
+    obey : In(1)
+        A trigger obeyed last cycle is applied now: the first pulses of the ``active`` groups.
     active : In(blocks)
-        Bit g: group g is one of the reset mode's.
-    retake : In(event(TIME_BITS))
-        No group's memory changes before ``payload``.
-    fell : In(event(groups, settled))
-        RST_ACTIVE fell after the pulses of ``groups``: no change of their memory before
-        ``settled``.
-    due, soon, soon_clear : Out(blocks)
-        Bit g: group g's pulse time has come; it comes within ``soon``, ``soon_clear`` cycles.
-    late : Out(1)
-        The group pulsing this cycle pulses after its time.
-    memory_free : Out(blocks)
-        Bit g: group g's memory may change (counted from its pulse, a retake and RST_ACTIVE's fall).
+    abandon : In(1)
+        The groups leave their frame: a chain of first pulses stops.
+    due : Out(blocks)
+        Bit g: group g's pulse falls due by the next cycle.
+    soon, soon_clear : Out(blocks)
+        Bit g: an operation of ``soon`` (``soon_clear``) cycles decided next cycle would end after
+        group g's pulse falls due.
+    late : Out(blocks)
+        Bit g: a pulse decided this cycle would be after the first even cycle of its time.
     rst_over : Out(blocks)
-        Bit g: RST_ACTIVE may no longer be high for group g's last pulse.
-    rst_over_any : Out(1)
-        The same, for the last pulse of any group.
+        Bit g: RST_ACTIVE no longer needs to be waited for by the next cycle, for a pulse of
+        group g (strict: since any group's pulse; loose: since its own).
+    settled : Out(blocks)
+        Bit g: the group's memory may change by the next cycle, as far as its last pulse goes.
     """
 
     def __init__(self, dmd, *, soon, soon_clear):
@@ -64,64 +73,80 @@ class GroupTimes(wiring.Component):
         groups = dmd.blocks
         super().__init__({
             "regs": In(Registers),
-            "now": In(TIME_BITS),
-            "pulse": In(event(data.StructLayout({"group": group_bits(dmd), "delay": TIME_BITS}))),
-            "trigger": In(event(TIME_BITS)),
+            "pulse": In(groups),
+            "pulse_any": In(1),
+            "delay": In(data.ArrayLayout(DURATION_BITS, groups)),
+            "obey": In(1),
             "active": In(groups),
-            "retake": In(event(TIME_BITS)),
-            "fell": In(event(data.StructLayout({"groups": groups, "settled": TIME_BITS}))),
+            "abandon": In(1),
             "due": Out(groups),
             "soon": Out(groups),
             "soon_clear": Out(groups),
-            "late": Out(1),
-            "memory_free": Out(groups),
+            "late": Out(groups),
             "rst_over": Out(groups),
-            "rst_over_any": Out(1),
+            "settled": Out(groups),
         })
 
     def elaborate(self, platform):
         m = Module()
-        regs, now = self.regs, self.now
-        G = self._dmd.blocks
+        regs, G = self.regs, self._dmd.blocks
+        stagger_zero = Signal()
+        m.d.sync += stagger_zero.eq(regs.stagger == 0)
 
-        def per_group(name, init=0):
-            return Array(Signal(TIME_BITS, name=f"{name}{g}", init=init) for g in range(G))
-        pulse_at = per_group("pulse_at")
-        writable = per_group("writable", INIT_TO_DVALID)
-        rst_free = per_group("rst_free")
-        rst_any = Signal(TIME_BITS)
-
+        # the flags are for the next cycle: "by the next cycle" is within 2 cycles from now; the
+        # values loaded hold still the cycle before (the registers), or their flags are worked
+        # out ahead (each group's delay, as it is set)
+        m.submodules.rst_any = rst_any = Countdown(16, lag=LAG, within=(2,), flags="settled")
+        m.d.comb += [rst_any.load.eq(self.pulse_any), rst_any.value.eq(regs.t_rst)]
+        chained = [Signal(name=f"chained{g}") for g in range(G)]
+        pulse_cds = []
         for g in range(G):
+            pulse_cd = Countdown(DURATION_BITS, lag=LAG, slack=1, within=(2, self._soon, self._soon_clear),
+                                 flags="given")
+            rst_cd = Countdown(16, lag=LAG, slack=1, within=(2,), flags="settled")
+            settle_cd = Countdown(16, lag=LAG, within=(2,), flags="settled")
+            m.submodules[f"pulse{g}"], m.submodules[f"rst{g}"], m.submodules[f"settle{g}"] = pulse_cd, rst_cd, settle_cd
+            pulse_cds.append(pulse_cd)
+
+            # the pulse time: the delay after a pulse; the first pulse of a frame (group 0's two
+            # cycles after the trigger's, the others' ``stagger`` after the group's before them,
+            # chained: as the group before ends its count, unless it waits itself and the end
+            # is of its count before the trigger); each source with its flags worked out ahead
+            delay_flags = pulse_cd.flags_registered(m, self.delay[g], f"delay_flags{g}")
+            stagger_flags = pulse_cd.flags_registered(m, regs.stagger, f"stagger_flags{g}")
+            first = self.obey & self.active[g] & ((g == 0) | stagger_zero)
+            if g:
+                chain = chained[g] & pulse_cds[g - 1].ends & (~chained[g - 1] if g > 1 else 1)
+                m.d.sync += chained[g].eq(Mux(self.abandon | chain, 0, chained[g] | (self.obey & self.active[g]
+                                                                                     & ~stagger_zero)))
+            else:
+                chain = Const(0)
+            # (one of the three at most: a group pulses only loaded, never waiting for a trigger)
             m.d.comb += [
-                self.due[g].eq(diff(pulse_at[g], now) <= 0),
-                self.soon[g].eq(diff(pulse_at[g], now) < self._soon),
-                self.soon_clear[g].eq(diff(pulse_at[g], now) < self._soon_clear),
-                self.memory_free[g].eq(diff(writable[g], now) <= 0),
-                self.rst_over[g].eq(diff(rst_free[g], now) <= 0),
+                pulse_cd.load.eq(self.pulse[g] | first | chain),
+                pulse_cd.value.eq(Mux(self.pulse[g], self.delay[g], 0) | Mux(first, 2, 0)
+                                  | Mux(chain, regs.stagger, 0)),
+                pulse_cd.load_flags.eq(Mux(self.pulse[g], delay_flags, 0) | Mux(first, pulse_cd.flags_of(2), 0)
+                                       | Mux(chain, stagger_flags, 0)),
             ]
-        m.d.comb += self.rst_over_any.eq(diff(rst_any, now) <= 0)
 
-        p = self.pulse.payload.group
-        with m.If(self.pulse.valid):
-            m.d.comb += self.late.eq(diff(pulse_at[p], now) < 0)
-            m.d.sync += [
-                pulse_at[p].eq(now + self.pulse.payload.delay),
-                writable[p].eq(now + regs.t_rst + regs.t_settle),
-                rst_free[p].eq(now + regs.t_rst),
-                rst_any.eq(now + regs.t_rst),
+            # RST_ACTIVE over, then the settle time
+            m.d.comb += [rst_cd.load.eq(self.pulse[g]), rst_cd.value.eq(regs.t_rst),
+                         settle_cd.load.eq(rst_cd.ends), settle_cd.value.eq(regs.t_settle)]
+
+            # (a countdown loaded this cycle has the flags of its last count: a group waiting in
+            # the chain, or pulsing now, is masked; the strict RST_ACTIVE time of every group
+            # restarts with any pulse)
+            waiting = chained[g]
+            m.d.comb += [
+                self.due[g].eq(pulse_cd.within[0] & ~waiting),
+                self.soon[g].eq(pulse_cd.within[1] & ~waiting),
+                self.soon_clear[g].eq(pulse_cd.within[2] & ~waiting),
+                self.late[g].eq(pulse_cd.late),
+                self.rst_over[g].eq(Mux(regs.strict_rst, rst_any.within[0] & ~self.pulse_any,
+                                        rst_cd.within[0] & ~self.pulse[g])),
+                # the settle countdown is loaded once the RST_ACTIVE one has ended (its flags are
+                # the settle time's from the cycle after)
+                self.settled[g].eq(rst_cd.late & settle_cd.within[0] & ~self.pulse[g]),
             ]
-        with m.If(self.trigger.valid):
-            for g in range(G):
-                with m.If(self.active[g]):
-                    m.d.sync += pulse_at[g].eq(self.trigger.payload + regs.stagger * g)
-
-        lead = self.retake.payload
-        settled = self.fell.payload.settled
-        for g in range(G):
-            # a retake: no sooner than its lead; then RST_ACTIVE's fall: no sooner than settled
-            base = Mux(self.retake.valid & (diff(writable[g], lead) < 0), lead, writable[g])
-            with m.If(self.retake.valid):
-                m.d.sync += writable[g].eq(base)
-            with m.If(self.fell.valid & self.fell.payload.groups[g] & (diff(base, settled) < 0)):
-                m.d.sync += writable[g].eq(settled)
         return m

@@ -21,6 +21,7 @@ from amaranth.lib.wiring import In, Out
 
 from spec.facts import TIMING
 
+from ..counter import Counter
 from .layouts import COUNTER_BITS
 
 __all__ = ["Init", "TRAINING_EDGES"]
@@ -42,7 +43,7 @@ class Init(wiring.Component):
         The controller is ready for commands (ECP2_FINISHED high and INIT_ACTIVE low, two
         synchroniser cycles and one register late).
     restarts : Out(COUNTER_BITS)
-        ``running`` fell: the controller initialises again.
+        ``running`` fell: the controller initialises again (counted a cycle later).
     training : Out(1)
         High while the training pattern must be sent (not ``running``).
     rst_active : In(1), rst_active_synced : Out(1)
@@ -64,8 +65,8 @@ class Init(wiring.Component):
         m.submodules.init_sync = FFSynchronizer(self.init_active, init, init=1)
         m.submodules.rst_sync = FFSynchronizer(self.rst_active, self.rst_active_synced)
         ready = ecp2 & ~init
-        m.d.sync += self.running.eq(ready)
-        with m.If(self.running & ~ready):
-            m.d.sync += self.restarts.eq(self.restarts + 1)
-        m.d.comb += self.training.eq(~self.running)
+        fell = Signal()
+        m.d.sync += [self.running.eq(ready), fell.eq(self.running & ~ready)]
+        m.submodules.restarts = restarts = Counter(COUNTER_BITS)
+        m.d.comb += [restarts.inc.eq(fell), self.restarts.eq(restarts.count), self.training.eq(~self.running)]
         return m

@@ -24,15 +24,19 @@ block_bits = group_bits
 
 def load_job(dmd):
     """What a group must be loaded with next: display position ``pos`` of the frame in ``slot``
-    (of ``depth`` planes), or clears (``clear``)."""
-    return data.StructLayout({"group": group_bits(dmd), "slot": SLOT_BITS, "depth": 4, "pos": 3, "clear": 1})
+    (of ``depth`` planes), the stored plane that is (``plane``), or clears (``clear``)."""
+    return data.StructLayout({"group": group_bits(dmd), "slot": SLOT_BITS, "depth": 4, "pos": 3, "plane": 3,
+                              "clear": 1})
 
 
 def ready_load(dmd):
     """A load job with its blocks looked up: ``mask`` bit b set when block b's rows are loaded
-    (else it is cleared), for the blocks ``first`` .. ``last`` of the group."""
+    (else it is cleared), for the blocks ``first`` .. ``last`` of the group; ``first_row``, the
+    first block's first row; ``first_occupied``, ``mask``'s bit of ``first``, and ``single``, the
+    job's first operation is its last (one block, cleared or of one row)."""
     return data.StructLayout({"group": group_bits(dmd), "mask": dmd.blocks,
-                              "first": block_bits(dmd), "last": block_bits(dmd)})
+                              "first": block_bits(dmd), "last": block_bits(dmd), "first_row": 11,
+                              "first_occupied": 1, "single": 1})
 
 
 def event(shape):

@@ -12,7 +12,9 @@ from amaranth import Module, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from ..registers import LSB_BITS, Registers, TriggerMode
+from ..counter import Counter
+from ..limbs import greater, limb_order, limbs, pipelined_sum
+from ..registers import DURATION_BITS, LSB_BITS, Registers, TriggerMode
 from .layouts import COUNTER_BITS
 
 __all__ = ["PeriodWatch"]
@@ -42,11 +44,14 @@ class PeriodWatch(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         regs = self.regs
-        # two registered stages (a shift, then a compare): the depth and the registers are
-        # steady for a plane or more before the frame's first pulse
-        planes, too_short = Signal(LSB_BITS + 15), Signal()
-        m.d.sync += [planes.eq((self.lsb << self.depth) - self.lsb),
-                     too_short.eq((regs.trigger == TriggerMode.PERIODIC) & (regs.period < planes))]
-        with m.If(self.frame_start & too_short):
-            m.d.sync += self.short.eq(self.short + 1)
+        # registered stages, a limb at a time: the depth and the registers are steady for a plane
+        # or more before the frame's first pulse (a shift, a difference, a comparison)
+        depth, lsb, shifted = Signal(4), Signal(DURATION_BITS), Signal(DURATION_BITS)
+        m.d.sync += [depth.eq(self.depth), lsb.eq(self.lsb), shifted.eq(lsb << depth)]
+        planes, _ = pipelined_sum(m, [shifted] * len(limbs(DURATION_BITS)), lambda k: ~lsb, 1, "planes")
+        above, same = limb_order(m, planes[:DURATION_BITS], regs.period, "planes")
+        too_short = Signal()
+        m.d.sync += too_short.eq((regs.trigger == TriggerMode.PERIODIC) & greater(above, same))
+        m.submodules.count = count = Counter(COUNTER_BITS)
+        m.d.comb += [count.inc.eq(self.frame_start & too_short), self.short.eq(count.count)]
         return m

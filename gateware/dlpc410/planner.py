@@ -1,15 +1,21 @@
 """The planner: every pulse group's timeline, and what each group must be loaded with next.
 
 Each group (:func:`spec.registers.group_size` blocks pulsed together) keeps its place in the
-frame (display position, dark or not), whether it is loaded and plays, the frame it shows (slot,
-bit depth, entry settings: :mod:`.group_frames`) and its times (:mod:`.group_times`): when its
-next pulse falls due, when its memory may change again (``t_rst + t_settle`` after its last
-pulse, and no sooner than ``t_settle`` after RST_ACTIVE fell: :mod:`.reset_watch`) and when
-RST_ACTIVE allows its next pulse. When the bus makes a pulse, the planner decides what follows
-it: the group's next pulse time and its next load job, the next plane (a plane long enough to
-hide the load, ``hide``) or clears ended by a dark pulse. At the last plane of a frame group 0
-takes the newest complete frame, if one is offered (else the frame repeats). The frame control
-starts, reloads and triggers the groups through command events.
+frame (display position, dark or not), whether it is loaded and plays, the frame it shows
+(:mod:`.group_frames`) and its times (:mod:`.group_times`); :mod:`.plane_info` works out ahead
+what each group's next pulse does (the plane's length against ``hide``, the time to the pulse
+after it), and :mod:`.reset_watch` watches RST_ACTIVE.
+
+The bus decides a pulse (``choice``) from flags the planner registered the cycle before
+(``due``, ``imminent``, ``writable``); on that cycle the planner decides what the pulse does
+(from its registered answers and the frame offered) and registers it, and applies it on the
+next cycle: the group's position, frame, dark and pending flags, its times, the frame taken. The
+load job for the group's next plane follows a cycle later, from the group's new state. A frame
+control event (a start, a retake, a trigger obeyed, a first plane queued) comes registered and
+is applied on its cycle.
+
+``playing`` and ``ended`` are as the decisions made so far leave them (a pulse being applied is
+counted in), for the frame control, which counts in its own.
 """
 
 from amaranth import Array, Cat, Module, Mux, Signal
@@ -18,21 +24,23 @@ from amaranth.lib.wiring import In, Out
 
 from spec.schedule import row_cycles
 
-from ..registers import LSB_BITS, TIME_BITS, Registers, Source
+from ..counter import Counter
+from ..registers import LSB_BITS, Registers, Source
 from ..store.layouts import SLOT_BITS, FrameInfo, Showing
 from .group_frames import GroupFrames
 from .group_times import GroupTimes
 from .layouts import COUNTER_BITS, event, group_bits, load_job
+from .plane_info import PlaneInfo
 from .reset_watch import ResetWatch
-from .timebase import exponent
+from .timebase import exponent, stored_plane
 
-__all__ = ["Planner", "Offer"]
+__all__ = ["Planner", "Offer", "START"]
 
 
 class Offer(data.Struct):
-    """The frame the store offers now: ``valid`` when it has a bit depth the sequencer plays;
-    ``sequence`` when it is the next frame of a stored sequence (it does not replace a frame
-    waiting for its trigger); ``showing``, its sequence entry's settings."""
+    """The frame the store offers now: ``valid`` when it has a bit depth the sequencer plays and
+    no one is taking it; ``sequence`` when it is the next frame of a stored sequence (it does not
+    replace a frame waiting for its trigger); ``showing``, its sequence entry's settings."""
     valid: 1
     slot: SLOT_BITS
     depth: 4
@@ -56,54 +64,64 @@ class Planner(wiring.Component):
     Members
     -------
     regs : In(:class:`~gateware.registers.Registers`)
-    now : In(TIME_BITS)
-        The time base.
-    n_groups : In(range(blocks + 1))
-        Groups of the reset mode.
+    active : In(blocks)
+        Bit g: group g is one of the reset mode's.
     rst_active : In(1)
-        RST_ACTIVE, synchronised: with ``strict_rst``, no group's pulse is due while it is high.
+        RST_ACTIVE, synchronised.
     frames : In(stream.Signature(FrameInfo))
         The newest complete frame. A bit depth outside 1..8 is dropped when offered, and counted.
+        A frame taken is answered (``ready``) the cycle after it was taken.
     offer : Out(Offer)
         The frame offered now, for the frame control.
-    pulse : In(event(group))
-        The bus made this group's pulse this cycle.
-    loaded : In(event(group))
-        The bus finished this group's load this cycle.
+    choice : In(blocks)
+        The bus's decision this cycle: bit g, a pulse of group g (one bit at most).
+    pulsing : In(1)
+        Some bit of ``choice``.
+    loaded : In(blocks)
+        Bit g: the bus ends group g's load this cycle.
     start : In(event(START))
         Every group begins the frame ``slot`` of ``depth`` planes, shown as ``showing`` says, at
-        its first plane; ``take``: that frame is the one offered, taken now.
-    retake : In(event(newer, abandon, lead))
-        A newer frame (``newer``: the one offered, taken now) or the same frame under new
-        registers replaces what every group holds; each group's memory may change no sooner than
-        ``lead``. ``abandon`` (the controller restarted): every group also leaves the frame it
-        was playing and waits at its first plane.
-    trigger : In(event(TIME_BITS))
-        A trigger obeyed: group ``g``'s first pulse falls due at ``payload + g * stagger``.
+        its first plane; ``take``: that frame is the one offered.
+    retake : In(event(newer, abandon))
+        A newer frame (``newer``: the one offered) or the same frame under new registers replaces
+        what every group holds. ``abandon`` (the controller restarted): every group also leaves
+        the frame it was playing and waits at its first plane.
+    trigger : In(1)
+        A trigger obeyed: every active group's first pulse falls due (group 0 the cycle after
+        next, the others ``stagger`` apart).
     queue_first : In(event(group))
         Queue the group's first plane of the current frame.
+    lead_over : In(1)
+        The frame control lets the memory change by the next cycle (a retake's lead, the first
+        loads' wait after initialisation).
     jobs : Out(event(load_job))
         Load jobs, in the order of the pulses that freed the groups (the queue always has room).
     due : Out(blocks)
-        Bit g: group g is loaded, its pulse time has come and RST_ACTIVE allows it.
+        Bit g (registered): group g is loaded, its pulse time has come and RST_ACTIVE's countdown
+        allows it (the pin's own check is the bus's).
     imminent, imminent_clear : Out(1)
-        A loaded group's pulse falls due within a row cycle, within a clear (and its no-op rows).
+        (registered) A loaded group's pulse falls due within a row, within a clear (and its no-op
+        rows), decided now.
     writable : Out(blocks)
-        Bit g: group g's memory may change (its settle time is over, counted from its pulse and
-        from RST_ACTIVE's fall).
+        Bit g (registered): group g's memory may change (its settle time is over, counted from
+        its pulse and from RST_ACTIVE's fall, and the frame control's lead).
+    pending, holds : Out(blocks)
+        Bit g: group g plays a frame; is loaded with the plane (or dark) its next pulse shows.
     all_ready : Out(1)
-        Every group is loaded and waits for a trigger.
+        Every group of the reset mode is loaded and waits for a trigger (registered: as this
+        cycle's state is; the frame control counts in its own decisions).
+    job_due : Out(1)
+        A load job is on its way (it is written in a cycle or two).
     playing : Out(1)
         Some group plays a frame.
-    frame_start : Out(1)
-        This cycle's pulse is the first of a frame.
-    camera_start : Out(1)
-        The same, for a frame whose entry pulses the camera.
     ended : Out(1)
         The last frame of a sequence played once has started; a frame taken anew (``start``,
         ``retake`` of a newer one) clears it.
+    frame_start, camera_start : Out(1)
+        The pulse applied now is the first of a frame (that pulses the camera).
     sync_out : Out(1)
-        High while a frame is shown (first pulse to the last group's final dark pulse).
+        High while a frame is shown, with the pins (first pulse to the last group's final dark
+        pulse).
     frames_started, late, bad_frames : Out(COUNTER_BITS)
         Frames started; pulses made after their time; frames dropped for their bit depth.
     rst_late, rst_faults, rst_longest : Out(COUNTER_BITS)
@@ -121,31 +139,35 @@ class Planner(wiring.Component):
 
     def __init__(self, dmd, *, beats=1):
         self._dmd, self._beats = dmd, beats
-        groups = dmd.blocks
+        G = dmd.blocks
         gb = group_bits(dmd)
         super().__init__({
             "regs": In(Registers),
-            "now": In(TIME_BITS),
-            "n_groups": In(range(groups + 1)),
+            "active": In(G),
             "rst_active": In(1),
             "frames": In(stream.Signature(FrameInfo)),
             "offer": Out(Offer),
-            "pulse": In(event(gb)),
-            "loaded": In(event(gb)),
+            "choice": In(G),
+            "pulsing": In(1),
+            "loaded": In(G),
             "start": In(event(START)),
-            "retake": In(event(data.StructLayout({"newer": 1, "abandon": 1, "lead": TIME_BITS}))),
-            "trigger": In(event(TIME_BITS)),
+            "retake": In(event(data.StructLayout({"newer": 1, "abandon": 1}))),
+            "trigger": In(1),
             "queue_first": In(event(gb)),
+            "lead_over": In(1),
             "jobs": Out(event(load_job(dmd))),
-            "due": Out(groups),
+            "due": Out(G),
             "imminent": Out(1),
             "imminent_clear": Out(1),
-            "writable": Out(groups),
+            "writable": Out(G),
+            "pending": Out(G),
+            "holds": Out(G),
             "all_ready": Out(1),
+            "job_due": Out(1),
             "playing": Out(1),
+            "ended": Out(1),
             "frame_start": Out(1),
             "camera_start": Out(1),
-            "ended": Out(1),
             "sync_out": Out(1),
             "frames_started": Out(COUNTER_BITS),
             "late": Out(COUNTER_BITS),
@@ -159,154 +181,192 @@ class Planner(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        dmd, regs, now = self._dmd, self.regs, self.now
+        dmd, regs = self._dmd, self.regs
         R = row_cycles(dmd, self._beats)
         G = dmd.blocks
+        gb = group_bits(dmd)
         use_prng = regs.source == Source.PRNG
+        active = self.active
 
-        def per_group(shape, name, init=0):
-            return Array(Signal(shape, name=f"{name}{g}", init=init) for g in range(G))
-        pending = per_group(1, "pending")
-        loaded = per_group(1, "loaded")
-        pos = per_group(3, "pos")
-        dark = per_group(1, "dark")
+        pending, loaded, dark = self.pending, self.holds, Signal(G)
+        pos = [Signal(3, name=f"pos{g}") for g in range(G)]
         m.submodules.frames = frames = GroupFrames(dmd)
-
-        def lsb_of(frame):
-            """The least significant plane's time of ``frame``."""
-            return Mux(frame.showing.lsb != 0, frame.showing.lsb, regs.lsb)
-        m.d.comb += [self.depth.eq(frames.first.depth), self.lsb.eq(lsb_of(frames.first))]
-        active = Signal(G)
-        for g in range(G):
-            m.d.comb += active[g].eq(g < self.n_groups)
-
+        m.submodules.info = info = PlaneInfo(dmd)
+        m.submodules.times = times = GroupTimes(dmd, soon=R, soon_clear=dmd.clear_row_cycles * R)
         m.submodules.reset_watch = watch = ResetWatch(dmd)
-        m.d.comb += [watch.regs.eq(regs), watch.now.eq(now), watch.rst_active.eq(self.rst_active),
-                     watch.pulse.valid.eq(self.pulse.valid), watch.pulse.payload.eq(self.pulse.payload),
+        m.d.comb += [info.regs.eq(regs), times.regs.eq(regs), watch.regs.eq(regs),
+                     watch.rst_active.eq(self.rst_active), times.active.eq(active),
                      self.rst_late.eq(watch.late), self.rst_faults.eq(watch.faults),
                      self.rst_longest.eq(watch.longest)]
-        m.submodules.times = times = GroupTimes(dmd, soon=R, soon_clear=dmd.clear_row_cycles * R)
-        m.d.comb += [times.regs.eq(regs), times.now.eq(now), times.active.eq(active),
-                     times.trigger.valid.eq(self.trigger.valid), times.trigger.payload.eq(self.trigger.payload),
-                     times.retake.valid.eq(self.retake.valid), times.retake.payload.eq(self.retake.payload.lead),
-                     times.fell.valid.eq(watch.fell.valid), times.fell.payload.groups.eq(watch.fell.payload.groups),
-                     times.fell.payload.settled.eq(watch.fell.payload.settled)]
-        # ---- what the bus may do ----
-        armed = [Signal(name=f"armed{g}") for g in range(G)]
         for g in range(G):
-            # strict: no pulse while RST_ACTIVE may be high, by the plan or at the pin; loose: a
-            # group's own reset only (RST_ACTIVE at the pin may be another group's; a group whose
-            # reset has not ended is kept unloaded by the RST_ACTIVE watch, so it cannot pulse)
-            rst_ok = Mux(regs.strict_rst, times.rst_over_any & ~self.rst_active, times.rst_over[g])
-            m.d.comb += [
-                armed[g].eq(active[g] & pending[g] & loaded[g]),
-                self.due[g].eq(armed[g] & times.due[g] & rst_ok),
-                self.writable[g].eq(times.memory_free[g] & ~watch.waiting[g]),
-            ]
-        m.d.comb += [
-            self.imminent.eq(Cat(armed[g] & times.soon[g] for g in range(G)).any()),
-            self.imminent_clear.eq(Cat(armed[g] & times.soon_clear[g] for g in range(G)).any()),
-            self.all_ready.eq(Cat(~active[g] | (~pending[g] & loaded[g]) for g in range(G)).all()),
-            self.playing.eq(Cat(active[g] & pending[g] for g in range(G)).any()),
-        ]
+            m.d.comb += [info.pos[g].eq(pos[g]), info.frame[g].eq(frames.frame[g]),
+                         times.delay[g].eq(info.delay[g])]
+        m.d.comb += info.dark.eq(dark)
+        first = frames.frame[0]
+        m.d.comb += [self.depth.eq(first.depth),
+                     self.lsb.eq(Mux(first.showing.lsb != 0, first.showing.lsb, regs.lsb))]
 
-        # ---- the frame offered ----
+        # ---- the frame offered: free to take unless a take is being answered ----
         depth_in = self.frames.payload.bit_depth
         frame_ok = (depth_in != 0) & (depth_in <= 8)
-        m.d.comb += [self.offer.valid.eq(self.frames.valid & frame_ok),
+        taking = Signal()                      # group 0 took the offered frame last cycle
+        answered = taking | (self.start.valid & self.start.payload.take) | \
+            (self.retake.valid & self.retake.payload.newer)
+        m.d.comb += [self.offer.valid.eq(self.frames.valid & frame_ok & ~answered),
                      self.offer.slot.eq(self.frames.payload.slot), self.offer.depth.eq(depth_in),
                      self.offer.sequence.eq(self.frames.payload.sequence),
-                     self.offer.showing.eq(self.frames.payload.showing)]
-        with m.If(self.frames.valid & ~frame_ok):
-            m.d.comb += self.frames.ready.eq(1)
-            m.d.sync += self.bad_frames.eq(self.bad_frames + 1)
+                     self.offer.showing.eq(self.frames.payload.showing),
+                     self.frames.ready.eq(answered | (self.frames.valid & ~frame_ok))]
+        m.d.comb += [frames.offered.slot.eq(self.frames.payload.slot), frames.offered.depth.eq(depth_in),
+                     frames.offered.showing.eq(self.frames.payload.showing)]
+        m.submodules.bad = bad = Counter(COUNTER_BITS)
+        bad_seen = Signal()
+        m.d.sync += bad_seen.eq(self.frames.valid & ~frame_ok)
+        m.d.comb += [bad.inc.eq(bad_seen), self.bad_frames.eq(bad.count)]
 
-        # ---- a load finished ----
-        with m.If(self.loaded.valid):
-            m.d.sync += loaded[self.loaded.payload].eq(1)
+        # ---- the decision: what the pulse the bus chooses does (registered) ----
+        P = self.choice
+        usable = self.offer.valid & ~use_prng
+        offered_follow = self.offer.showing.follow
+        hidden, final = Signal(G), Signal(G)
+        for g in range(G):
+            # the frame after this one starts without a trigger: chained, or it follows (group 0
+            # takes the one offered, if any); never after a sequence's last frame
+            ends_sequence = frames.frame[g].showing.last
+            follows_next = (regs.chain | frames.next.showing.follow) & ~ends_sequence
+            if g == 0:
+                follows_offered = (regs.chain | offered_follow) & ~ends_sequence
+                follow = Mux(usable, follows_offered, follows_next)
+            else:
+                follow = follows_next
+            # the next plane is loaded behind this one; at a frame's end only if the frame after
+            # follows and this one wants no dark time
+            m.d.comb += [
+                hidden[g].eq((~dark[g] & info.big[g] & ~info.last[g])
+                             | (~dark[g] & info.big[g] & info.keeps_dark[g] & follow)),
+                final[g].eq(dark[g] & info.last[g] & ~follow),
+            ]
+        # group 0 takes the frame offered at its frame's last pulse, dark or hiding the next
+        # (which, being the offered frame's first plane, follows as the offered frame says)
+        takes_offered = info.last[0] & (dark[0] | (info.big[0] & info.keeps_dark[0] & ~frames.frame[0].showing.last
+                                                    & (regs.chain | offered_follow)))
+        # the reset mode's last group (its groups are 0 .. n - 1)
+        last_group = Cat(active[g] & (~active[g + 1] if g + 1 < G else 1) for g in range(G))
+        decided = Signal(G)                    # the pulse decided last cycle, applied now
+        decided_any = Signal()
+        moves, ends_play, take, starts, camera, ends_seq, late_now = (
+            Signal(G), Signal(G), Signal(), Signal(), Signal(), Signal(), Signal(G))
+        first_plane = ~dark[0] & (pos[0] == 0)
+        m.d.sync += [
+            decided.eq(P), decided_any.eq(self.pulsing),
+            moves.eq(P & (dark | hidden)),
+            ends_play.eq(P & final),
+            take.eq(P[0] & usable & takes_offered),
+            starts.eq(P[0] & first_plane),
+            camera.eq(P[0] & first_plane & ~first.showing.camera_off),
+            ends_seq.eq(P[0] & first_plane & first.showing.last),
+            late_now.eq(times.late),
+        ]
+        m.d.comb += taking.eq(take)
 
-        # ---- a pulse: what follows it ----
-        p = self.pulse.payload
-        mine = frames.frame                    # the pulsed group's frame
-        m.d.comb += [frames.group.eq(p), frames.offered.slot.eq(self.frames.payload.slot),
-                     frames.offered.depth.eq(depth_in), frames.offered.showing.eq(self.frames.payload.showing)]
-        pj, pdark, pdepth = pos[p], dark[p], mine.depth
-        pe = exponent(m, regs, pj, pdepth, "pulse_exp")
-        last = pj == pdepth - 1
-        plane_len = Signal.like(regs.hide)
-        m.d.comb += plane_len.eq(lsb_of(mine) << pe)
-        # the frame after this one starts without a trigger: chained, or it follows (group 0
-        # takes the one offered, if any); never after a sequence's last frame, nor hidden behind
-        # a frame that wants dark time after it
-        offered = (p == 0) & self.offer.valid & ~use_prng
-        follow = Signal()
-        m.d.comb += follow.eq((regs.chain | Mux(offered, self.offer.showing.follow, frames.next.showing.follow))
-                              & ~mine.showing.last)
-        pdark_time = mine.showing.dark
-        hidden = ~pdark & (plane_len >= regs.hide) & (~last | (follow & (pdark_time == 0)))
-        new_frame = last & (pdark | hidden)
-        take = frames.take
-        m.d.comb += take.eq(self.pulse.valid & new_frame & offered)
-        with m.If(take):
-            m.d.comb += self.frames.ready.eq(1)
-        job = self.jobs.payload
-        m.d.comb += [times.pulse.valid.eq(self.pulse.valid), times.pulse.payload.group.eq(p),
-                     times.pulse.payload.delay.eq(
-                         Mux(pdark, Mux(last & (pdark_time > regs.dark_gap), pdark_time, regs.dark_gap), plane_len))]
-        with m.If(self.pulse.valid):
-            with m.If(times.late):
-                m.d.sync += self.late.eq(self.late + 1)
-            m.d.sync += loaded[p].eq(0)
-            m.d.comb += [self.jobs.valid.eq(1), job.group.eq(p), job.slot.eq(mine.slot),
-                         job.depth.eq(pdepth), job.pos.eq(pj + 1)]
-            with m.If(pdark | hidden):
-                m.d.sync += [dark[p].eq(0), pos[p].eq(Mux(last, 0, pj + 1))]
-                with m.If(last):
-                    m.d.comb += [frames.advance.valid.eq(1), frames.advance.payload.eq(p),
-                                 job.slot.eq(frames.coming.slot), job.depth.eq(frames.coming.depth), job.pos.eq(0)]
-                    with m.If(pdark & ~follow):
-                        m.d.sync += pending[p].eq(0)
-            with m.Else():
-                m.d.sync += dark[p].eq(1)
-                m.d.comb += job.clear.eq(1)
-            # frame boundaries: sync out, the frame counter
-            with m.If((p == 0) & ~pdark & (pj == 0)):
-                m.d.comb += [self.frame_start.eq(1), self.camera_start.eq(~frames.first.showing.camera_off)]
-                m.d.sync += [self.sync_out.eq(1), self.frames_started.eq(self.frames_started + 1)]
-                with m.If(frames.first.showing.last):
-                    m.d.sync += self.ended.eq(1)
-            with m.If((p == self.n_groups - 1) & pdark & last & ~follow):
-                m.d.sync += self.sync_out.eq(0)
-
-        # ---- commands of the frame control (a retake's frame over a start's) ----
+        # ---- the pulse, applied (a load that ends now first) ----
+        ev = self.loaded
+        m.d.sync += loaded.eq(loaded | ev)
         every = frames.every
+        m.d.comb += [frames.take.eq(take), times.pulse.eq(decided), times.pulse_any.eq(decided_any),
+                     watch.pulse.eq(decided),
+                     info.changed.eq(decided | Mux(every.valid, (1 << G) - 1, 0)),
+                     self.frame_start.eq(starts), self.camera_start.eq(camera)]
+        for g in range(G):
+            with m.If(decided[g]):
+                m.d.sync += loaded[g].eq(0)
+                with m.If(moves[g]):
+                    m.d.sync += [dark[g].eq(0), pos[g].eq(Mux(info.last[g], 0, pos[g] + 1))]
+                    m.d.comb += frames.advance[g].eq(info.last[g])
+                with m.Else():
+                    m.d.sync += dark[g].eq(1)
+                with m.If(ends_play[g]):
+                    m.d.sync += pending[g].eq(0)
+        m.submodules.started = started = Counter(COUNTER_BITS)
+        m.submodules.late_count = late_count = Counter(COUNTER_BITS)
+        was_late = Signal()                    # (counted a cycle later)
+        m.d.sync += was_late.eq((decided & late_now).any())
+        m.d.comb += [started.inc.eq(starts), self.frames_started.eq(started.count),
+                     late_count.inc.eq(was_late), self.late.eq(late_count.count)]
+        ended = Signal()
+        with m.If(starts):
+            m.d.sync += self.sync_out.eq(1)
+        with m.If((ends_play & last_group).any()):
+            m.d.sync += self.sync_out.eq(0)
+        with m.If(ends_seq):
+            m.d.sync += ended.eq(1)
+
+        # ---- the load job, from the group's new state (and a first plane queued), registered;
+        # the stored plane it reads worked out on the stage after ----
+        job = Signal(load_job(dmd))
+        job_due, job_group, job_formed = Signal(), Signal(gb), Signal()
+        m.d.sync += [job_due.eq(decided_any),
+                     job_group.eq(Cat(Cat(decided[g] for g in range(G) if g >> b & 1).any()
+                                      for b in range(gb))),
+                     job_formed.eq(job_due | self.queue_first.valid)]
+        with m.If(job_due):
+            kept = frames.frame[job_group]
+            m.d.sync += [job.group.eq(job_group), job.slot.eq(kept.slot), job.depth.eq(kept.depth),
+                         job.pos.eq(Array(pos)[job_group]), job.clear.eq(dark.bit_select(job_group, 1))]
+        job_exp = exponent(m, regs, job.pos, job.depth, "job_exp")
+        job_out, job_valid = Signal(load_job(dmd)), Signal()
+        m.d.sync += [job_valid.eq(job_formed), job_out.eq(job), job_out.plane.eq(stored_plane(job.depth, job_exp))]
+        m.d.comb += [self.jobs.valid.eq(job_valid), self.jobs.payload.eq(job_out)]
+
+        # ---- the frame control's events ----
         with m.If(self.start.valid):
             begin = self.start.payload
-            with m.If(begin.take):
-                m.d.comb += self.frames.ready.eq(1)
             m.d.comb += [every.valid.eq(1), every.payload.slot.eq(begin.slot), every.payload.depth.eq(begin.depth),
                          every.payload.showing.eq(begin.showing)]
-            m.d.sync += self.ended.eq(0)
-            for g in range(G):
-                m.d.sync += [pos[g].eq(0), dark[g].eq(0)]
+            m.d.sync += [ended.eq(0), dark.eq(0)] + [pos[g].eq(0) for g in range(G)]
         with m.If(self.queue_first.valid):
-            m.d.comb += [self.jobs.valid.eq(1), job.group.eq(self.queue_first.payload),
-                         job.slot.eq(frames.next.slot), job.depth.eq(frames.next.depth), job.pos.eq(0), job.clear.eq(0)]
+            m.d.sync += [job.group.eq(self.queue_first.payload), job.slot.eq(frames.next.slot),
+                         job.depth.eq(frames.next.depth), job.pos.eq(0), job.clear.eq(0)]
+        abandon = self.retake.valid & self.retake.payload.abandon
         with m.If(self.retake.valid):
             newer = self.retake.payload.newer
             with m.If(newer):
-                m.d.comb += self.frames.ready.eq(1)
-                m.d.sync += self.ended.eq(0)
+                m.d.sync += ended.eq(0)
             m.d.comb += [every.valid.eq(1),
                          every.payload.eq(Mux(newer, frames.offered.as_value(), frames.next.as_value()))]
-            for g in range(G):
-                m.d.sync += loaded[g].eq(0)
-                with m.If(self.retake.payload.abandon):
-                    m.d.sync += [pending[g].eq(0), pos[g].eq(0), dark[g].eq(0)]
-            with m.If(self.retake.payload.abandon):
-                m.d.sync += self.sync_out.eq(0)
-        with m.If(self.trigger.valid):
-            for g in range(G):
-                with m.If(active[g]):
-                    m.d.sync += pending[g].eq(1)
+            m.d.sync += loaded.eq(0)
+            with m.If(abandon):
+                m.d.sync += [pending.eq(0), dark.eq(0), self.sync_out.eq(0)] + [pos[g].eq(0) for g in range(G)]
+        with m.If(self.trigger):
+            m.d.sync += pending.eq(pending | active)
+        m.d.comb += [times.obey.eq(self.trigger), times.abandon.eq(abandon)]
+
+        # ---- as the decisions so far leave them ----
+        m.d.comb += [
+            self.playing.eq((active & pending & ~ends_play).any()),
+            self.ended.eq(ended | ends_seq),
+            self.job_due.eq(job_due | job_formed | job_valid),
+        ]
+        # every group loaded and waiting, registered from this cycle's changes: a trigger or a
+        # retake makes it false; else each group of the mode neither playing nor pulsing now
+        # (a pulse only changes a group that plays) and loaded (or its load ends now)
+        m.d.sync += self.all_ready.eq(~self.trigger & ~self.retake.valid
+                                      & (~active | (~pending & ~decided & (loaded | ev))).all())
+
+        # ---- what the bus may do next cycle (registered) ----
+        # (group by group, each flag one function of its group's registered state)
+        stagger_zero = Signal()
+        m.d.sync += stagger_zero.eq(regs.stagger == 0)
+        first_now = Cat((g == 0) | stagger_zero for g in range(G))
+        armed = active & pending & ~decided & (loaded | ev)
+        ready_now = times.rst_over & info.fresh
+        m.d.sync += [
+            self.due.eq((armed & times.due & ready_now)
+                        | Mux(self.trigger, active & first_now & (loaded | ev) & ready_now, 0)),
+            self.imminent.eq((armed & times.soon).any()),
+            self.imminent_clear.eq((armed & times.soon_clear).any()),
+            # (and none in the cycle a retake is applied: the lead's countdown loads then)
+            self.writable.eq(times.settled & watch.free & ~decided
+                             & Mux(self.lead_over & ~self.retake.valid, (1 << G) - 1, 0)),
+        ]
         return m

@@ -6,7 +6,7 @@ rebuilds the same patterns with :mod:`spec.prng`. A four-bus DMD takes two
 consecutive words per cycle (the same sequence, two steps at a time).
 """
 
-from amaranth import Cat, Module, Mux, Signal
+from amaranth import Cat, Const, Module, Mux, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -15,10 +15,29 @@ from spec.prng import ZERO_SEED
 __all__ = ["Prng"]
 
 
-def _step(state):
-    a = state ^ (state << 13)[:64]
-    b = a ^ (a >> 7)
-    return b ^ (b << 17)[:64]
+def _matrix(steps):
+    """xorshift64's ``steps`` steps as a map over GF(2): per output bit, the input bits whose XOR
+    it is (the step is linear)."""
+    from spec.prng import step
+    columns = []
+    for i in range(64):
+        value = 1 << i
+        for _ in range(steps):
+            value = step(value)
+        columns.append(value)
+    return [[i for i in range(64) if columns[i] >> bit & 1] for bit in range(64)]
+
+
+def _steps(state, steps):
+    """``steps`` xorshift64 steps of ``state``, each output bit one balanced XOR of the input bits
+    it depends on (few LUT levels, where the steps in a row would chain)."""
+    return Cat(_xor([state[i] for i in taps]) for taps in _matrix(steps))
+
+
+def _xor(bits):
+    while len(bits) > 1:
+        bits = [bits[i] ^ bits[i + 1] if i + 1 < len(bits) else bits[i] for i in range(0, len(bits), 2)]
+    return bits[0] if bits else Const(0, 1)
 
 
 class Prng(wiring.Component):
@@ -33,7 +52,8 @@ class Prng(wiring.Component):
     Members
     -------
     seed : In(64)
-        Loaded when ``reseed`` is high (zero is replaced by :data:`prng.ZERO_SEED`).
+        Loaded when ``reseed`` is high (zero is replaced by :data:`prng.ZERO_SEED`), on the
+        cycle after.
     reseed : In(1)
     next : In(1)
         Take ``word`` this cycle; the next word follows on the next cycle.
@@ -49,15 +69,14 @@ class Prng(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         state = Signal(64, init=_const_step(ZERO_SEED))
-        seeded = Mux(self.seed == 0, ZERO_SEED, self.seed)
-        with m.If(self.reseed):
-            m.d.sync += state.eq(_step(seeded))
-        seq = [state]
-        for _ in range(self._words):
-            seq.append(_step(seq[-1]))
+        # the seed, checked for zero, a cycle before its first step
+        seeded, reseeding = Signal(64), Signal()
+        m.d.sync += [seeded.eq(Mux(self.seed == 0, ZERO_SEED, self.seed)), reseeding.eq(self.reseed)]
+        with m.If(reseeding):
+            m.d.sync += state.eq(_steps(seeded, 1))
         with m.Elif(self.next):
-            m.d.sync += state.eq(seq[-1])
-        m.d.comb += self.word.eq(Cat(*seq[:-1]))
+            m.d.sync += state.eq(_steps(state, self._words))
+        m.d.comb += self.word.eq(Cat(*(_steps(state, k) if k else state for k in range(self._words))))
         return m
 
 

@@ -16,7 +16,6 @@ from amaranth.lib.wiring import In, Out
 from ..registers import Registers, ResetMode, Source
 from ..store.layouts import SLOT_BITS, PlaneRequest
 from .layouts import block_bits, load_job, ready_load
-from .timebase import exponent
 
 __all__ = ["Requester"]
 
@@ -78,63 +77,90 @@ class Requester(wiring.Component):
         entry = Signal(load_job(dmd))          # the job being requested
         mask = Signal(dmd.blocks)
         block = Signal(bb + 1)
-        first = Signal(bb)
+        block_row = Signal(11)                 # the first row of ``block``
+        first_row = Signal(11)
+        first_occupied = Signal()
+        occupied = Signal(dmd.blocks)          # each block's bit of the job's plane
+        ahead = Signal(dmd.blocks)             # the mask from ``block`` on
+        at_last = Signal()                     # ``block`` is the job's last block
+        passed = Signal()                      # the last block's request is made (or skipped)
+        last_group = Signal.like(self.n_groups)          # (the registers hold still)
+        m.d.sync += last_group.eq(n_groups - 1)
         last = Signal(bb)
         head = self.jobs.payload
-        m.d.comb += self.occ_slot.eq(head.slot)
         plane = Signal(3)
-        m.d.comb += plane.eq(8 - entry.depth + exponent(m, regs, entry.pos, entry.depth, "req_exp"))
 
-        # the job's group's blocks: all of them in global mode, else 2**size_log2 from
-        # group << size_log2, cut at the last block (the DLP9500's 15 blocks)
-        span_first = Signal(bb)
-        span_last = Signal(bb)
-        g_first = (entry.group << self.size_log2)[:bb + 1]
-        g_end = g_first + (Const(1, 4) << self.size_log2) - 1
+        # the head job's plane, and its group's blocks: all of them in global mode, else
+        # 2**size_log2 from group << size_log2, cut at the last block (the DLP9500's 15 blocks);
+        # registered as the job is taken
+        head_first = Signal(bb)
+        head_last = Signal(bb)
+        g_first = (head.group << self.size_log2)[:bb + 1]
+        g_end = g_first | ((Const(1, 4) << self.size_log2) - 1)
         with m.If(regs.reset_mode == ResetMode.GLOBAL):
-            m.d.comb += [span_first.eq(0), span_last.eq(dmd.blocks - 1)]
+            m.d.comb += [head_first.eq(0), head_last.eq(dmd.blocks - 1)]
         with m.Else():
-            m.d.comb += [span_first.eq(g_first), span_last.eq(Mux(g_end > dmd.blocks - 1, dmd.blocks - 1, g_end))]
+            m.d.comb += [head_first.eq(g_first), head_last.eq(Mux(g_end > dmd.blocks - 1, dmd.blocks - 1, g_end))]
+        span_first, span_last = Signal(bb), Signal(bb)
 
         m.d.comb += [
             self.loads.payload.group.eq(entry.group), self.loads.payload.mask.eq(mask),
-            self.loads.payload.first.eq(first), self.loads.payload.last.eq(last),
+            self.loads.payload.first.eq(span_first), self.loads.payload.last.eq(last),
+            self.loads.payload.first_row.eq(first_row),
+            self.loads.payload.first_occupied.eq(first_occupied),
+            self.loads.payload.single.eq((span_first == last) & (~first_occupied | (rpb == 1))),
             self.requests.payload.slot.eq(entry.slot),
             self.requests.payload.plane.eq(plane),
-            self.requests.payload.first_row.eq(block * rpb),
+            self.requests.payload.first_row.eq(block_row),
             self.requests.payload.row_count.eq(rpb),
         ]
 
         # slots handed back, in order
-        m.submodules.releases = releases = fifo.SyncFIFOBuffered(width=SLOT_BITS, depth=4)
+        # (a release is written the cycle after its job is taken: a job is taken only with room
+        # for it and one more)
+        depth = 4
+        m.submodules.releases = releases = fifo.SyncFIFOBuffered(width=SLOT_BITS, depth=depth)
         wiring.connect(m, releases.r_stream, wiring.flipped(self.release))
         last_slot = Signal(SLOT_BITS)
         seen_slot = Signal()
-        m.d.comb += releases.w_stream.payload.eq(last_slot)
+        releasing, released = Signal(), Signal(SLOT_BITS)
+        room = Signal()
+        m.d.sync += [releasing.eq(0), room.eq(releases.level < depth - 2)]
+        m.d.comb += [releases.w_stream.valid.eq(releasing), releases.w_stream.payload.eq(released)]
 
         with m.FSM(name="requester") as fsm:
             with m.State("IDLE"):
                 # the last group's first load from a new slot: no group reads the old one again
-                leaves = (head.group == n_groups - 1) & ~head.clear & seen_slot & (head.slot != last_slot)
-                m.d.comb += [self.jobs.ready.eq(~leaves | releases.w_stream.ready),
-                             releases.w_stream.valid.eq(self.jobs.valid & leaves)]
+                leaves = (head.group == last_group) & ~head.clear & seen_slot & (head.slot != last_slot)
+                m.d.comb += self.jobs.ready.eq(room & ~releasing)
+                with m.If(self.jobs.valid & self.jobs.ready & leaves):
+                    m.d.sync += [releasing.eq(1), released.eq(last_slot)]
                 # flushing: stale jobs are dropped here, through the same slot accounting
                 with m.If(self.jobs.valid & self.jobs.ready):
-                    m.d.sync += entry.eq(head)
-                    with m.If((head.group == n_groups - 1) & ~head.clear):
+                    m.d.sync += [entry.eq(head), span_first.eq(head_first), span_last.eq(head_last),
+                                 plane.eq(head.plane)]
+                    with m.If((head.group == last_group) & ~head.clear):
                         m.d.sync += [last_slot.eq(head.slot), seen_slot.eq(1)]
                     with m.If(~flushing):
                         m.next = "LOOK"
             with m.State("LOOK"):
+                # the slot's occupancy is answered now: each block's bit of the job's plane
+                m.d.sync += occupied.eq(Cat(use_prng | self.occupancy[b].bit_select(plane, 1)
+                                            for b in range(dmd.blocks)))
+                m.next = "MASK"
+                with m.If(flushing):
+                    m.next = "IDLE"
+            with m.State("MASK"):
                 # (comparisons that cannot fail are left out: Verilator rejects them)
                 def in_span(b):
                     after_first = (span_first <= b) if b < (1 << bb) - 1 else 1
                     before_last = (span_last >= b) if b else 1
                     return after_first & before_last
-                looked = Cat(
-                    in_span(b) & ~entry.clear & (use_prng | self.occupancy[b].bit_select(plane, 1))
-                    for b in range(dmd.blocks))
-                m.d.sync += [mask.eq(looked), block.eq(span_first), first.eq(span_first), last.eq(span_last)]
+                looked = Cat(in_span(b) & ~entry.clear & occupied[b] for b in range(dmd.blocks))
+                m.d.sync += [mask.eq(looked), block.eq(span_first), last.eq(span_last),
+                             first_row.eq(span_first * rpb), block_row.eq(span_first * rpb),
+                             first_occupied.eq(~entry.clear & occupied.bit_select(span_first, 1)),
+                             at_last.eq(span_first == span_last), passed.eq(0)]
                 m.next = "PUSH"
                 with m.If(flushing):
                     m.next = "IDLE"
@@ -145,20 +171,28 @@ class Requester(wiring.Component):
                     m.next = "IDLE"
                 with m.Else():
                     m.d.comb += self.loads.valid.eq(1)
+                    # the requests to come: the mask from the first block on
+                    m.d.sync += ahead.eq(mask >> span_first)
                     with m.If(self.loads.ready):
                         m.next = "REQUEST"
             with m.State("REQUEST"):
-                wanted = mask.bit_select(block, 1) & ~use_prng
+                wanted = ahead[0] & ~use_prng
+
+                def next_block():
+                    m.d.sync += [block.eq(block + 1), block_row.eq(block_row + rpb), ahead.eq(ahead >> 1),
+                                 at_last.eq(block + 1 == last), passed.eq(at_last)]
                 # flushing: a request offered is held until taken (its words are discarded)
-                with m.If((block > last) | (flushing & ~wanted)):
+                with m.If(passed | (flushing & ~wanted)):
                     m.next = "IDLE"
+                    m.d.sync += passed.eq(0)
                 with m.Elif(wanted):
                     m.d.comb += self.requests.valid.eq(1)
                     with m.If(self.requests.ready):
-                        m.d.sync += block.eq(block + 1)
+                        next_block()
                         with m.If(flushing):
                             m.next = "IDLE"
                 with m.Else():
-                    m.d.sync += block.eq(block + 1)
-        m.d.comb += self.idle.eq(fsm.ongoing("IDLE"))
+                    next_block()
+        # the occupancy of the head job's slot, answered the cycle after it is taken (in LOOK)
+        m.d.comb += [self.idle.eq(fsm.ongoing("IDLE")), self.occ_slot.eq(head.slot)]
         return m

@@ -6,13 +6,15 @@ starts a row only when a whole row is buffered. With the pattern source
 (:attr:`~spec.registers.Source.PRNG`) beats come from :class:`~gateware.dlpc410.prng.Prng` and
 need no memory bandwidth.
 
-The row source also counts the words asked of the store and not yet taken: when the frame
-control flushes stale loads, those still owed are discarded as they arrive.
+The row source also counts the words asked of the store and not yet taken (in rows, and the
+beats of the row being taken): when the frame control flushes stale loads, those still owed are
+discarded as they arrive.
 """
 
 from amaranth import Array, Cat, Module, Mux, Signal
 from amaranth.lib import fifo, stream, wiring
 from amaranth.lib.wiring import In, Out
+from amaranth.utils import ceil_log2
 
 from spec.schedule import WORD_FIFO_ROWS, row_cycles
 
@@ -42,9 +44,11 @@ class RowSource(wiring.Component):
     beats : Out(stream.Signature(bits_per_dclk * beats))
         One cycle's beats of a row; the bus takes one a cycle through a row.
     row_ready : Out(1)
-        A whole row is there (always, from the pattern source).
-    owed : Out(range(...))
-        Words asked of the store and not yet taken.
+        A whole row is there for the bus's next decision (always, from the pattern source):
+        registered, so counted without the beats taken on the cycle before or still owed to the
+        row under way.
+    drained : Out(1)
+        No word asked of the store is still to be taken (registered: as of the cycle before).
     seed, reseed : In(64), In(1)
         Seed of the pattern source.
     """
@@ -60,7 +64,7 @@ class RowSource(wiring.Component):
             "flushing": In(1),
             "beats": Out(stream.Signature(width)),
             "row_ready": Out(1),
-            "owed": Out(range((dmd.blocks + 2) * dmd.words_per_plane + 1)),
+            "drained": Out(1),
             "seed": In(64),
             "reseed": In(1),
         })
@@ -93,14 +97,30 @@ class RowSource(wiring.Component):
                     m.d.sync += held[count].eq(self.words.payload)
 
         out = buffer.r_stream
-        discard = self.flushing & ~self.beats.ready & (self.owed != 0)
+        # owed: rows asked of the store, less the rows taken (``R`` beats take a row), counted
+        # apart (a request's rows, a row) and compared
+        # (both wrap; at most ``rows`` are owed at a time)
+        rows = (dmd.blocks + 2) * dmd.rows_per_block
+        asked, taken_rows = Signal(ceil_log2(rows) + 1), Signal(ceil_log2(rows) + 1)
+        beat = Signal(range(R))
+        taken = out.ready & out.valid & ~use_prng
+        discard = self.flushing & ~self.beats.ready & ~self.drained
         m.d.comb += [
             self.beats.valid.eq(use_prng | out.valid),
             self.beats.payload.eq(Mux(use_prng, prng.word, out.payload)),
             out.ready.eq(self.beats.ready & ~use_prng | discard),
             prng.next.eq(self.beats.ready & use_prng),
-            self.row_ready.eq(use_prng | (buffer.level >= R)),
         ]
-        asked = Mux(self.asked, dmd.rows_per_block * dmd.words_per_row, 0)
-        m.d.sync += self.owed.eq(self.owed + asked - Mux(out.ready & out.valid, wpc, 0))
+        # a whole row for the next decision (made next cycle, on what is registered now): beyond
+        # the beats taken now and those of the row under way (every row decided before has begun)
+        beat_next = Mux(taken, Mux(beat == R - 1, 0, beat + 1), beat)
+        under_way = Mux(beat_next == 0, 0, R - beat_next)
+        m.d.sync += [self.row_ready.eq(use_prng | (buffer.level >= R + taken + under_way)),
+                     self.drained.eq((asked == taken_rows) & (beat == 0))]
+        with m.If(self.asked):
+            m.d.sync += asked.eq(asked + dmd.rows_per_block)
+        with m.If(taken):
+            m.d.sync += beat.eq(Mux(beat == R - 1, 0, beat + 1))
+            with m.If(beat == R - 1):
+                m.d.sync += taken_rows.eq(taken_rows + 1)
         return m

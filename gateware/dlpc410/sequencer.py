@@ -20,10 +20,11 @@ Its parts, joined by streams::
 * :class:`~.camera.CameraTrigger`, :class:`~.init.Init`, :class:`~.trigger.Trigger`.
 """
 
-from amaranth import Module, Mux, Signal
+from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
+from ..counter import Counter
 from ..queue import Queue
 from ..registers import Registers, ResetMode
 from ..store.layouts import SLOT_BITS, FrameInfo, PlaneRequest
@@ -164,9 +165,8 @@ class Sequencer(wiring.Component):
         ]
 
         # ---- the time base, and the groups of the reset mode ----
-        now = self.status.now
-        with m.If(init.running):
-            m.d.sync += now.eq(now + 1)
+        m.submodules.time_base = time_base = Counter(len(self.status.now))
+        m.d.comb += [time_base.inc.eq(init.running), self.status.now.eq(time_base.count)]
         n_groups = Signal(range(G + 1))
         size_log2 = Signal(3)
         with m.Switch(regs.reset_mode):
@@ -178,28 +178,33 @@ class Sequencer(wiring.Component):
                 m.d.comb += [n_groups.eq((G + 1) // 2), size_log2.eq(1)]
             with m.Case(ResetMode.SINGLE):
                 m.d.comb += n_groups.eq(G)
+        # (registered: the registers hold still while anything reads it)
+        active = Signal(G)
+        m.d.sync += active.eq(Cat(g < n_groups for g in range(G)))
         for part in (planner, control, requester, source, bus, camera, period_watch):
             m.d.comb += part.regs.eq(regs)
-        for part in (planner, control, bus, camera):
-            m.d.comb += part.now.eq(now)
-        for part in (planner, control, requester):
+        for part in (control, requester):
             m.d.comb += part.n_groups.eq(n_groups)
 
-        # ---- frames and the planner's commands ----
+        # ---- frames, the planner and the frame control ----
         wiring.connect(m, wiring.flipped(self.frames), planner.frames)
         m.d.comb += [
+            planner.active.eq(active),
             planner.rst_active.eq(init.rst_active_synced),
+            control.all_ready.eq(planner.all_ready),
+            control.counting.eq(init.running),
             control.initialised.eq(init.running & ~self.store_lost),
             control.strobe.eq(trig.strobe),
             control.reload.eq(self.reload),
             self.at_rest.eq(control.at_rest),
             self.ready.eq(control.ready),
             control.offer.eq(planner.offer),
-            control.all_ready.eq(planner.all_ready),
             control.playing.eq(planner.playing),
             control.ended.eq(planner.ended),
+            planner.trigger.eq(control.trigger),
+            planner.lead_over.eq(control.lead_over),
         ]
-        for name in ("start", "retake", "trigger", "queue_first"):
+        for name in ("start", "retake", "queue_first"):
             wiring.connect(m, getattr(control, name), getattr(planner, name))
 
         # ---- load jobs -> requester -> ready loads; row data ----
@@ -217,22 +222,25 @@ class Sequencer(wiring.Component):
             source.asked.eq(self.requests.valid & self.requests.ready),
             source.flushing.eq(control.flushing),
             source.seed.eq(self.seed), source.reseed.eq(self.reseed),
-            control.drained.eq(requester.idle & ~jobs.r_stream.valid & ~loads.r_stream.valid
-                               & (source.owed == 0)),
         ]
+        # (registered: the frame control's flush and restart wait on it)
+        m.d.sync += control.drained.eq(requester.idle & ~planner.job_due & (jobs.level == 0) & (loads.level == 0)
+                                       & source.drained)
 
         # ---- the bus ----
         wiring.connect(m, loads.r_stream, bus.loads)
         wiring.connect(m, source.beats, bus.beats)
         m.d.comb += [
+            bus.even.eq(~time_base.count[0]),
             bus.row_ready.eq(source.row_ready),
             bus.running.eq(control.running), bus.flushing.eq(control.flushing),
-            bus.restart.eq(control.retake.valid),
+            bus.hold.eq(control.retake.valid), bus.restart.eq(control.retake.valid),
+            bus.rst_active.eq(init.rst_active_synced),
             bus.due.eq(planner.due), bus.writable.eq(planner.writable),
             bus.imminent.eq(planner.imminent), bus.imminent_clear.eq(planner.imminent_clear),
+            planner.choice.eq(bus.choice), planner.pulsing.eq(bus.pulsing),
         ]
-        wiring.connect(m, bus.pulse, planner.pulse)
-        wiring.connect(m, bus.loaded, planner.loaded)
+        m.d.comb += planner.loaded.eq(bus.loaded)
 
         # ---- outputs and counters ----
         m.d.comb += [

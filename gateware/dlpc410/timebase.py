@@ -1,19 +1,24 @@
-"""Cycle arithmetic the sequencer's parts share: the time base and the plane order.
+"""The plane order, in the arithmetic the sequencer's parts share.
 
-Times are cycles of the free-running ``now`` counter (:data:`gateware.registers.TIME_BITS`
-wide); comparisons are made on differences, so the base may wrap.
+A frame of ``depth`` planes shows its planes in the order of the registers: the exponent of the
+plane at display position ``j`` (the plane of weight ``2**e``), and the stored plane it reads
+(planes ``8 - depth .. 7`` of a slot, most significant last). Both are small tables of
+``depth`` and ``j``, written as lookups, not sums, so no carry chain is made for them.
 """
 
-from amaranth import Signal
+from amaranth import Array, Signal
 
-from ..registers import TIME_BITS, PlaneOrder
+from ..registers import PlaneOrder
 
-__all__ = ["diff", "exponent"]
+__all__ = ["exponent", "stored_plane"]
 
 
-def diff(a, b):
-    """``a - b`` as a signed time difference (the time base may wrap)."""
-    return (a - b)[:TIME_BITS].as_signed()
+def _table(function):
+    """``function(depth, j)`` as a lookup on ``depth`` (0..15) and ``j`` (0..7), 3-bit results."""
+    return Array(Array(function(depth, j) & 7 for j in range(8)) for depth in range(16))
+
+
+_MSB_FIRST = _table(lambda depth, j: depth - 1 - j)
 
 
 def exponent(m, regs, j, depth, name):
@@ -22,9 +27,17 @@ def exponent(m, regs, j, depth, name):
     e = Signal(3, name=name)
     with m.Switch(regs.order):
         with m.Case(PlaneOrder.MSB_FIRST):
-            m.d.comb += e.eq(depth - 1 - j)
+            m.d.comb += e.eq(_MSB_FIRST[depth][j])
         with m.Case(PlaneOrder.LSB_FIRST):
             m.d.comb += e.eq(j)
         with m.Default():
             m.d.comb += e.eq(regs.order_table[j])
     return e
+
+
+_STORED = _table(lambda depth, e: 8 - depth + e)
+
+
+def stored_plane(depth, e):
+    """The stored plane (0..7) of exponent ``e`` in a frame of ``depth`` planes: ``8 - depth + e``."""
+    return _STORED[depth][e]

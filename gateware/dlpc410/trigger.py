@@ -4,7 +4,8 @@ The TTL trigger and the sync input are asynchronous: each goes through a
 :class:`amaranth.lib.cdc.FFSynchronizer`. On Spartan-6 the platform layer places the
 synchroniser's first flip-flop in the input pad's IOB register (``IOB = TRUE`` on the pin's
 input flip-flop in the UCF) so that the pad-to-register delay is fixed; this module stays free
-of vendor primitives. A rising edge of the selected source gives one strobe.
+of vendor primitives. A rising edge of the selected source gives one strobe. The periodic timer
+is a countdown (:mod:`gateware.countdown`), reloaded with the period at each strobe.
 """
 
 from amaranth import Module, Signal
@@ -12,6 +13,7 @@ from amaranth.lib import wiring
 from amaranth.lib.cdc import FFSynchronizer
 from amaranth.lib.wiring import In, Out
 
+from ..countdown import Countdown
 from ..registers import DURATION_BITS, TriggerMode
 
 __all__ = ["Trigger", "PIN_TO_STROBE", "SYNC_STAGES"]
@@ -29,7 +31,9 @@ class Trigger(wiring.Component):
     -------
     mode : In(TriggerMode)
     period : In(DURATION_BITS)
-        Strobe period in :attr:`TriggerMode.PERIODIC` (counted from when ``run`` rose).
+        Strobe period in :attr:`TriggerMode.PERIODIC`: the first strobe ``period - 1`` cycles
+        after ``run`` rose, then one every ``period`` cycles (a new period takes effect from the
+        next strobe).
     run : In(1)
         The periodic timer runs while high.
     pin : In(1)
@@ -59,13 +63,11 @@ class Trigger(wiring.Component):
             m.d.sync += last.eq(synced)
             edges[name] = synced & ~last
 
-        count = Signal(DURATION_BITS)
-        tick = Signal()
-        with m.If(~self.run | tick):
-            m.d.sync += count.eq(0)
-        with m.Else():
-            m.d.sync += count.eq(count + 1)
-        m.d.comb += tick.eq(self.run & (count == self.period - 1))
+        # the period counted from the cycle before the timer runs (its first strobe is the
+        # period's last cycle), and again from each strobe
+        m.submodules.timer = timer = Countdown(DURATION_BITS, flags="settled")
+        tick = self.run & timer.ends
+        m.d.comb += [timer.load.eq(~self.run | tick), timer.value.eq(self.period)]
 
         with m.Switch(self.mode):
             with m.Case(TriggerMode.EXTERNAL):

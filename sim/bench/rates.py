@@ -60,9 +60,9 @@ def measured_rate(dmd_name, mode, strict, dclk, reading="ti", *, frames=FRAMES, 
     cycles = first + (frames + 1) * plan.frame_cycles
     run = run_rig(dmd, p, [(0, 8)], pins=pins, cycles=cycles, store_words=words,
                   name=name or f"rates_{dmd_name}_{mode.lower()}_{int(dclk / 1e6)}")
-    # group 0's first pulse of each frame: the camera trigger rises ``camera_offset + 1`` after
-    # it (sync out may stay high across back-to-back phased frames)
-    frame_starts = [t - 1 - p.camera_offset for t, level in run.camera_out if level]
+    # group 0's first pulse of each frame: the camera trigger rises ``camera_offset`` after its
+    # command on the pins (sync out may stay high across back-to-back phased frames)
+    frame_starts = [t - schedule.DECISION_TO_PINS - p.camera_offset for t, level in run.camera_out if level]
     assert len(frame_starts) >= frames, f"{len(frame_starts)} frames played"
     period = _median_period(frame_starts)
     _same_as_model(dmd, p, [schedule.Frame(0, 8)], pins, cycles, run, f"{dmd_name} {mode}")

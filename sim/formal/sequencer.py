@@ -42,6 +42,7 @@ from amaranth import Cat, Mux, Signal
 from amaranth.hdl import Assert, Assume, Fragment
 
 from spec.facts import TEST_DMD
+from spec.schedule import DECISION_TO_PINS
 
 from .harness import Check, FormalTop
 
@@ -211,12 +212,15 @@ def _settle_rule(m, regs, rst, pulse, write, extra, name):
 
 def _settle_after_pulse(pulse, dmd, modes, extra, strict):
     """The settle rule of every block, under the reset ``modes`` (see :func:`_settle_environment`);
-    ``pulse``: the bus decides a pulse (on the pins the next cycle)."""
+    ``pulse``: the bus decides a pulse (on the pins ``DECISION_TO_PINS`` cycles later)."""
     def prop(m, top):
         pins, regs = top.dut.pins, top.dut.regs
         _settle_environment(m, regs, modes, strict)
-        on_pins = Signal()
-        m.d.sync += on_pins.eq(pulse)
+        on_pins = pulse
+        for k in range(DECISION_TO_PINS):
+            later = Signal(name=f"pulse_{k + 1}")
+            m.d.sync += later.eq(on_pins)
+            on_pins = later
         for b, (pulsed, written) in enumerate(zip(_pulsed_blocks(pins, dmd.blocks), _written_blocks(pins, dmd),
                                                   strict=True)):
             _settle_rule(m, regs, pins.rst_active, on_pins & pulsed, written, extra, f"block{b}")
@@ -264,16 +268,16 @@ def _sequencer_top(prop, watch=None, *, init_to_dvalid=None, dmd=DMD):
     member ``member`` of its part ``part`` for ``watch = (part, member)`` (:func:`_watched`);
     ``init_to_dvalid``: a shorter wait before the first load than the facts' 64 clocks, so that a
     bounded check reaches a pulse within a few tens of steps (15 with 2)."""
-    from gateware.dlpc410 import group_times
+    from gateware.dlpc410 import control
     from gateware.dlpc410.sequencer import Sequencer
     watched = Signal()
-    original = group_times.INIT_TO_DVALID
-    group_times.INIT_TO_DVALID = original if init_to_dvalid is None else init_to_dvalid
+    original = control.INIT_TO_DVALID
+    control.INIT_TO_DVALID = original if init_to_dvalid is None else init_to_dvalid
     try:
         with _watched(*watch, watched) if watch else nullcontext():
             return Fragment.get(FormalTop(Sequencer(dmd, beats=1, store_words=1), [prop(watched)]), None)
     finally:
-        group_times.INIT_TO_DVALID = original
+        control.INIT_TO_DVALID = original
 
 
 def _init_top():
@@ -283,7 +287,7 @@ def _init_top():
 def rst_top(latency=2, init_to_dvalid=None):
     """The RST_ACTIVE property's top; ``latency``: cycles from the pins to the decision it allows
     (the synchroniser's two; one is too few, and the check must then fail)."""
-    return _sequencer_top(lambda pulse: _no_pulse_while_rst_active(pulse, latency), ("Bus", "pulse.valid"),
+    return _sequencer_top(lambda pulse: _no_pulse_while_rst_active(pulse, latency), ("Bus", "pulsing"),
                           init_to_dvalid=init_to_dvalid)
 
 
@@ -293,7 +297,7 @@ def settle_top(init_to_dvalid=2, extra=0):
     ``t_rst + t_settle``)."""
     from gateware.registers import ResetMode
     return _sequencer_top(lambda pulse: _settle_after_pulse(pulse, DMD, [ResetMode.GLOBAL], extra, strict=False),
-                          ("Bus", "pulse.valid"), init_to_dvalid=init_to_dvalid)
+                          ("Bus", "pulsing"), init_to_dvalid=init_to_dvalid)
 
 
 def phased_settle_top(modes=("QUAD", "DUAL", "SINGLE"), init_to_dvalid=2, extra=0, strict=True, dmd=DMD4):
@@ -303,7 +307,7 @@ def phased_settle_top(modes=("QUAD", "DUAL", "SINGLE"), init_to_dvalid=2, extra=
     from gateware.registers import ResetMode
     modes = [ResetMode[mode] for mode in modes]
     return _sequencer_top(lambda pulse: _settle_after_pulse(pulse, dmd, modes, extra, strict),
-                          ("Bus", "pulse.valid"), init_to_dvalid=init_to_dvalid, dmd=dmd)
+                          ("Bus", "pulsing"), init_to_dvalid=init_to_dvalid, dmd=dmd)
 
 
 def clear_top(dmd=DMD, extra=0, init_to_dvalid=2):
@@ -317,9 +321,9 @@ def sequencer_checks():
             Check("no clocking pulse while RST_ACTIVE is high", "Sequencer", rst_top, depth=12, induction=4,
                   quick=4),
             Check("no load within the settle time after a pulse and after RST_ACTIVE fell", "Sequencer",
-                  settle_top, depth=36, quick=28),
+                  settle_top, depth=40, quick=32),
             Check("no load of a pulsed group within its settle time, phased modes", "Sequencer",
-                  phased_settle_top, depth=36, quick=24),
+                  phased_settle_top, depth=40, quick=24),
             Check("no clear overlapping a row load", "Sequencer", clear_top, depth=24, induction=4, quick=4),
             Check("no clear overlapping a row load, 1080p clear", "Sequencer",
                   lambda: clear_top(DMD_1080P_CLEAR), depth=24, induction=6, quick=4)]

@@ -8,8 +8,9 @@ time are the plan's ``t_rst_s`` and ``t_settle_s`` (the facts, or the scaled-dow
 test), so the sequencer's parameters are checked against the times they were planned for.
 
 The model's command log, moved to the sequencer's time base (``status.now``; a command's cycle
-is its decision cycle, one before the pins show it), is what the tests compare with the schedule
-model; the model's mirror history feeds the camera model (:func:`frame_lights`).
+is its decision cycle, :data:`~spec.schedule.DECISION_TO_PINS` before the pins show it), is what
+the tests compare with the schedule model; the model's mirror history feeds the camera model
+(:func:`frame_lights`).
 """
 
 from dataclasses import dataclass, field
@@ -22,7 +23,7 @@ from sim.harness.amaranth_sim import simulate
 from sim.models.camera import Camera
 from sim.models.dlpc410 import Dlpc410, amaranth_process
 from sim.tb.plane_source import SequencerBench
-from spec.schedule import FABRIC_HZ, RST_MARGIN
+from spec.schedule import DECISION_TO_PINS, FABRIC_HZ, RST_MARGIN
 
 __all__ = ["Run", "run_bench", "dlpc410_for", "frame_lights", "INIT_CYCLES", "INIT_GRACE",
            "CAMERA_RAMP", "CAMERA_DELAY"]
@@ -134,5 +135,5 @@ def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, nam
 
     process = amaranth_process(model, dut.pins)
     simulate(dut, [bench], name=name, clocks={"sync": 200e6}, processes=[process])
-    run.commands = model.commands(run.shift - 1)
+    run.commands = model.commands(run.shift - DECISION_TO_PINS)
     return run
