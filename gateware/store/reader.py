@@ -298,10 +298,11 @@ class Reader(wiring.Component):
                 m.d.sync += [run_source.eq(row_source), run_off.eq(row_off), run_words.eq(row_words),
                              run_single.eq(row_words <= mcb.MAX_BURST)]
 
-        # answering with zeros from the loss until nothing is owed between requests, none taken
+        # answering with zeros from the loss until the store has recovered and nothing is owed,
+        # between requests (one taken in that very cycle is taken after the recovery: it is read)
         with m.If(lost):
             m.d.sync += zero.eq(1)
-        with m.Elif(idle & ~self.requests.valid & ~issuing & (owed == 0)):
+        with m.Elif(idle & ~issuing & (owed == 0)):
             m.d.sync += zero.eq(0)
         if self._domain != "sync":
             return DomainRenamer({"sync": self._domain})(m)
