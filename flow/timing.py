@@ -38,6 +38,13 @@ _LUTRAM_READS = {
     **{kind: {"SPO": "A", "DPO": "DPRA"} for kind in ("RAM32X1D", "RAM64X1D", "RAM128X1D")},
     **{kind: {"O": "A"} for kind in ("RAM32X1S", "RAM64X1S", "RAM128X1S")},
 }
+#: LUT-RAM read addresses that are not its write address too: a path through one goes on through
+#: the read (and is counted where it ends) and does not end at the LUT-RAM, whose write clock may
+#: be another domain's.
+_LUTRAM_READ_ONLY = {
+    **{kind: {"ADDRA", "ADDRB", "ADDRC"} for kind in ("RAM32M", "RAM64M")},
+    **{kind: {"DPRA"} for kind in ("RAM32X1D", "RAM64X1D", "RAM128X1D")},
+}
 _FREE = {"MUXF7", "MUXF8", "BUFG", "BUF", "IBUF", "OBUF", "VCC", "GND"}
 #: Cells whose outputs are registered: a path ends at their inputs and starts at their outputs.
 _SEQUENTIAL_PREFIXES = ("FD", "LD", "RAMB", "SRL", "DSP48A1_REGISTERED")
@@ -186,16 +193,18 @@ def analyse(module, *, keep=5):
     domains = {}
     for cname, cell in cells.items():
         # a path ends at a flip-flop, block RAM, DSP or shift register input, and at a LUT-RAM's
-        # write side (its read addresses too: those paths go on through the read, and are
-        # counted there as well)
+        # write side (its read-only addresses not: those paths go on through the read)
         if not (_sequential(cell["type"]) or cell["type"] in _LUTRAM_READS):
             continue
+        read_only = _LUTRAM_READ_ONLY.get(cell["type"], set())
         clocks = [cell["connections"][p][0] for p in _CLOCK_PINS if p in cell["connections"]]
         domain = names.get(clocks[0], "?") if clocks else "?"
         entry = domains.setdefault(domain, {"lut_levels_max": 0, "carry_max": 0, "carry_chains_max": 0,
                                             "paths": []})
         end = names.get(cell["connections"].get("Q", [None])[0], cname)
-        for _pin, bit in inputs(cell):
+        for pin, bit in inputs(cell):
+            if pin.rstrip("0123456789") in read_only:
+                continue
             d = of(bit)
             entry["lut_levels_max"] = max(entry["lut_levels_max"], d.luts)
             entry["carry_max"] = max(entry["carry_max"], d.carry)

@@ -64,8 +64,13 @@ class FrameBroker(wiring.Component):
         cache = Array(Array(Signal(8, name=f"occ_s{s}_b{b}") for b in range(blocks))
                       for s in range(self._slots))
         info = Signal(FrameInfo)
-        block = Signal(range(blocks + 1))
+        block = Signal(range(blocks + 1))      # the block asked for
+        # the block whose planes come back this cycle (one-hot, registered: each cache byte's
+        # write enable is a small AND of flip-flops)
+        answered = Signal(blocks)
+        answering = Signal()
 
+        m.d.sync += [answering.eq(0), answered.eq(0)]
         with m.FSM():
             with m.State("ASK"):
                 m.d.comb += self.ask.valid.eq(1)
@@ -77,18 +82,22 @@ class FrameBroker(wiring.Component):
                     m.d.sync += [info.eq(self.offered.payload), block.eq(0)]
                     m.next = "SCAN"
             with m.State("SCAN"):
-                # Block b is asked for on one cycle and its planes read on the next.
+                # Block b is asked for on one cycle and its planes written on the next.
                 m.d.comb += [self.store_occupancy.slot.eq(info.slot), self.store_occupancy.block.eq(block)]
                 m.d.sync += block.eq(block + 1)
-                with m.If(block != 0):
-                    m.d.sync += cache[info.slot][block - 1].eq(self.store_occupancy.planes)
                 with m.If(block == blocks):
                     m.next = "OFFER"
+                with m.Else():
+                    m.d.sync += [answering.eq(1), answered.eq(1 << block)]
             with m.State("OFFER"):
                 m.d.comb += [self.frames.valid.eq(1), self.frames.payload.eq(info)]
                 with m.If(self.frames.ready):
                     m.next = "ASK"
 
+        for s in range(self._slots):
+            for b in range(blocks):
+                with m.If(answering & (info.slot == s) & answered[b]):
+                    m.d.sync += cache[s][b].eq(self.store_occupancy.planes)
         with m.If(self.store_lost):
             # written last, so this wins over a scan under way
             m.d.sync += [cache[s][b].eq(0) for s in range(self._slots) for b in range(blocks)]

@@ -11,33 +11,70 @@ first in its low bits, and the reader hands it on as it is, so that a sequencer 
 a transfer gets them as fast as the memory gives them. The words go through a FIFO to the
 sequencer, in order, requests one after another.
 
-Look-ahead: the reader keeps issuing commands, across request boundaries, as long as the words
-it has asked for and not yet handed on fit in its FIFO (``fifo_depth`` plane words, several
-commands outstanding), so the memory's latency is hidden and a port word per ``dmd`` cycle
-leaves whenever the memory delivers that fast. Because those words always have room, the reader
-takes every word from the MCB's read FIFO as soon as it is there: that FIFO never overflows.
+Look-ahead: the reader keeps issuing commands, across request boundaries, as long as a whole
+burst fits in its FIFO beside the words it has asked for and not yet handed on (``fifo_depth``
+plane words, several commands outstanding), so the memory's latency is hidden and a port word
+per ``dmd`` cycle leaves whenever the memory delivers that fast. Because those words always have
+room, the reader takes every word from the MCB's read FIFO as soon as it is there: that FIFO
+never overflows.
 
 A request that does not fit the frame (slot beyond the slots, no rows, rows past the last) is
 dropped and counted; it produces no words.
 
 A lost memory (``store_lost``, from :mod:`gateware.store.recovery`): the MCB has dropped the
-commands and words in flight, so the reader forgets them too (nothing reserved, nothing taken
-from the port) and answers every word still owed beyond those it holds, and every request taken
-until the store has recovered, with zeros; the sequencer is never left waiting for words that
-will not come.
+commands and words in flight, so the reader puts a zero word in its FIFO for each word it had
+asked for and not received, and answers the rest of its requests, and every request taken until
+the store has recovered, with zeros (its commands go to no memory); the sequencer is never left
+waiting for words that will not come, and gets the words read before the loss first.
+
+Pipeline (every path between flip-flops within the ``dmd`` budget of :mod:`flow.timing`): a
+request is taken into registers (``IDLE``), its first row looked up and its sums formed
+(``CHECK``), then checked and gathered into runs (``GATHER``); a run's address is its slot and
+plane's start (a small table) plus its rows' offset, and its bursts are counted down in
+registers; the counts of words asked for and owed step by a burst and a word in one carry chain
+each. A request's first command leaves three cycles after it is taken (``valid`` and ``ready``
+both high), and a word from the memory reaches ``planes`` three cycles after the MCB offers it.
 """
 
-from amaranth import DomainRenamer, Module, Mux, Signal
-from amaranth.lib import stream, wiring
-from amaranth.lib.fifo import SyncFIFOBuffered
-from amaranth.lib.wiring import In, Out
+import math
 
+from amaranth import Cat, Const, DomainRenamer, Module, Mux, Signal
+from amaranth.lib import stream, wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
+from amaranth.utils import ceil_log2, exact_log2
+
+from ..counter import Counter
 from . import mcb
-from .addresses import WORD_BYTES, AddressMap
+from .addresses import PLANES, AddressMap
 from .layouts import SLOT_BITS, PlaneRequest
+from .read_fifo import ReadFifo
 from .slot_maps import RowLookupSignature
 
 __all__ = ["Reader"]
+
+
+def _times(value, factor):
+    """``value * factor`` as shifts of ``value``, at most two of them added or subtracted: one
+    carry chain at most, never a multiplier (``factor``: a row's port words)."""
+    terms, shift = [], 0
+    while factor:
+        if factor & 1:
+            digit = 2 - (factor & 3)           # the non-adjacent form: +1 or -1
+            terms.append((digit, value << shift))
+            factor -= digit
+        factor >>= 1
+        shift += 1
+    assert 1 <= len(terms) <= 2, "a row's port words: a power of two, or the sum or difference of two"
+    terms.sort(key=lambda term: -term[0])      # the positive term first
+    result = terms[0][1]
+    for digit, term in terms[1:]:
+        result = result + term if digit > 0 else result - term
+    return result
+
+
+def _trailing_zeros(n):
+    return (n & -n).bit_length() - 1
 
 
 class Reader(wiring.Component):
@@ -49,8 +86,8 @@ class Reader(wiring.Component):
     slots : int
         Frame slots in the memory (the address map).
     fifo_depth : int
-        Plane words of look-ahead and buffering (a multiple of 64 port words; 256 = four
-        commands of a 64-bit port, or two of a 128-bit port, in flight).
+        Plane words of look-ahead and buffering (a power of two, a multiple of 64 port words;
+        256 = four commands of a 64-bit port, or two of a 128-bit port, in flight).
     domain : str
         Clock domain of the reader and of its MCB port.
     width : int
@@ -69,7 +106,7 @@ class Reader(wiring.Component):
         Requests dropped because they do not fit the frame.
     store_lost : In(1)
         The store has lost its contents and not recovered yet (answer with zeros).
-    sources : Out(RowLookupSignature(dmd))
+    sources : Out(RowLookupSignature(dmd, "source"))
         The row map: which slot each row of a slot shows, and whether the slot holds a delta.
     """
 
@@ -87,127 +124,186 @@ class Reader(wiring.Component):
             "mcb": Out(mcb.PortSignature(width)),
             "bad_requests": Out(16),
             "store_lost": In(1),
-            "sources": Out(RowLookupSignature(dmd)),
+            "sources": Out(RowLookupSignature(dmd, "source")),
         })
 
     def elaborate(self, platform):
         m = Module()
-        dmd, port = self._dmd, self.mcb
-        words = self._width // 64
-        depth = self._fifo_depth // words        # port words
-        port_words_per_row = dmd.words_per_row // words
+        dmd, port, src = self._dmd, self.mcb, self.sources
+        word_bytes = port.signature.word_bytes
+        depth = self._fifo_depth * 64 // self._width           # port words
+        row_words = dmd.words_per_row * 64 // self._width      # port words per row
+        plane_words = dmd.rows * row_words
+        burst_bits = exact_log2(mcb.MAX_BURST)
 
-        # the memory is lost: the words owed are answered as zeros (until none is owed)
+        # Addresses in port words. A run starts at its slot and plane's start (a table) plus its
+        # rows' offset: every start is a multiple of 2**low, so the sum is one short carry chain
+        # above the offset's low bits; a burst of 64 steps the bits above the burst's. (Each
+        # chain is at most 16 bits for every DMD through a 128-bit port, 17 for the DLP9500's
+        # burst step through a 64-bit one.)
+        assert self._map.base % word_bytes == 0
+        starts = [self._map.address(s, p) // word_bytes if s < self._slots else 0
+                  for s in range(1 << SLOT_BITS) for p in range(PLANES)]
+        low = _trailing_zeros(math.gcd(self._map.base // word_bytes, plane_words))
+        address_bits = (self._map.end // word_bytes - 1).bit_length()
+
+        # ---- the words: the memory's (or zeros) through a FIFO to the sequencer ----------------
+        m.submodules.fifo = fifo = ReadFifo(self._width, depth)
+        wiring.connect(m, fifo.r_stream, wiring.flipped(self.planes))
+
         lost = self.store_lost
-        zero = Signal()
-
-        m.submodules.fifo = fifo = SyncFIFOBuffered(width=self._width, depth=depth)
-        owed = Signal(range(depth + dmd.rows * port_words_per_row + 1))     # port words taken, not handed on
-        # the words read before the loss go first (a word offered stays offered), then zeros
-        with m.If(zero & ~fifo.r_stream.valid):
-            m.d.comb += [self.planes.valid.eq(owed != 0), self.planes.payload.eq(0)]
-        with m.Else():
-            wiring.connect(m, fifo.r_stream, wiring.flipped(self.planes))
-
-        address = Signal(30)
-        remaining = Signal(range(dmd.words_per_plane // words + 1))     # port words
-        reserved = Signal(range(depth + 1))      # asked for and not yet handed on
-        burst = Signal(range(mcb.MAX_BURST + 1))
-        m.d.comb += burst.eq(Mux(remaining > mcb.MAX_BURST, mcb.MAX_BURST, remaining))
-
-        request = self.requests.payload
-        issue = Signal()
-        handed = Signal()
-        accepted = Signal()
-        m.d.comb += handed.eq(self.planes.valid & self.planes.ready)
-        m.d.sync += [reserved.eq(reserved + Mux(issue, burst, 0) - handed),
-                     owed.eq(owed + Mux(accepted, request.row_count * port_words_per_row, 0)
-                             - (handed & (owed != 0)))]
-        with m.If(lost | zero):
-            m.d.sync += reserved.eq(0)
-        with m.If(lost):
-            m.d.sync += zero.eq(1)
-        with m.Elif((owed == 0) & ~accepted):
-            m.d.sync += zero.eq(0)
-
-        # every word in the read FIFO has room in ours (reserved covers it): take it at once
-        arriving = fifo.w_stream
+        zero = Signal()                          # lost since, and words still owed
+        fill = lost | zero                       # answer with zeros
+        issue, bl = Signal(), Signal(burst_bits)  # a command (its port words less one) goes
+        arrived = Signal()                       # a word goes into the FIFO
+        handed = Signal()                        # a word went on to the sequencer last cycle
+        # Port words asked for (or answered as zeros) and not yet handed on, and asked for and not
+        # yet in the FIFO. Each steps by bl + 1 at an issue and back by one at an event, as one
+        # sum with the event in its carry: count + (bl, or -1) + (1, or 0).
+        count_bits = depth.bit_length()
+        used, owed = Signal(count_bits), Signal(count_bits)
+        step = Mux(issue, bl, (1 << count_bits) - 1)
+        m.d.sync += [
+            handed.eq(self.planes.valid & self.planes.ready),   # (registered: ``ready`` stops here)
+            used.eq(used + step + ~handed),
+            owed.eq(owed + step + ~arrived),
+        ]
+        # Every word in the read FIFO has room in ours (``used`` covers it): take it at once. Lost,
+        # none come (the MCB dropped them): a zero word is put in for each owed instead, at most
+        # every other cycle, so that whether one is owed is a flag a cycle old (no word came since).
+        owing, came = Signal(), Signal()
+        m.d.sync += [owing.eq(owed != 0), came.eq(arrived)]
         m.d.comb += [
             port.rd_en.eq(port.calib_done & ~port.rd_empty),
-            arriving.valid.eq(port.rd_en & ~lost & ~zero),     # (none come: the MCB dropped them)
-            arriving.payload.eq(port.rd_data),
-            port.cmd_instr.eq(mcb.Instr.READ),
-            port.cmd_bl.eq(burst - 1),
-            port.cmd_byte_addr.eq(address),
-            port.cmd_en.eq(issue),
-            port.wr_en.eq(0),
+            arrived.eq(Mux(fill, owing & ~came, port.rd_en)),
+            fifo.w_stream.valid.eq(arrived),
+            fifo.w_stream.payload.eq(Mux(fill, 0, port.rd_data)),
         ]
 
-        # the run of rows being gathered: rows from one slot, contiguous in memory
-        slot, plane = Signal(SLOT_BITS), Signal(3)
-        row = Signal(range(dmd.rows + 1))        # the row whose lookup is on ``sources`` now
-        left = Signal(range(dmd.rows + 1))       # rows of the request from ``row`` on
-        run_source, run_first = Signal(SLOT_BITS), Signal(range(dmd.rows))
-        run_rows = Signal(range(dmd.rows + 1))
-        src = self.sources
-        m.d.comb += [src.slot.eq(slot), src.row.eq(row)]
+        # ---- the commands: one run of rows at a time, in bursts of up to 64 port words --------
+        issuing = Signal()                       # a run is loaded
+        address = Signal(address_bits)
+        last_bl = Signal(burst_bits)             # the run's last burst, less one
+        before_last = Signal(range(((plane_words - 1) >> burst_bits) + 1))     # bursts before it
+        is_last = Signal()
+        # Room for a burst of any length (the FIFO's word count needs no sum with the burst's), as a
+        # flag a cycle old: it holds while no command went since (``handed`` only makes room), so
+        # a command goes at most every other cycle, and its decision is one LUT of flip-flops.
+        room, issued = Signal(), Signal()
+        m.d.sync += [room.eq(used <= depth - mcb.MAX_BURST), issued.eq(issue)]
+        m.d.comb += [
+            bl.eq(Mux(is_last, last_bl, mcb.MAX_BURST - 1)),
+            issue.eq(issuing & room & ~issued & (fill | (port.calib_done & ~port.cmd_full))),
+            port.cmd_en.eq(issue & ~fill),
+            port.cmd_instr.eq(mcb.Instr.READ),
+            port.cmd_bl.eq(bl),
+            port.cmd_byte_addr.eq(Cat(Const(0, exact_log2(word_bytes)), address)),
+            port.wr_en.eq(0),
+        ]
+        with m.If(issue):
+            with m.If(is_last):
+                m.d.sync += issuing.eq(0)
+            with m.Else():
+                m.d.sync += [address[burst_bits:].eq(address[burst_bits:] + 1),
+                             before_last.eq(before_last - 1), is_last.eq(before_last == 1)]
 
-        with m.FSM():
-            with m.State("IDLE"):
-                # (answering zeros: one request at a time)
-                m.d.comb += self.requests.ready.eq(~zero | (owed == 0))
-                m.d.comb += [src.slot.eq(request.slot), src.row.eq(request.first_row)]
-                with m.If(self.requests.valid & self.requests.ready):      # (not while answering zeros)
-                    fits = ((request.slot < self._slots) & (request.row_count != 0)
-                            & (request.first_row + request.row_count <= dmd.rows))
-                    with m.If(fits):
-                        m.d.comb += accepted.eq(1)
-                        m.d.sync += [slot.eq(request.slot), plane.eq(request.plane), row.eq(request.first_row),
-                                     left.eq(request.row_count), run_rows.eq(0)]
-                        m.next = "GATHER"
-                        with m.If(lost | zero):
-                            m.next = "IDLE"            # answered as zeros
-                    with m.Else():
-                        m.d.sync += self.bad_requests.eq(self.bad_requests + 1)
-            with m.State("LOOK"):
-                m.next = "GATHER"                      # ``row`` is looked up
-                with m.If(lost):
-                    m.next = "IDLE"
-            with m.State("GATHER"):
-                whole = ~src.delta
-                joins = (run_rows == 0) | (src.source == run_source)
-                with m.If(lost):
-                    m.next = "IDLE"
-                with m.Elif(joins):
-                    with m.If(run_rows == 0):
-                        m.d.sync += [run_source.eq(Mux(whole, slot, src.source)), run_first.eq(row)]
-                    taken = Mux(whole, left, 1)        # a whole frame's request is one run
-                    m.d.sync += [run_rows.eq(run_rows + taken), left.eq(left - taken), row.eq(row + taken)]
-                    m.d.comb += src.row.eq(row + 1)
-                    with m.If(left == taken):
-                        m.next = "PREPARE"
-                with m.Else():
-                    m.next = "PREPARE"                 # ``row`` starts the next run
-            with m.State("PREPARE"):
-                m.d.sync += [
-                    address.eq(self._map.address(run_source, plane, run_first)),
-                    remaining.eq(run_rows * port_words_per_row),
-                    run_rows.eq(0),
-                ]
-                m.next = "ISSUE"
-                with m.If(lost):
-                    m.next = "IDLE"
-            with m.State("ISSUE"):
-                with m.If(lost):
-                    m.next = "IDLE"                    # the rest of the request is answered as zeros
-                with m.Elif(port.calib_done & ~port.cmd_full & (reserved + burst <= depth)):
-                    m.d.comb += issue.eq(1)
-                    m.d.sync += [address.eq(address + burst * (words * WORD_BYTES)),
-                                 remaining.eq(remaining - burst)]
-                    with m.If(remaining == burst):
-                        m.next = "IDLE"
-                        with m.If(left != 0):
-                            m.next = "LOOK"
+        # the request taken, and the run gathered from it, loaded into the above when ``emit``
+        taken = Signal(PlaneRequest)
+        emit = Signal()
+        run_source, run_off = Signal(SLOT_BITS), Signal(range(plane_words))
+        run_words = Signal(range(plane_words + 1))
+        run_single = Signal()                    # run_words <= MAX_BURST (one burst)
+        m.submodules.starts = starts_rom = Memory(shape=address_bits - low, depth=len(starts),
+                                                  init=[start >> low for start in starts])
+        start = starts_rom.read_port(domain="comb")
+        run_last = run_words - 1
+        m.d.comb += start.addr.eq(Cat(taken.plane, run_source))
+        with m.If(emit):
+            m.d.sync += [
+                issuing.eq(1),
+                address[:low].eq(run_off[:low]),
+                address[low:].eq(start.data + run_off[low:]),
+                last_bl.eq(run_last[:burst_bits]),
+                before_last.eq(run_last[burst_bits:]),
+                is_last.eq(run_single),
+            ]
+
+        # ---- requests into runs -------------------------------------------------------------
+        # the request fits the frame: a slot of the store and some rows, none past the last
+        # (two flags: each is a short path from the request's registers)
+        some, within = Signal(), Signal()
+        look = Signal(ceil_log2(dmd.rows))       # the row looked up on ``sources``
+        # the row decided on (a delta's walk: two behind ``look``): its offset in port words,
+        # the request's rows from it on, and whether it is the request's last
+        row_off = Signal(range(plane_words))
+        left = Signal(range(dmd.rows + 1))
+        last = Signal()
+        run_open = Signal()
+        # the row map's answers a stage later, for a delta's walk: the row's source, and whether
+        # the row before showed the same (so that the walk decides from registers alone)
+        row_source, same = Signal(SLOT_BITS), Signal()
+        m.d.comb += [src.slot.eq(taken.slot), src.row.eq(look)]
+        with m.If(src.en):
+            # (every lookup steps on to the next row, but while a delta's row waits)
+            m.d.sync += [look.eq(look + 1), row_source.eq(src.source), same.eq(src.source == row_source)]
+        m.submodules.bad = bad = Counter(16)
+        m.d.comb += self.bad_requests.eq(bad.count)
+
+        # The steps of a request, a flag each (one-hot: a decision on the step is a LUT input of
+        # its own, not a state to decode): IDLE takes it; CHECK looks its first row up and forms
+        # its sums; GATHER has the first row's answer: a whole frame's request is one run, a
+        # delta's WALKs its rows one a cycle, a run for each stretch of rows from one slot, and
+        # FLUSHes the last run.
+        idle = Signal(init=1)
+        check, gather, walk, flush = Signal(), Signal(), Signal(), Signal()
+        request = self.requests.payload
+        whole = ~src.delta
+        fits = some & within
+        joins = run_open & same
+        # a row that ends the run before it waits (the row map's answers held) until the commands
+        # take that run
+        advance = joins | ~run_open | ~issuing
+        m.d.comb += [
+            self.requests.ready.eq(idle),
+            src.en.eq(~walk | advance),
+            bad.inc.eq(gather & ~fits),
+            emit.eq(~issuing & (gather & fits & whole | walk & run_open & ~same | flush)),
+        ]
+        m.d.sync += [
+            idle.eq(idle & ~self.requests.valid | gather & ~fits | gather & whole & ~issuing | flush & ~issuing),
+            check.eq(idle & self.requests.valid),
+            gather.eq(check | gather & fits & whole & issuing),
+            walk.eq(gather & fits & ~whole | walk & ~(advance & last)),
+            flush.eq(walk & advance & last | flush & issuing),
+        ]
+        with m.If(idle):
+            # (every cycle: nothing uses them before a request is taken)
+            m.d.sync += [taken.eq(request), look.eq(request.first_row)]
+        with m.If(check):
+            first, count = taken.first_row, taken.row_count
+            m.d.sync += [
+                some.eq((taken.slot < self._slots) & (count != 0)), within.eq(first + count <= dmd.rows),
+                row_off.eq(_times(first, row_words)), left.eq(count), last.eq(count == 1),
+                # the request as one run (a whole frame's)
+                run_source.eq(taken.slot), run_off.eq(_times(first, row_words)),
+                run_words.eq(_times(count, row_words)), run_single.eq(count <= mcb.MAX_BURST // row_words),
+                run_open.eq(0),
+            ]
+        with m.If(walk & advance):
+            m.d.sync += [row_off.eq(row_off + row_words), left.eq(left - 1), last.eq(left == 2), run_open.eq(1)]
+            with m.If(joins):
+                m.d.sync += [run_words.eq(run_words + row_words),
+                             run_single.eq(run_words <= mcb.MAX_BURST - row_words)]
+            with m.Else():
+                m.d.sync += [run_source.eq(row_source), run_off.eq(row_off), run_words.eq(row_words),
+                             run_single.eq(row_words <= mcb.MAX_BURST)]
+
+        # answering with zeros from the loss until the store has recovered and nothing is owed,
+        # between requests (one taken in that very cycle is taken after the recovery: it is read)
+        with m.If(lost):
+            m.d.sync += zero.eq(1)
+        with m.Elif(idle & ~issuing & (owed == 0)):
+            m.d.sync += zero.eq(0)
         if self._domain != "sync":
             return DomainRenamer({"sync": self._domain})(m)
         return m

@@ -80,7 +80,7 @@ class RowIngest(wiring.Component):
         The slot whose last missing row has arrived, to the slot table.
     map_writes : Out(stream.Signature(slot_maps.map_write_layout(dmd), always_ready=True))
         Clearing and setting the row bitmap and the occupancy map.
-    bitmap : Out(RowLookupSignature(dmd))
+    bitmap : Out(RowLookupSignature(dmd, "stored"))
         Whether a row arrived before.
     base_occupancy : Out(OccupancySignature())
         The occupancy map of a delta's base, copied when the delta's slot is set up.
@@ -98,7 +98,7 @@ class RowIngest(wiring.Component):
             "opened": Out(stream.Signature(opening_layout(frame_bits), always_ready=True)),
             "completed": Out(stream.Signature(SLOT_BITS, always_ready=True)),
             "map_writes": Out(stream.Signature(map_write_layout(dmd), always_ready=True)),
-            "bitmap": Out(RowLookupSignature(dmd)),
+            "bitmap": Out(RowLookupSignature(dmd, "stored")),
             "base_occupancy": Out(OccupancySignature()),
             "counters": Out(IngestCounters),
         })

@@ -2,14 +2,16 @@
 
 Row map: per slot and row, whether the row arrived in that slot (``stored``) and the slot whose
 words the row shows (``source``): the slot itself for a whole frame and for a row a delta frame
-carries, the delta's base for a row it does not. Read back in ``sync`` (one cycle later) to
-refuse a row that arrived before, and in ``dmd`` by the plane reader, with the slot's kind
-(whole or delta). Occupancy map: per slot and DMD block, 8 bits, plane ``k`` has a bit set
-somewhere in the block (a delta starts from its base's, a superset of what its rows from the
-base hold: a block it says has bits is loaded, never wrongly cleared). Every map is written in
-``sync`` through one stream of writes; the ``dmd`` read ports are safe because a slot reaches
-the sequencer only after it is complete, and a base is never written while a delta uses it (see
-:mod:`gateware.store.layouts`).
+carries, the delta's base for a row it does not. ``stored`` is read back in ``sync`` (one cycle
+later) to refuse a row that arrived before, ``source`` in ``dmd`` by the plane reader, with the
+slot's kind (whole or delta). Each half is a memory of its own with one write and one read port,
+so that each maps to block RAM: a read is then a flip-flop to flip-flop path with no logic (as
+one memory with two read ports it took distributed RAM and several LUT levels of multiplexers).
+Occupancy map: per slot and DMD block, 8 bits, plane ``k`` has a bit set somewhere in the block
+(a delta starts from its base's, a superset of what its rows from the base hold: a block it says
+has bits is loaded, never wrongly cleared). Every map is written in ``sync`` through one stream
+of writes; the ``dmd`` read ports are safe because a slot reaches the sequencer only after it is
+complete, and a base is never written while a delta uses it (see :mod:`gateware.store.layouts`).
 """
 
 from amaranth import Cat, Module
@@ -21,10 +23,10 @@ from amaranth.utils import ceil_log2
 from .addresses import PLANES
 from .layouts import BLOCK_BITS, SLOT_BITS, OccupancySignature
 
-__all__ = ["SlotMaps", "RowLookupSignature", "map_write_layout", "row_entry_layout"]
+__all__ = ["SlotMaps", "RowLookupSignature", "map_write_layout", "ROW_ANSWERS"]
 
-#: One entry of the row map.
-row_entry_layout = data.StructLayout({"stored": 1, "source": SLOT_BITS})
+#: What each read port of the row map answers: whether the row arrived, or where its words are.
+ROW_ANSWERS = {"stored": {"stored": 1}, "source": {"source": SLOT_BITS, "delta": 1}}
 
 
 def map_write_layout(dmd):
@@ -47,30 +49,40 @@ def map_write_layout(dmd):
 class RowLookupSignature(wiring.Signature):
     """A read port of the row map, seen from its user.
 
+    Parameters
+    ----------
+    dmd : :class:`spec.facts.DmdType`
+    answers : str
+        A key of :data:`ROW_ANSWERS`: ``"stored"`` (the row ingest's port) or ``"source"`` (the
+        plane reader's).
+
     Members
     -------
     slot, row : Out
         Which row of which slot to look up.
+    en : Out(1)
+        Look up (high unless driven low); low, the answers keep their values.
     stored : In(1)
-        One cycle later: that row arrived in that slot.
+        (``"stored"``) One cycle later: that row arrived in that slot.
     source : In(SLOT_BITS)
-        One cycle later: the slot whose words that row shows.
+        (``"source"``) One cycle later: the slot whose words that row shows.
     delta : In(1)
-        One cycle later: the slot holds a delta frame (some rows show its base's words).
+        (``"source"``) One cycle later: the slot holds a delta frame (some rows show its base's
+        words).
     """
 
-    def __init__(self, dmd):
-        self._row_bits = ceil_log2(dmd.rows)
+    def __init__(self, dmd, answers):
+        self._row_bits, self._answers = ceil_log2(dmd.rows), answers
         super().__init__({
             "slot": Out(SLOT_BITS),
             "row": Out(self._row_bits),
-            "stored": In(1),
-            "source": In(SLOT_BITS),
-            "delta": In(1),
+            "en": Out(1, init=1),
+            **{name: In(width) for name, width in ROW_ANSWERS[answers].items()},
         })
 
     def __eq__(self, other):
-        return isinstance(other, RowLookupSignature) and other._row_bits == self._row_bits
+        return (isinstance(other, RowLookupSignature) and other._row_bits == self._row_bits
+                and other._answers == self._answers)
 
 
 class SlotMaps(wiring.Component):
@@ -86,12 +98,12 @@ class SlotMaps(wiring.Component):
     -------
     writes : In(stream.Signature(map_write_layout(dmd), always_ready=True))
         Writes to the maps, one per cycle (``sync``).
-    bitmap : In(RowLookupSignature(dmd))
-        Row map read port (``sync``).
+    bitmap : In(RowLookupSignature(dmd, "stored"))
+        Row map read port (``sync``): whether a row arrived.
     base_occupancy : In(OccupancySignature())
         Occupancy read port (``sync``): a delta's map starts as its base's.
-    sources : In(RowLookupSignature(dmd))
-        Row map read port (``dmd``) for the plane reader.
+    sources : In(RowLookupSignature(dmd, "source"))
+        Row map read port (``dmd``) for the plane reader: where a row's words are.
     occupancy : In(OccupancySignature())
         Occupancy map read port (``dmd``).
     """
@@ -100,9 +112,9 @@ class SlotMaps(wiring.Component):
         self._dmd, self._slots = dmd, slots
         super().__init__({
             "writes": In(stream.Signature(map_write_layout(dmd), always_ready=True)),
-            "bitmap": In(RowLookupSignature(dmd)),
+            "bitmap": In(RowLookupSignature(dmd, "stored")),
             "base_occupancy": In(OccupancySignature()),
-            "sources": In(RowLookupSignature(dmd)),
+            "sources": In(RowLookupSignature(dmd, "source")),
             "occupancy": In(OccupancySignature()),
         })
 
@@ -111,27 +123,22 @@ class SlotMaps(wiring.Component):
         row_bits = ceil_log2(self._dmd.rows)
         write = self.writes.payload
 
-        m.submodules.rows = rows = Memory(shape=row_entry_layout, depth=self._slots << row_bits, init=[])
+        written = Cat(write.row, write.slot)
+        for name, port, domain in (("stored", self.bitmap, "sync"), ("source", self.sources, "dmd")):
+            m.submodules[name] = memory = Memory(shape=len(getattr(port, name)), depth=self._slots << row_bits, init=[])
+            w, r = memory.write_port(), memory.read_port(domain=domain)
+            m.d.comb += [w.addr.eq(written), w.data.eq(write[name]), w.en.eq(self.writes.valid),
+                         r.addr.eq(Cat(port.row, port.slot)), r.en.eq(port.en), getattr(port, name).eq(r.data)]
         m.submodules.kinds = kinds = Memory(shape=1, depth=self._slots, init=[])
-        rows_w, kinds_w = rows.write_port(), kinds.write_port()
+        kinds_w, kinds_r = kinds.write_port(), kinds.read_port(domain="dmd")
         m.d.comb += [
-            rows_w.addr.eq(Cat(write.row, write.slot)),
-            rows_w.data.stored.eq(write.stored),
-            rows_w.data.source.eq(write.source),
-            rows_w.en.eq(self.writes.valid),
             kinds_w.addr.eq(write.slot),
             kinds_w.data.eq(write.delta),
             kinds_w.en.eq(self.writes.valid & write.opening),
+            kinds_r.addr.eq(self.sources.slot),
+            kinds_r.en.eq(self.sources.en),
+            self.sources.delta.eq(kinds_r.data),
         ]
-        for port, domain in ((self.bitmap, "sync"), (self.sources, "dmd")):
-            rows_r, kinds_r = rows.read_port(domain=domain), kinds.read_port(domain=domain)
-            m.d.comb += [
-                rows_r.addr.eq(Cat(port.row, port.slot)),
-                kinds_r.addr.eq(port.slot),
-                port.stored.eq(rows_r.data.stored),
-                port.source.eq(rows_r.data.source),
-                port.delta.eq(kinds_r.data),
-            ]
 
         m.submodules.occupancy = occ = Memory(shape=PLANES, depth=self._slots << BLOCK_BITS, init=[])
         occ_w = occ.write_port(granularity=1)

@@ -270,15 +270,18 @@ class Projector(wiring.Component):
         pulse and only a newer one replaces it there, so the frame that starts is the one taken
         last (a repeat keeps its id)."""
         taken = Signal(FrameInfo)
-        counted, shown_id = Signal.like(seq.status.frames), Signal(FRAME_BITS)
+        counted, shown_id = Signal(), Signal(FRAME_BITS)
         with m.If(frames.valid & frames.ready):
             m.d.dmd += taken.eq(frames.payload)
-        m.d.dmd += counted.eq(seq.status.frames)
-        started = seq.status.frames != counted
+        # the count of frames started steps by one at most a cycle (its CountSynchronizer needs
+        # that), so it has stepped exactly when its lowest bit has changed: no wide comparison
+        m.d.dmd += counted.eq(seq.status.frames[0])
+        started = seq.status.frames[0] != counted
         with m.If(started):
             m.d.dmd += [self.shown.number.eq(self.shown.number + 1), self.shown.frame.eq(taken.frame_id),
                         self.shown.depth.eq(taken.bit_depth), self.shown.lsb.eq(seq.regs.lsb)]
-        m.submodules.shown_cdc = crossing = AsyncQueue(FRAME_BITS, 4, w_domain="dmd", r_domain="sync")
+        m.submodules.shown_cdc = crossing = AsyncQueue(FRAME_BITS, 4, w_domain="dmd", r_domain="sync",
+                                                       staged=("dmd",))
         m.d.comb += [crossing.w_stream.valid.eq(started), crossing.w_stream.payload.eq(taken.frame_id),
                      crossing.r_stream.ready.eq(1)]
         with m.If(crossing.r_stream.valid):
