@@ -45,8 +45,8 @@ class RowSource(wiring.Component):
         One cycle's beats of a row; the bus takes one a cycle through a row.
     row_ready : Out(1)
         A whole row is there for the bus's next decision (always, from the pattern source):
-        registered, so counted without the beats taken on the cycle before or still owed to the
-        row under way.
+        registered, so counted with the words that arrived and without the beats taken on the
+        cycle before, and without those still owed to the row under way.
     drained : Out(1)
         No word asked of the store is still to be taken (registered: as of the cycle before).
     seed, reseed : In(64), In(1)
@@ -111,11 +111,14 @@ class RowSource(wiring.Component):
             out.ready.eq(self.beats.ready & ~use_prng | discard),
             prng.next.eq(self.beats.ready & use_prng),
         ]
-        # a whole row for the next decision (made next cycle, on what is registered now): beyond
-        # the beats taken now and those of the row under way (every row decided before has begun)
+        # a whole row for the next decision (made next cycle, on what is registered now, its
+        # first beat read the cycle after): the words buffered and arriving now (each readable by
+        # then), less the beats taken now and those of the row under way (every row decided
+        # before has begun)
+        arriving = buffer.w_stream.valid & buffer.w_stream.ready
         beat_next = Mux(taken, Mux(beat == R - 1, 0, beat + 1), beat)
         under_way = Mux(beat_next == 0, 0, R - beat_next)
-        m.d.sync += [self.row_ready.eq(use_prng | (buffer.level >= R + taken + under_way)),
+        m.d.sync += [self.row_ready.eq(use_prng | (buffer.level + arriving >= R + taken + under_way)),
                      self.drained.eq((asked == taken_rows) & (beat == 0))]
         with m.If(self.asked):
             m.d.sync += asked.eq(asked + dmd.rows_per_block)
