@@ -54,7 +54,8 @@ before each group's settle time ends, as always). Nothing abandoned is ever puls
 Time base: cycle 0 is the first cycle after initialisation (INIT_ACTIVE low); the first loads
 may start at ``init_to_dvalid`` (64 clocks, DLPC910). Command cycles are decision cycles; the
 pins show each command :data:`DECISION_TO_PINS` cycles later. A frame taken at ``t`` is answered
-to the store on the next cycle, so the frame after it is offered no sooner than ``t + 2``.
+to the store on the next cycle, so the frame after it is offered no sooner than ``t + 2``; the
+sequencer sees an offer :data:`OFFER_LAG` cycles after the store makes it.
 """
 
 import math
@@ -137,6 +138,9 @@ RST_MARGIN = DECISION_TO_PINS + 3
 #: trigger (the guard's thresholds, the interval plus an eighth and the interval less
 #: :func:`reload_bound`, are summed in a pipeline of the gateware).
 PACE_LAG = 6
+#: Cycles from the store's offer of a frame to the sequencer's decisions seeing it (the planner
+#: registers the offer).
+OFFER_LAG = 1
 
 
 def even(t):
@@ -276,13 +280,17 @@ class _Frames:
         self.offer_from = 0
 
     def offer(self):
-        """(bad frames before it, cycle it is offered from) of the next good frame, or None."""
+        """(bad frames before it, cycle the sequencer sees it from) of the next good frame, or
+        None. The store offers it from its ``ready`` cycle (a bad one before it is dropped the
+        cycle it is offered); the sequencer sees an offer :data:`OFFER_LAG` cycles later. The time
+        base stands at 0 until the controller is initialised, so what is offered at 0 is offered
+        long before it runs: seen from 0, and a bad frame then dropped in no time."""
         at = self.offer_from
         for k, f in enumerate(self.offered):
             at = max(at, f.ready)
             if 1 <= f.depth <= 8:
-                return k, at
-            at += 1
+                return k, at + OFFER_LAG if at > 0 else 0
+            at += 1 if at > 0 else 0
         return None
 
     def take(self, t, repeat=True):

@@ -1,7 +1,7 @@
 """The row source's ``row_ready`` against the bus's use of it, with a store that stalls at random:
 the bus decides on even cycles from what is registered, and a row it starts on ``row_ready``
-takes its ``R`` beats back to back from the next cycle (the next decision may fall on its last
-beat). Every beat so taken must be there, in the order the store sent it; and a row waits no
+takes its ``R`` beats back to back from the next cycle (``row_started`` on the first; the next
+decision may fall on its last beat). Every beat so taken must be there, in the order the store sent it; and a row waits no
 longer than it must (``row_ready`` rises within two cycles of a whole row being free)."""
 
 import random
@@ -27,7 +27,7 @@ def test_a_row_started_on_row_ready_finds_every_beat(name, beats):
     async def bench(ctx):
         sent = taken = 0
         busy_until = -1            # the last cycle a started row takes a beat
-        beat_cycles = set()
+        beat_cycles, first_beats = set(), set()
         free_since = None          # the cycle a whole row beyond the row under way was first buffered
         for t in range(6000):
             # the store: words at a rate that varies between a trickle and every cycle
@@ -37,6 +37,7 @@ def test_a_row_started_on_row_ready_finds_every_beat(name, beats):
             # the bus: decide on even cycles once the row before has its last beat under way
             if t % 2 == 0 and t >= busy_until and ctx.get(dut.row_ready):
                 beat_cycles.update(range(t + 1, t + R + 1))
+                first_beats.add(t + 1)
                 busy_until = t + R
                 checked["rows"] += 1
                 if free_since is not None:
@@ -45,6 +46,7 @@ def test_a_row_started_on_row_ready_finds_every_beat(name, beats):
                 free_since = None
             reading = t in beat_cycles
             ctx.set(dut.beats.ready, reading)
+            ctx.set(dut.row_started, t in first_beats)
             if reading:
                 assert ctx.get(dut.beats.valid), (t, taken)
                 assert ctx.get(dut.beats.payload) == (taken * 0x9E3779B97F4A7C15) & mask, (t, taken)

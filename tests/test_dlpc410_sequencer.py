@@ -573,7 +573,8 @@ def test_trigger_during_reload_is_an_overrun(test_name):
     first = next_ready(p, model_frames([(0, 3)], None), []) - PIN_TO_STROBE
     idle = waiting_after(p, [(0, 3)], [first + PIN_TO_STROBE]) + 30
     offered = [(0, 3, 0), (1, 3, idle)]
-    early = [idle - PIN_TO_STROBE, idle + p.reload_lead + 10 - PIN_TO_STROBE]
+    # (the first strobe on the cycle the sequencer sees the newer frame)
+    early = [idle + schedule.OFFER_LAG - PIN_TO_STROBE, idle + p.reload_lead + 10 - PIN_TO_STROBE]
     strobes = [first + PIN_TO_STROBE] + [t + PIN_TO_STROBE for t in early]
     second = next_ready(p, model_frames(offered, None), strobes) - PIN_TO_STROBE
     run, model = check(p, [(0, 3), (1, 3)], None, [first, *early, second], test_name, offered=offered)
@@ -607,7 +608,7 @@ def test_frame_offered_late_in_a_frame_abandons_the_stale_preload(mode, after, t
     assert [f.slot for f in model.shown] == [0, 1] and model.overruns == 1
     assert [s for _t, s in run.releases] == [0]
     # the stale repeat was cut: fewer rows than a plane loaded before frame 1's first row
-    taken = max(ready, end + 1)
+    taken = max(ready + schedule.OFFER_LAG, end + 1)
     wait = schedule.flush_rows(DMD) * p.row_period
     new_start = schedule.even(max(taken + p.reload_lead + wait, end + p.t_rst + p.t_settle))
     loads = [t for t, k, _a in model.commands if k != "pulse" and t >= last_pulse]

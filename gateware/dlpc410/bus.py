@@ -67,6 +67,8 @@ class Bus(wiring.Component):
         This cycle's decision: bit g, a clocking pulse of group g.
     pulsing : Out(1)
         Some bit of ``choice``.
+    row_started : Out(1)
+        The first beat of a row is taken this cycle.
     loaded : Out(blocks)
         Bit g: group g's load ends this cycle (its last operation's last row cycle is on the pins
         by the next decision).
@@ -95,6 +97,7 @@ class Bus(wiring.Component):
             "row_ready": In(1),
             "choice": Out(dmd.blocks),
             "pulsing": Out(1),
+            "row_started": Out(1),
             "loaded": Out(dmd.blocks),
             "dvalid": Out(1),
             "command": Out(Command),
@@ -223,7 +226,7 @@ class Bus(wiring.Component):
         cmd = self.command
         op_row = Signal()                      # the row cycle on the pins loads a row
         reading = dec.row | (op_row & (row_left != 0))
-        m.d.comb += self.beats.ready.eq(reading)
+        m.d.comb += [self.beats.ready.eq(reading), self.row_started.eq(dec.row)]
         m.d.sync += self.beat.eq(Mux(reading, self.beats.payload, 0))
         with m.If(remain != 0):
             m.d.sync += [remain.eq(remain - 1), spent.eq(remain == 1)]

@@ -72,7 +72,8 @@ class Planner(wiring.Component):
         The newest complete frame. A bit depth outside 1..8 is dropped when offered, and counted.
         A frame taken is answered (``ready``) the cycle after it was taken.
     offer : Out(Offer)
-        The frame offered now, for the frame control.
+        The frame offered, as the store offered it the cycle before
+        (:data:`spec.schedule.OFFER_LAG`), for the frame control.
     choice : In(blocks)
         The bus's decision this cycle: bit g, a pulse of group g (one bit at most).
     pulsing : In(1)
@@ -206,19 +207,24 @@ class Planner(wiring.Component):
         m.d.comb += [self.depth.eq(first.depth),
                      self.lsb.eq(Mux(first.showing.lsb != 0, first.showing.lsb, regs.lsb))]
 
-        # ---- the frame offered: free to take unless a take is being answered ----
+        # ---- the frame offered: the store's offer as of the cycle before (registered: the
+        # decisions that read it start from flip-flops), free to take unless a take is being
+        # answered; a frame taken is answered while the store still offers it (a stream holds
+        # its payload until the transfer), and one with a bad bit depth is dropped at once ----
         depth_in = self.frames.payload.bit_depth
         frame_ok = (depth_in != 0) & (depth_in <= 8)
         taking = Signal()                      # group 0 took the offered frame last cycle
         answered = taking | (self.start.valid & self.start.payload.take) | \
             (self.retake.valid & self.retake.payload.newer)
-        m.d.comb += [self.offer.valid.eq(self.frames.valid & frame_ok & ~answered),
-                     self.offer.slot.eq(self.frames.payload.slot), self.offer.depth.eq(depth_in),
-                     self.offer.sequence.eq(self.frames.payload.sequence),
-                     self.offer.showing.eq(self.frames.payload.showing),
+        held = Signal(Offer)
+        m.d.sync += [held.valid.eq(self.frames.valid & frame_ok & ~answered),
+                     held.slot.eq(self.frames.payload.slot), held.depth.eq(depth_in),
+                     held.sequence.eq(self.frames.payload.sequence),
+                     held.showing.eq(self.frames.payload.showing)]
+        m.d.comb += [self.offer.eq(held), self.offer.valid.eq(held.valid & ~answered),
                      self.frames.ready.eq(answered | (self.frames.valid & ~frame_ok))]
-        m.d.comb += [frames.offered.slot.eq(self.frames.payload.slot), frames.offered.depth.eq(depth_in),
-                     frames.offered.showing.eq(self.frames.payload.showing)]
+        m.d.comb += [frames.offered.slot.eq(held.slot), frames.offered.depth.eq(held.depth),
+                     frames.offered.showing.eq(held.showing)]
         m.submodules.bad = bad = Counter(COUNTER_BITS)
         bad_seen = Signal()
         m.d.sync += bad_seen.eq(self.frames.valid & ~frame_ok)

@@ -41,12 +41,14 @@ class RowSource(wiring.Component):
         A request for ``rows_per_block`` rows was taken by the store this cycle.
     flushing : In(1)
         Discard the words still owed (while the bus reads none).
+    row_started : In(1)
+        The bus reads the first beat of a row this cycle.
     beats : Out(stream.Signature(bits_per_dclk * beats))
         One cycle's beats of a row; the bus takes one a cycle through a row.
     row_ready : Out(1)
         A whole row is there for the bus's next decision (always, from the pattern source):
-        registered, so counted with the words that arrived and without the beats taken on the
-        cycle before, and without those still owed to the row under way.
+        registered, so counted with the words that arrived and without the rows begun on the
+        cycle before.
     drained : Out(1)
         No word asked of the store is still to be taken (registered: as of the cycle before).
     seed, reseed : In(64), In(1)
@@ -62,6 +64,7 @@ class RowSource(wiring.Component):
             "words": In(stream.Signature(64 * store_words)),
             "asked": In(1),
             "flushing": In(1),
+            "row_started": In(1),
             "beats": Out(stream.Signature(width)),
             "row_ready": Out(1),
             "drained": Out(1),
@@ -111,14 +114,20 @@ class RowSource(wiring.Component):
             out.ready.eq(self.beats.ready & ~use_prng | discard),
             prng.next.eq(self.beats.ready & use_prng),
         ]
-        # a whole row for the next decision (made next cycle, on what is registered now, its
-        # first beat read the cycle after): the words buffered and arriving now (each readable by
-        # then), less the beats taken now and those of the row under way (every row decided
-        # before has begun)
+        # a whole row for the next decision (made next cycle on what is registered now, its first
+        # beat read the cycle after): the beats arrived and not yet given to a row the bus began
+        # (``free``; every row decided before has begun, as decisions are two cycles apart at
+        # least). A beat arriving now is readable by then. The flag is chosen among four
+        # comparisons of ``free`` with constants, so that no sum lies on its path.
         arriving = buffer.w_stream.valid & buffer.w_stream.ready
-        beat_next = Mux(taken, Mux(beat == R - 1, 0, beat + 1), beat)
-        under_way = Mux(beat_next == 0, 0, R - beat_next)
-        m.d.sync += [self.row_ready.eq(use_prng | (buffer.level + arriving >= R + taken + under_way)),
+        free = Signal(range(WORD_FIFO_ROWS * R + 1))
+        with m.If(self.flushing | use_prng):
+            m.d.sync += free.eq(0)             # (the words owed are discarded as they arrive)
+        with m.Else():
+            m.d.sync += free.eq(free + arriving - Mux(self.row_started, R, 0))
+        enough = Mux(self.row_started, Mux(arriving, free >= 2 * R - 1, free >= 2 * R),
+                     Mux(arriving, free >= R - 1, free >= R))
+        m.d.sync += [self.row_ready.eq(use_prng | (enough & ~self.flushing)),
                      self.drained.eq((asked == taken_rows) & (beat == 0))]
         with m.If(self.asked):
             m.d.sync += asked.eq(asked + dmd.rows_per_block)

@@ -232,6 +232,7 @@ class Sequencer(wiring.Component):
         wiring.connect(m, source.beats, bus.beats)
         m.d.comb += [
             bus.even.eq(~time_base.count[0]),
+            source.row_started.eq(bus.row_started),
             bus.row_ready.eq(source.row_ready),
             bus.running.eq(control.running), bus.flushing.eq(control.flushing),
             bus.hold.eq(control.retake.valid), bus.restart.eq(control.retake.valid),
