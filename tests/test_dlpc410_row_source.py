@@ -1,8 +1,9 @@
 """The row source's ``row_ready`` against the bus's use of it, with a store that stalls at random:
 the bus decides on even cycles from what is registered, and a row it starts on ``row_ready``
 takes its ``R`` beats back to back from the next cycle (``row_started`` on the first; the next
-decision may fall on its last beat). Every beat so taken must be there, in the order the store sent it; and a row waits no
-longer than it must (``row_ready`` rises within two cycles of a whole row being free)."""
+decision may fall on its last beat). Every beat so taken must be there, in the order the store
+sent it; and a row waits no longer than it must (``row_ready`` rises within two cycles of a
+whole row being free)."""
 
 import random
 
