@@ -90,13 +90,24 @@ def test_ready_paths():
 
 
 @pytest.mark.parametrize("check", [
-    *[c for c in blocks.checks() if c.block in ("Queue", "Countdown")],
+    *[c for c in blocks.checks() if c.block == "Countdown"],
     *[c for c in store.store_checks()],
 ], ids=lambda c: c.key)
 def test_checks_quick(check):
-    result = run(dataclasses.replace(check, induction=check.induction if check.block == "Queue" else None),
-                 depth=check.quick)
+    result = run(dataclasses.replace(check, induction=None), depth=check.quick)
     assert result.status in ("proven", "checked")
+
+
+@pytest.mark.parametrize("check", blocks.stream_checks(), ids=lambda c: c.block)
+def test_stream_rules_of_every_block(check):
+    """The stream rules of every block with stream ports: proven where a proof closes, else
+    checked to the block's test depth (20 steps: the transmitter's header changing with the
+    addresses failed at step 9, the transmit crossing offering a frame too soon after a frame
+    longer than its FIFO at step 19); and no output ``valid`` waits combinationally for a
+    ``ready``."""
+    assert run(check, depth=check.quick).status in ("proven", "checked")
+    block = next(b for b in blocks.STREAM_BLOCKS if b.name == check.block)
+    assert ready_paths(block.make(), build_dir("formal", f"test-ready-{check.block}")) == {}
 
 
 class Through(wiring.Component):

@@ -122,6 +122,48 @@ def test_transmitter_builds_and_arbitrates(test_name):
             assert bytes(p[ICMP]) == icmp_message
 
 
+def test_transmitter_addresses_change_mid_frame(test_name):
+    """The host changes our addresses while a UDP reply is on its way out (the sink stalls in
+    its header): that frame carries the old ones throughout, its IPv4 checksum right; the next
+    frame the new ones."""
+    dut = Transmitter(sources=2)
+    peer = {"mac": 0x0200000000AA, "ip": 0x0A000009, "port": 1234}
+    new = {"mac": 0x0200000000BB, "ip": 0x0A000077, "port": 4321}
+    frames_out = []
+
+    async def src(ctx):
+        ctx.set(dut.mac, A.mac)
+        ctx.set(dut.ip, A.ip)
+        ctx.set(dut.port, A.port)
+        for _ in range(2):
+            await stream_put(ctx, dut.requests[0], {"kind": ReplyKind.UDP, "peer": peer, "length": 4})
+            for j in range(4):
+                await stream_put(ctx, dut.bodies[0], {"data": j, "last": int(j == 3)})
+
+    async def sink(ctx):
+        current = bytearray()
+        while len(frames_out) < 2:
+            data, last = (await stream_collect(ctx, dut.tx, 1, convert=lambda p: (p.data, p.last)))[0]
+            current.append(data)
+            if len(frames_out) == 0 and len(current) == 20:
+                # mid-header (the IPv4 header's first bytes are out): new addresses
+                ctx.set(dut.mac, new["mac"])
+                ctx.set(dut.ip, new["ip"])
+                ctx.set(dut.port, new["port"])
+                await ctx.tick().repeat(5)
+            if last:
+                frames_out.append(bytes(current))
+                current = bytearray()
+
+    simulate(dut, [src, sink], name=test_name, deadline=1e-3)
+    first, second = (Ether(f) for f in frames_out)
+    for p, mac, ip, port in ((first, A.mac_str, A.ip_str, A.port), (second, "02:00:00:00:00:bb", "10.0.0.119", 4321)):
+        assert (p.src, p[IP].src, p[UDP].sport) == (mac, ip, port)
+        ip_sum = p[IP].chksum
+        del p[IP].chksum
+        assert Ether(bytes(p))[IP].chksum == ip_sum
+
+
 def test_parser_against_model(test_name):
     """Records of every kind, good and bad, as datagrams: the pixels of each image record the
     model accepts (with their position, their record's end and first), queries, settings and

@@ -172,7 +172,11 @@ class TxCrossing(wiring.Component):
         with m.If(self.o.valid & self.o.ready):
             m.d[r] += sending.eq(~self.o.payload.last)
 
-        whole_frame = written.o != taken
+        # (a frame longer than the FIFO goes out before its count crosses: ``taken`` may run ahead
+        # of ``written.o`` for a few cycles, so compare the signed difference, not equality)
+        ahead = Signal(width)
+        m.d.comb += ahead.eq(written.o - taken)
+        whole_frame = (ahead != 0) & ~ahead[-1]
         full = fifo.r_level >= self._depth - 1
         m.d.comb += [
             self.o.valid.eq(out.valid & (sending | whole_frame | full)),

@@ -26,7 +26,7 @@ class Transmitter(wiring.Component):
     Members
     -------
     mac, ip, port : In(48), In(32), In(16)
-        Our addresses, written into every frame.
+        Our addresses, written into every frame (as they were when its request was taken).
     requests : In(stream.Signature(ReplyRequest)).array(sources)
         A frame to send. The request is taken when its frame starts.
     bodies : In(stream.Signature(BodyByte)).array(sources)
@@ -52,6 +52,9 @@ class Transmitter(wiring.Component):
         m = Module()
         n = self._sources
         request = Signal(ReplyRequest)
+        # our addresses, taken with the request: a frame's header is built from one set of them
+        # even if the host changes them while it is sent
+        mac, ip, port = Signal.like(self.mac), Signal.like(self.ip), Signal.like(self.port)
         selected = Signal(range(n))
         turn = Signal(range(n))
         ident = Signal(16)
@@ -62,14 +65,14 @@ class Transmitter(wiring.Component):
         is_udp = request.kind == ReplyKind.UDP
         ip_payload = Mux(is_udp, request.length + size(headers.UDP), request.length)
         eth_bytes = to_bytes(headers.ETHERNET, {
-            "dst": request.peer.mac, "src": self.mac,
+            "dst": request.peer.mac, "src": mac,
             "ethertype": Mux(is_arp, headers.ETHERTYPE_ARP, headers.ETHERTYPE_IPV4)})
-        arp_bytes = to_bytes(headers.ARP, arp.reply_fields(self.mac, self.ip, request.peer))
+        arp_bytes = to_bytes(headers.ARP, arp.reply_fields(mac, ip, request.peer))
         ip_bytes = to_bytes(headers.IPV4, ipv4.header_fields(
-            Mux(is_udp, headers.IP_PROTOCOL_UDP, headers.IP_PROTOCOL_ICMP), ip_payload, ident, self.ip,
+            Mux(is_udp, headers.IP_PROTOCOL_UDP, headers.IP_PROTOCOL_ICMP), ip_payload, ident, ip,
             request.peer.ip))
         udp_bytes = to_bytes(headers.UDP, {
-            "src_port": self.port, "dst_port": request.peer.port,
+            "src_port": port, "dst_port": request.peer.port,
             "length": request.length + size(headers.UDP)})
         # An ARP packet is as long as the IPv4 and UDP headers together: one 42-byte header table.
         header = Array([*eth_bytes, *(Mux(is_arp, a, b)
@@ -94,6 +97,7 @@ class Transmitter(wiring.Component):
                         m.d.comb += source.ready.eq(1)
                         m.d.sync += request.eq(source.payload)
                 m.d.sync += [
+                    mac.eq(self.mac), ip.eq(self.ip), port.eq(self.port),
                     index.eq(0),
                     sent.eq(0),
                     turn.eq(Mux(selected == n - 1, 0, selected + 1)),

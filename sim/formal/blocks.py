@@ -36,8 +36,9 @@ class StreamBlock:
     induction: int | None = None
     domains: tuple = ("sync",)
     port_domains: dict = field(default_factory=dict)
-    quick: int = 8
+    quick: int = 20
     parts: object = None
+    resets: tuple = ()
 
 
 def _queue():
@@ -82,7 +83,7 @@ def _stack():
 
 def _parser():
     from gateware.protocol.parser import Parser, config_init
-    return Parser(FORMAL_DMD, config_init(**_ADDRESSES), frame_bits=2)
+    return Parser(FORMAL_DMD, config_init(**_ADDRESSES))
 
 
 def _status_reply():
@@ -147,7 +148,8 @@ STREAM_BLOCKS = [
                 port_domains={"r_stream": "dmd"}),
     StreamBlock("RxCrossing", _rx_crossing, depth=40, domains=("gmii_rx", "sync"),
                 port_domains={"i": "gmii_rx", "dropped": "gmii_rx"}),
-    StreamBlock("TxCrossing", _tx_crossing, depth=40, domains=("sync", "gmii_tx"),
+    # (each step past 28 doubles the solver's time: 40 would take hours)
+    StreamBlock("TxCrossing", _tx_crossing, depth=28, domains=("sync", "gmii_tx"),
                 port_domains={"o": "gmii_tx"}),
     StreamBlock("ReceivePath", _receive_path, depth=30, domains=("gmii_rx", "sync"),
                 port_domains={"gmii": "gmii_rx"}),
@@ -160,7 +162,8 @@ STREAM_BLOCKS = [
     StreamBlock("RowIngest", _row_ingest, depth=24, induction=4),
     StreamBlock("SlotCrossing", _slot_crossing, depth=40, domains=("dmd", "sync"),
                 port_domains={"ask": "dmd", "release": "dmd", "frames": "dmd"}),
-    StreamBlock("Writer", _writer, depth=24, induction=6),
+    # (``discard`` resets the writer: the memory is lost, what it held is forgotten)
+    StreamBlock("Writer", _writer, depth=24, induction=6, resets=("discard",)),
     StreamBlock("Reader", _reader, depth=24, induction=6),
     StreamBlock("Split", _split, depth=16, induction=2),
     StreamBlock("FrameBroker", _broker, depth=24, induction=6),
@@ -174,12 +177,13 @@ STREAM_BLOCKS = [
 def _top(block):
     dut = block.make()
     parts = block.parts(dut) if block.parts else ()
-    return FormalTop(dut, [stream_rules(parts=parts)], domains=block.domains, port_domains=block.port_domains)
+    return FormalTop(dut, [stream_rules(parts=parts, resets=block.resets)], domains=block.domains,
+                     port_domains=block.port_domains)
 
 
 def stream_checks():
     return [Check("stream rules", block.name, lambda block=block: _top(block), depth=block.depth,
-                  induction=block.induction, quick=block.quick)
+                  induction=block.induction, quick=min(block.quick, block.depth))
             for block in STREAM_BLOCKS]
 
 

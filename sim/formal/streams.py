@@ -41,14 +41,23 @@ def stream_ports(dut):
     yield from walk(dut.signature, dut, (), False)
 
 
-def _held(m, domain, port, name, statement):
-    """``statement`` (Assert or Assume): a payload offered and not taken is offered again, unchanged."""
+def _held(m, domain, port, name, statement, reset=None):
+    """``statement`` (Assert or Assume): a payload offered and not taken is offered again,
+    unchanged; unless ``reset`` (a synchronous reset of the producer) is high now or was on the
+    cycle before."""
     ready = port.ready
     if not isinstance(ready, Signal):
         return                           # always ready: every offer is a transfer
     payload = port.payload.as_value() if hasattr(port.payload, "as_value") else port.payload
     waiting = Signal(name=f"{name}__waiting")
-    m.d[domain] += waiting.eq(port.valid & ~ready)
+    offered = port.valid & ~ready
+    if reset is not None:
+        was_reset = Signal(name=f"{name}__was_reset")
+        m.d[domain] += was_reset.eq(reset)
+        m.d[domain] += waiting.eq(offered & ~reset)
+        waiting = waiting & ~reset & ~was_reset
+    else:
+        m.d[domain] += waiting.eq(offered)
     with m.If(waiting):
         m.d.comb += statement(port.valid, f"{name}: valid fell before the transfer")
     if len(payload):
@@ -58,18 +67,25 @@ def _held(m, domain, port, name, statement):
             m.d.comb += statement(payload == before, f"{name}: payload changed before the transfer")
 
 
-def stream_rules(exclude=(), parts=()):
+def stream_rules(exclude=(), parts=(), resets=()):
     """A property function ``f(m, top)`` for :class:`sim.formal.harness.FormalTop`: the stream
     rules on every stream port of ``top.dut`` but those named in ``exclude``, each in the port's
     domain (``top.port_domains``). ``parts``: ``(name, component, {port: domain})`` of parts
     inside ``top.dut``, whose streams between each other are asserted too (a part's streams
-    from the boundary are the top's own, assumed there and so holding here)."""
+    from the boundary are the top's own, assumed there and so holding here). ``resets``: names
+    of one-bit inputs of ``top.dut`` that reset it synchronously (the writer's ``discard``): an
+    output stream may be withdrawn only while one is high (or the cycle after)."""
     def prop(m, top):
+        reset = None
+        for name in resets:
+            signal = getattr(top.dut, name)
+            reset = signal if reset is None else reset | signal
         for path, produced, port in stream_ports(top.dut):
             if path[0] in exclude:
                 continue
             name = "__".join(map(str, path))
-            _held(m, top.domain_of(path), port, name, Assert if produced else Assume)
+            _held(m, top.domain_of(path), port, name, Assert if produced else Assume,
+                  reset if produced else None)
         for part_name, part, domains in parts:
             for path, _produced, port in stream_ports(part):
                 name = "__".join([part_name, *map(str, path)])
@@ -92,7 +108,9 @@ def ready_paths(dut, folder):
               if produced and isinstance(port.valid, Signal)]
     if not readies or not valids:
         return {}
-    text = rtlil.convert(dut, name="dut", emit_src=False)
+    # (an always-ready stream's ``ready`` is a constant, which cannot be a port)
+    signals = [value for _path, _member, value in dut.signature.flatten(dut) if isinstance(value, Signal)]
+    text = rtlil.convert(dut, name="dut", ports=signals, emit_src=False)
     script = ["read_rtlil dut.il", "hierarchy -top dut", "proc", "flatten", "opt_clean"]
     for valid in valids:
         for ready in readies:
