@@ -35,8 +35,9 @@ from ..countdown import Countdown
 from ..counter import Counter
 from ..limbs import pipelined_sum
 from ..registers import DURATION_BITS, Registers, Source, TriggerMode
+from .frame_offer import Offer
 from .layouts import COUNTER_BITS, event, group_bits
-from .planner import START, Offer
+from .planner import START
 
 __all__ = ["FrameControl"]
 
@@ -69,7 +70,7 @@ class FrameControl(wiring.Component):
     at_rest : Out(1)
         No frame plays and no load is under way: before the first frame, or every group loaded
         and waiting for a trigger (as registered the cycle before, less this cycle's decisions).
-    offer : In(:class:`~gateware.dlpc410.planner.Offer`)
+    offer : In(:class:`~gateware.dlpc410.frame_offer.Offer`)
         The frame the store offers.
     playing, ended : In(1)
         From the planner.

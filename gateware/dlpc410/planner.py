@@ -4,7 +4,8 @@ Each group (:func:`spec.registers.group_size` blocks pulsed together) keeps its 
 frame (display position, dark or not), whether it is loaded and plays, the frame it shows
 (:mod:`.group_frames`) and its times (:mod:`.group_times`); :mod:`.plane_info` works out ahead
 what each group's next pulse does (the plane's length against ``hide``, the time to the pulse
-after it), and :mod:`.reset_watch` watches RST_ACTIVE.
+after it), :mod:`.reset_watch` watches RST_ACTIVE, :mod:`.frame_offer` registers the store's
+offer and :mod:`.load_jobs` forms the load jobs.
 
 The bus decides a pulse (``choice``) from flags the planner registered the cycle before
 (``due``, ``imminent``, ``writable``); on that cycle the planner decides what the pulse does
@@ -18,7 +19,7 @@ is applied on its cycle.
 counted in), for the frame control, which counts in its own.
 """
 
-from amaranth import Array, Cat, Module, Mux, Signal
+from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -27,25 +28,15 @@ from spec.schedule import row_cycles
 from ..counter import Counter
 from ..registers import LSB_BITS, Registers, Source
 from ..store.layouts import SLOT_BITS, FrameInfo, Showing
+from .frame_offer import FrameOffer, Offer
 from .group_frames import GroupFrames
 from .group_times import GroupTimes
 from .layouts import COUNTER_BITS, event, group_bits, load_job
+from .load_jobs import LoadJobs
 from .plane_info import PlaneInfo
 from .reset_watch import ResetWatch
-from .timebase import exponent, stored_plane
 
-__all__ = ["Planner", "Offer", "START"]
-
-
-class Offer(data.Struct):
-    """The frame the store offers now: ``valid`` when it has a bit depth the sequencer plays and
-    no one is taking it; ``sequence`` when it is the next frame of a stored sequence (it does not
-    replace a frame waiting for its trigger); ``showing``, its sequence entry's settings."""
-    valid: 1
-    slot: SLOT_BITS
-    depth: 4
-    sequence: 1
-    showing: Showing
+__all__ = ["Planner", "START"]
 
 
 #: What the frame control's ``start`` begins: a frame, and whether it is the one offered.
@@ -185,7 +176,6 @@ class Planner(wiring.Component):
         dmd, regs = self._dmd, self.regs
         R = row_cycles(dmd, self._beats)
         G = dmd.blocks
-        gb = group_bits(dmd)
         use_prng = regs.source == Source.PRNG
         active = self.active
 
@@ -207,55 +197,20 @@ class Planner(wiring.Component):
         m.d.comb += [self.depth.eq(first.depth),
                      self.lsb.eq(Mux(first.showing.lsb != 0, first.showing.lsb, regs.lsb))]
 
-        # ---- the frame offered: the store's offer as of the cycle before (registered: the
-        # decisions that read it start from flip-flops), free to take unless a take is being
-        # answered; a frame taken is answered while the store still offers it (a stream holds
-        # its payload until the transfer), and one with a bad bit depth is dropped at once ----
-        depth_in = self.frames.payload.bit_depth
-        frame_ok = (depth_in != 0) & (depth_in <= 8)
+        # ---- the frame offered: taken by group 0 (last cycle), or by a start or retake now ----
+        m.submodules.offers = offers = FrameOffer()
+        wiring.connect(m, wiring.flipped(self.frames), offers.frames)
         taking = Signal()                      # group 0 took the offered frame last cycle
-        answered = taking | (self.start.valid & self.start.payload.take) | \
-            (self.retake.valid & self.retake.payload.newer)
-        held = Signal(Offer)
-        m.d.sync += [held.valid.eq(self.frames.valid & frame_ok & ~answered),
-                     held.slot.eq(self.frames.payload.slot), held.depth.eq(depth_in),
-                     held.sequence.eq(self.frames.payload.sequence),
-                     held.showing.eq(self.frames.payload.showing)]
-        m.d.comb += [self.offer.eq(held), self.offer.valid.eq(held.valid & ~answered),
-                     self.frames.ready.eq(answered | (self.frames.valid & ~frame_ok))]
-        m.d.comb += [frames.offered.slot.eq(held.slot), frames.offered.depth.eq(held.depth),
-                     frames.offered.showing.eq(held.showing)]
-        m.submodules.bad = bad = Counter(COUNTER_BITS)
-        bad_seen = Signal()
-        m.d.sync += bad_seen.eq(self.frames.valid & ~frame_ok)
-        m.d.comb += [bad.inc.eq(bad_seen), self.bad_frames.eq(bad.count)]
+        m.d.comb += [offers.answered.eq(taking | (self.start.valid & self.start.payload.take)
+                                        | (self.retake.valid & self.retake.payload.newer)),
+                     self.offer.eq(offers.offer), self.bad_frames.eq(offers.bad_frames),
+                     frames.offered.slot.eq(offers.offer.slot), frames.offered.depth.eq(offers.offer.depth),
+                     frames.offered.showing.eq(offers.offer.showing)]
 
         # ---- the decision: what the pulse the bus chooses does (registered) ----
         P = self.choice
         usable = self.offer.valid & ~use_prng
-        offered_follow = self.offer.showing.follow
-        hidden, final = Signal(G), Signal(G)
-        for g in range(G):
-            # the frame after this one starts without a trigger: chained, or it follows (group 0
-            # takes the one offered, if any); never after a sequence's last frame
-            ends_sequence = frames.frame[g].showing.last
-            follows_next = (regs.chain | frames.next.showing.follow) & ~ends_sequence
-            if g == 0:
-                follows_offered = (regs.chain | offered_follow) & ~ends_sequence
-                follow = Mux(usable, follows_offered, follows_next)
-            else:
-                follow = follows_next
-            # the next plane is loaded behind this one; at a frame's end only if the frame after
-            # follows and this one wants no dark time
-            m.d.comb += [
-                hidden[g].eq((~dark[g] & info.big[g] & ~info.last[g])
-                             | (~dark[g] & info.big[g] & info.keeps_dark[g] & follow)),
-                final[g].eq(dark[g] & info.last[g] & ~follow),
-            ]
-        # group 0 takes the frame offered at its frame's last pulse, dark or hiding the next
-        # (which, being the offered frame's first plane, follows as the offered frame says)
-        takes_offered = info.last[0] & (dark[0] | (info.big[0] & info.keeps_dark[0] & ~frames.frame[0].showing.last
-                                                    & (regs.chain | offered_follow)))
+        hidden, final, takes_offered = self._outcomes(m, info, frames, dark, usable)
         # the reset mode's last group (its groups are 0 .. n - 1)
         last_group = Cat(active[g] & (~active[g + 1] if g + 1 < G else 1) for g in range(G))
         decided = Signal(G)                    # the pulse decided last cycle, applied now
@@ -307,22 +262,14 @@ class Planner(wiring.Component):
         with m.If(ends_seq):
             m.d.sync += ended.eq(1)
 
-        # ---- the load job, from the group's new state (and a first plane queued), registered;
-        # the stored plane it reads worked out on the stage after ----
-        job = Signal(load_job(dmd))
-        job_due, job_group, job_formed = Signal(), Signal(gb), Signal()
-        m.d.sync += [job_due.eq(decided_any),
-                     job_group.eq(Cat(Cat(decided[g] for g in range(G) if g >> b & 1).any()
-                                      for b in range(gb))),
-                     job_formed.eq(job_due | self.queue_first.valid)]
-        with m.If(job_due):
-            kept = frames.frame[job_group]
-            m.d.sync += [job.group.eq(job_group), job.slot.eq(kept.slot), job.depth.eq(kept.depth),
-                         job.pos.eq(Array(pos)[job_group]), job.clear.eq(dark.bit_select(job_group, 1))]
-        job_exp = exponent(m, regs, job.pos, job.depth, "job_exp")
-        job_out, job_valid = Signal(load_job(dmd)), Signal()
-        m.d.sync += [job_valid.eq(job_formed), job_out.eq(job), job_out.plane.eq(stored_plane(job.depth, job_exp))]
-        m.d.comb += [self.jobs.valid.eq(job_valid), self.jobs.payload.eq(job_out)]
+        # ---- the load job, from the group's new state (and a first plane queued) ----
+        m.submodules.load_jobs = jobs = LoadJobs(dmd)
+        wiring.connect(m, wiring.flipped(self.queue_first), jobs.queue_first)
+        wiring.connect(m, jobs.jobs, wiring.flipped(self.jobs))
+        m.d.comb += [jobs.regs.eq(regs), jobs.pulse.eq(decided), jobs.pulse_any.eq(decided_any),
+                     jobs.dark.eq(dark), jobs.next.eq(frames.next)]
+        for g in range(G):
+            m.d.comb += [jobs.pos[g].eq(pos[g]), jobs.frame[g].eq(frames.frame[g])]
 
         # ---- the frame control's events ----
         with m.If(self.start.valid):
@@ -330,9 +277,6 @@ class Planner(wiring.Component):
             m.d.comb += [every.valid.eq(1), every.payload.slot.eq(begin.slot), every.payload.depth.eq(begin.depth),
                          every.payload.showing.eq(begin.showing)]
             m.d.sync += [ended.eq(0), dark.eq(0)] + [pos[g].eq(0) for g in range(G)]
-        with m.If(self.queue_first.valid):
-            m.d.sync += [job.group.eq(self.queue_first.payload), job.slot.eq(frames.next.slot),
-                         job.depth.eq(frames.next.depth), job.pos.eq(0), job.clear.eq(0)]
         abandon = self.retake.valid & self.retake.payload.abandon
         with m.If(self.retake.valid):
             newer = self.retake.payload.newer
@@ -351,7 +295,7 @@ class Planner(wiring.Component):
         m.d.comb += [
             self.playing.eq((active & pending & ~ends_play).any()),
             self.ended.eq(ended | ends_seq),
-            self.job_due.eq(job_due | job_formed | job_valid),
+            self.job_due.eq(jobs.due),
         ]
         # every group loaded and waiting, registered from this cycle's changes: a trigger or a
         # retake makes it false; else each group of the mode neither playing nor pulsing now
@@ -376,3 +320,33 @@ class Planner(wiring.Component):
                              & Mux(self.lead_over & ~self.retake.valid, (1 << G) - 1, 0)),
         ]
         return m
+
+    def _outcomes(self, m, info, frames, dark, usable):
+        """What each group's next pulse does: ``hidden`` (bit g: it shows a plane and the next
+        one is loaded behind it), ``final`` (bit g: its dark pulse ends the group's play), and
+        ``takes_offered`` (group 0's pulse takes the frame offered, if ``usable``)."""
+        regs, G = self.regs, self._dmd.blocks
+        offered_follow = self.offer.showing.follow
+        hidden, final = Signal(G), Signal(G)
+        for g in range(G):
+            # the frame after this one starts without a trigger: chained, or it follows (group 0
+            # takes the one offered, if any); never after a sequence's last frame
+            ends_sequence = frames.frame[g].showing.last
+            follows_next = (regs.chain | frames.next.showing.follow) & ~ends_sequence
+            if g == 0:
+                follows_offered = (regs.chain | offered_follow) & ~ends_sequence
+                follow = Mux(usable, follows_offered, follows_next)
+            else:
+                follow = follows_next
+            # the next plane is loaded behind this one; at a frame's end only if the frame after
+            # follows and this one wants no dark time
+            m.d.comb += [
+                hidden[g].eq((~dark[g] & info.big[g] & ~info.last[g])
+                             | (~dark[g] & info.big[g] & info.keeps_dark[g] & follow)),
+                final[g].eq(dark[g] & info.last[g] & ~follow),
+            ]
+        # group 0 takes the frame offered at its frame's last pulse, dark or hiding the next
+        # (which, being the offered frame's first plane, follows as the offered frame says)
+        takes_offered = info.last[0] & (dark[0] | (info.big[0] & info.keeps_dark[0] & ~frames.frame[0].showing.last
+                                                    & (regs.chain | offered_follow)))
+        return hidden, final, takes_offered

@@ -29,7 +29,7 @@ waiting for words that will not come, and gets the words read before the loss fi
 
 Pipeline (every path between flip-flops within the ``dmd`` budget of :mod:`flow.timing`): a
 request is taken into registers (``IDLE``), its first row looked up and its sums formed
-(``CHECK``), then checked and gathered into runs (``GATHER``); a run's address is its slot and
+(``CHECK``), then checked and gathered into runs (``GATHER``, :mod:`.runs`); a run's address is its slot and
 plane's start (a small table) plus its rows' offset, and its bursts are counted down in
 registers; the counts of words asked for and owed step by a burst and a word in one carry chain
 each. A request's first command leaves three cycles after it is taken (``valid`` and ``ready``
@@ -42,35 +42,16 @@ from amaranth import Cat, Const, DomainRenamer, Module, Mux, Signal
 from amaranth.lib import stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
-from amaranth.utils import ceil_log2, exact_log2
+from amaranth.utils import exact_log2
 
-from ..counter import Counter
 from . import mcb
 from .addresses import PLANES, AddressMap
 from .layouts import SLOT_BITS, PlaneRequest
 from .read_fifo import ReadFifo
+from .runs import Runs
 from .slot_maps import RowLookupSignature
 
 __all__ = ["Reader"]
-
-
-def _times(value, factor):
-    """``value * factor`` as shifts of ``value``, at most two of them added or subtracted: one
-    carry chain at most, never a multiplier (``factor``: a row's port words)."""
-    terms, shift = [], 0
-    while factor:
-        if factor & 1:
-            digit = 2 - (factor & 3)           # the non-adjacent form: +1 or -1
-            terms.append((digit, value << shift))
-            factor -= digit
-        factor >>= 1
-        shift += 1
-    assert 1 <= len(terms) <= 2, "a row's port words: a power of two, or the sum or difference of two"
-    terms.sort(key=lambda term: -term[0])      # the positive term first
-    result = terms[0][1]
-    for digit, term in terms[1:]:
-        result = result + term if digit > 0 else result - term
-    return result
 
 
 def _trailing_zeros(n):
@@ -129,7 +110,7 @@ class Reader(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        dmd, port, src = self._dmd, self.mcb, self.sources
+        dmd, port = self._dmd, self.mcb
         word_bytes = port.signature.word_bytes
         depth = self._fifo_depth * 64 // self._width           # port words
         row_words = dmd.words_per_row * 64 // self._width      # port words per row
@@ -207,102 +188,32 @@ class Reader(wiring.Component):
                 m.d.sync += [address[burst_bits:].eq(address[burst_bits:] + 1),
                              before_last.eq(before_last - 1), is_last.eq(before_last == 1)]
 
-        # the request taken, and the run gathered from it, loaded into the above when ``emit``
-        taken = Signal(PlaneRequest)
-        emit = Signal()
-        run_source, run_off = Signal(SLOT_BITS), Signal(range(plane_words))
-        run_words = Signal(range(plane_words + 1))
-        run_single = Signal()                    # run_words <= MAX_BURST (one burst)
+        # ---- requests into runs (:mod:`.runs`), each loaded into the above when given ----------
+        m.submodules.runs = runs = Runs(dmd, slots=self._slots, row_words=row_words, max_burst=mcb.MAX_BURST)
+        wiring.connect(m, wiring.flipped(self.requests), runs.requests)
+        wiring.connect(m, runs.sources, wiring.flipped(self.sources))
+        m.d.comb += [runs.busy.eq(issuing), self.bad_requests.eq(runs.bad_requests)]
+        run = runs.run
         m.submodules.starts = starts_rom = Memory(shape=address_bits - low, depth=len(starts),
                                                   init=[start >> low for start in starts])
         start = starts_rom.read_port(domain="comb")
-        run_last = run_words - 1
-        m.d.comb += start.addr.eq(Cat(taken.plane, run_source))
-        with m.If(emit):
+        run_last = run.words - 1
+        m.d.comb += start.addr.eq(Cat(run.plane, run.slot))
+        with m.If(runs.emit):
             m.d.sync += [
                 issuing.eq(1),
-                address[:low].eq(run_off[:low]),
-                address[low:].eq(start.data + run_off[low:]),
+                address[:low].eq(run.off[:low]),
+                address[low:].eq(start.data + run.off[low:]),
                 last_bl.eq(run_last[:burst_bits]),
                 before_last.eq(run_last[burst_bits:]),
-                is_last.eq(run_single),
+                is_last.eq(run.single),
             ]
-
-        # ---- requests into runs -------------------------------------------------------------
-        # the request fits the frame: a slot of the store and some rows, none past the last
-        # (two flags: each is a short path from the request's registers)
-        some, within = Signal(), Signal()
-        look = Signal(ceil_log2(dmd.rows))       # the row looked up on ``sources``
-        # the row decided on (a delta's walk: two behind ``look``): its offset in port words,
-        # the request's rows from it on, and whether it is the request's last
-        row_off = Signal(range(plane_words))
-        left = Signal(range(dmd.rows + 1))
-        last = Signal()
-        run_open = Signal()
-        # the row map's answers a stage later, for a delta's walk: the row's source, and whether
-        # the row before showed the same (so that the walk decides from registers alone)
-        row_source, same = Signal(SLOT_BITS), Signal()
-        m.d.comb += [src.slot.eq(taken.slot), src.row.eq(look)]
-        with m.If(src.en):
-            # (every lookup steps on to the next row, but while a delta's row waits)
-            m.d.sync += [look.eq(look + 1), row_source.eq(src.source), same.eq(src.source == row_source)]
-        m.submodules.bad = bad = Counter(16)
-        m.d.comb += self.bad_requests.eq(bad.count)
-
-        # The steps of a request, a flag each (one-hot: a decision on the step is a LUT input of
-        # its own, not a state to decode): IDLE takes it; CHECK looks its first row up and forms
-        # its sums; GATHER has the first row's answer: a whole frame's request is one run, a
-        # delta's WALKs its rows one a cycle, a run for each stretch of rows from one slot, and
-        # FLUSHes the last run.
-        idle = Signal(init=1)
-        check, gather, walk, flush = Signal(), Signal(), Signal(), Signal()
-        request = self.requests.payload
-        whole = ~src.delta
-        fits = some & within
-        joins = run_open & same
-        # a row that ends the run before it waits (the row map's answers held) until the commands
-        # take that run
-        advance = joins | ~run_open | ~issuing
-        m.d.comb += [
-            self.requests.ready.eq(idle),
-            src.en.eq(~walk | advance),
-            bad.inc.eq(gather & ~fits),
-            emit.eq(~issuing & (gather & fits & whole | walk & run_open & ~same | flush)),
-        ]
-        m.d.sync += [
-            idle.eq(idle & ~self.requests.valid | gather & ~fits | gather & whole & ~issuing | flush & ~issuing),
-            check.eq(idle & self.requests.valid),
-            gather.eq(check | gather & fits & whole & issuing),
-            walk.eq(gather & fits & ~whole | walk & ~(advance & last)),
-            flush.eq(walk & advance & last | flush & issuing),
-        ]
-        with m.If(idle):
-            # (every cycle: nothing uses them before a request is taken)
-            m.d.sync += [taken.eq(request), look.eq(request.first_row)]
-        with m.If(check):
-            first, count = taken.first_row, taken.row_count
-            m.d.sync += [
-                some.eq((taken.slot < self._slots) & (count != 0)), within.eq(first + count <= dmd.rows),
-                row_off.eq(_times(first, row_words)), left.eq(count), last.eq(count == 1),
-                # the request as one run (a whole frame's)
-                run_source.eq(taken.slot), run_off.eq(_times(first, row_words)),
-                run_words.eq(_times(count, row_words)), run_single.eq(count <= mcb.MAX_BURST // row_words),
-                run_open.eq(0),
-            ]
-        with m.If(walk & advance):
-            m.d.sync += [row_off.eq(row_off + row_words), left.eq(left - 1), last.eq(left == 2), run_open.eq(1)]
-            with m.If(joins):
-                m.d.sync += [run_words.eq(run_words + row_words),
-                             run_single.eq(run_words <= mcb.MAX_BURST - row_words)]
-            with m.Else():
-                m.d.sync += [run_source.eq(row_source), run_off.eq(row_off), run_words.eq(row_words),
-                             run_single.eq(row_words <= mcb.MAX_BURST)]
 
         # answering with zeros from the loss until the store has recovered and nothing is owed,
         # between requests (one taken in that very cycle is taken after the recovery: it is read)
         with m.If(lost):
             m.d.sync += zero.eq(1)
-        with m.Elif(idle & ~issuing & (owed == 0)):
+        with m.Elif(runs.idle & ~issuing & (owed == 0)):
             m.d.sync += zero.eq(0)
         if self._domain != "sync":
             return DomainRenamer({"sync": self._domain})(m)

@@ -1,0 +1,81 @@
+"""The load jobs: what a group must be loaded with next, after its pulse or when its first plane
+is queued.
+
+The cycle after a pulse is applied, the group's new state (its frame, display position, dark)
+is registered as a job; a first plane queued (the frame taken next, position 0) replaces it in
+that cycle. The stored plane the job reads is worked out on the stage after, and the job leaves.
+"""
+
+from amaranth import Cat, Module, Signal
+from amaranth.lib import data, wiring
+from amaranth.lib.wiring import In, Out
+
+from ..registers import Registers
+from .group_frames import FRAME
+from .layouts import event, group_bits, load_job
+from .timebase import exponent, stored_plane
+
+__all__ = ["LoadJobs"]
+
+
+class LoadJobs(wiring.Component):
+    """Load jobs from the groups' state (``sync``).
+
+    Parameters
+    ----------
+    dmd : :class:`spec.facts.DmdType`
+
+    Members
+    -------
+    regs : In(:class:`~gateware.registers.Registers`)
+        ``order``, ``order_table``.
+    pulse : In(blocks); pulse_any : In(1)
+        Bit g: group g's pulse is applied now (one bit at most); some bit of ``pulse``.
+    pos : In(ArrayLayout(3, blocks)); dark : In(blocks); frame : In(ArrayLayout(FRAME, blocks))
+        Each group's display position, whether its next pulse is a dark one, and its frame.
+    queue_first : In(event(group)); next : In(FRAME)
+        Queue the group's first plane of ``next``, the frame taken next.
+    jobs : Out(event(load_job))
+        Load jobs, two cycles after their pulse or their queueing.
+    due : Out(1)
+        A job is on its way (it leaves in a cycle or two).
+    """
+
+    def __init__(self, dmd):
+        self._dmd = dmd
+        G = dmd.blocks
+        super().__init__({
+            "regs": In(Registers),
+            "pulse": In(G),
+            "pulse_any": In(1),
+            "pos": In(data.ArrayLayout(3, G)),
+            "dark": In(G),
+            "frame": In(data.ArrayLayout(FRAME, G)),
+            "queue_first": In(event(group_bits(dmd))),
+            "next": In(FRAME),
+            "jobs": Out(event(load_job(dmd))),
+            "due": Out(1),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        dmd, G, gb = self._dmd, self._dmd.blocks, group_bits(self._dmd)
+        job = Signal(load_job(dmd))
+        pulsed, group, formed = Signal(), Signal(gb), Signal()
+        m.d.sync += [pulsed.eq(self.pulse_any),
+                     group.eq(Cat(Cat(self.pulse[g] for g in range(G) if g >> b & 1).any() for b in range(gb))),
+                     formed.eq(pulsed | self.queue_first.valid)]
+        with m.If(pulsed):
+            kept = self.frame[group]
+            m.d.sync += [job.group.eq(group), job.slot.eq(kept.slot), job.depth.eq(kept.depth),
+                         job.pos.eq(self.pos[group]),
+                         job.clear.eq(self.dark.bit_select(group, 1))]
+        with m.If(self.queue_first.valid):
+            m.d.sync += [job.group.eq(self.queue_first.payload), job.slot.eq(self.next.slot),
+                         job.depth.eq(self.next.depth), job.pos.eq(0), job.clear.eq(0)]
+        e = exponent(m, self.regs, job.pos, job.depth, "job_exp")
+        out, valid = Signal(load_job(dmd)), Signal()
+        m.d.sync += [valid.eq(formed), out.eq(job), out.plane.eq(stored_plane(job.depth, e))]
+        m.d.comb += [self.jobs.valid.eq(valid), self.jobs.payload.eq(out),
+                     self.due.eq(pulsed | formed | valid)]
+        return m
