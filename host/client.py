@@ -4,8 +4,9 @@ What it does for the user:
 
 * **Record size.** Records must travel unfragmented (the projector drops fragments). The client
   sends with the don't-fragment flag, takes the path MTU the operating system knows for the
-  projector (or the ``mtu`` it is given) and sizes image records to fill it: 1,458 pixels a
-  record on an ordinary 1,500-byte MTU, 8,958 on a jumbo path. A record that does not fit (the
+  projector (or the ``mtu`` it is given) and sizes image records to fill it: 1,462 pixels a
+  record on an ordinary 1,500-byte MTU, 8,962 on a jumbo path (a delta frame's records, 1,458
+  and 8,958). A record that does not fit (the
   path turned out narrower, or ``mtu`` was too large) raises :class:`ClientError` saying so.
 * **Frame ids.** Before its first frame the client reads a status reply and continues after the
   newest frame id the projector has handed on, so a restarted sender is never refused as old
@@ -169,7 +170,7 @@ class Client:
         self._sock.settimeout(timeout)
         self.mtu = mtu or path_mtu(self._sock) or 1500
         self.limit = records.record_limit(self.mtu)
-        if self.limit <= records.IMAGE_HEADER:
+        if self.limit <= records.DELTA_HEADER:
             raise ClientError(f"an MTU of {self.mtu} bytes leaves no room for pixels")
         self._paced_since = None
         self._paced_bytes = 0

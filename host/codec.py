@@ -26,20 +26,23 @@ def header(record_type, sequence):
                                        "type": record_type, "sequence": sequence & SEQUENCE_MASK})
 
 
-def pixels_per_record(limit=DEFAULT_LIMIT):
-    """Pixels an image record of at most ``limit`` bytes carries: 1,458 in a 1500-byte MTU,
-    8,958 in a 9,000-byte one."""
-    pixels = limit - records.IMAGE_HEADER
+def pixels_per_record(limit=DEFAULT_LIMIT, *, delta=False):
+    """Pixels an image record of at most ``limit`` bytes carries: 1,462 in a 1500-byte MTU,
+    8,962 in a 9,000-byte one; a delta record, four fewer (it names its base and row count)."""
+    pixels = limit - (records.DELTA_HEADER if delta else records.IMAGE_HEADER)
     if pixels < 1:
         raise ValueError(f"a {limit}-byte record has no room for pixels")
     return pixels
 
 
 def image_record(frame, offset, pixels, sequence=0, *, base=0, carried=0):
-    """One image record: ``pixels`` (bytes) of frame ``frame`` from position ``offset``; a record
-    of a delta frame names its ``base`` and the rows the delta ``carried`` (0: a whole frame)."""
-    body = wire.pack(records.IMAGE, {"frame": frame & 0xFFFF, "base": base & 0xFFFF, "carried": carried,
-                                     "offset": offset})
+    """One record of ``pixels`` (bytes) of frame ``frame`` from position ``offset``: an image
+    record of a whole frame, or (``carried`` rows, not 0) a delta record naming its ``base``."""
+    if carried:
+        body = wire.pack(records.DELTA, {"frame": frame & 0xFFFF, "base": base & 0xFFFF, "carried": carried,
+                                         "offset": offset})
+        return header(RecordType.DELTA, sequence) + body + bytes(pixels)
+    body = wire.pack(records.IMAGE, {"frame": frame & 0xFFFF, "offset": offset})
     return header(RecordType.IMAGE, sequence) + body + bytes(pixels)
 
 
@@ -86,7 +89,7 @@ def image_records(image, frame, *, sequence=0, limit=DEFAULT_LIMIT, pixels=None,
             raise ValueError(f"a delta carries 1 to {height} rows of the image, got {rows.tolist()}")
         runs, carried = _runs(rows), rows.size
     flat = np.ascontiguousarray(image).reshape(-1).tobytes()
-    step = pixels or pixels_per_record(limit)
+    step = pixels or pixels_per_record(limit, delta=bool(carried))
     spans = [(offset, min(offset + step, end * columns))
              for first, end in runs for offset in range(first * columns, end * columns, step)]
     return [image_record(frame, start, flat[start:stop], sequence + i, base=base, carried=carried)
@@ -162,6 +165,7 @@ def status_reply(sequence, values):
 
 _BODIES = {
     RecordType.IMAGE: records.IMAGE,
+    RecordType.DELTA: records.DELTA,
     RecordType.CONTROL: records.CONTROL,
     RecordType.STATUS_QUERY: [],
     RecordType.STATUS_REPLY: records.STATUS_REPLY,
@@ -172,7 +176,7 @@ _BODIES = {
 
 def decode(raw):
     """A record's bytes (a whole UDP payload) -> ``(header, body, rest)``: two dicts and the
-    bytes after the body (an image record's pixels). Raises :class:`ProtocolError` on anything
+    bytes after the body (an image or delta record's pixels). Raises :class:`ProtocolError` on anything
     malformed."""
     raw = bytes(raw)
     n = wire.size(records.HEADER)
@@ -189,10 +193,10 @@ def decode(raw):
         raise ProtocolError(f"unknown record type {head['type']}") from None
     table = _BODIES[kind]
     size = n + wire.size(table)
-    if len(raw) < size + (kind == RecordType.IMAGE):
-        raise ProtocolError(f"record type {head['type']} needs {size + (kind == RecordType.IMAGE)} bytes, "
-                            f"got {len(raw)}")
-    if kind != RecordType.IMAGE and len(raw) != size:
+    pixels = kind in (RecordType.IMAGE, RecordType.DELTA)
+    if len(raw) < size + pixels:
+        raise ProtocolError(f"record type {head['type']} needs {size + pixels} bytes, got {len(raw)}")
+    if not pixels and len(raw) != size:
         raise ProtocolError(f"record type {head['type']} is {size} bytes, got {len(raw)}")
     body = wire.unpack(table, raw[n:]) if table else {}
     return head, body, raw[size:]

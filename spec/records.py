@@ -15,9 +15,11 @@ store's bit depth and sequence, arming, the network addresses.
 
 __all__ = [
     "MAGIC", "VERSION", "RecordType", "Action", "ENTRIES",
-    "HEADER", "IMAGE", "CONTROL", "CONFIG", "SEQUENCER", "ENTRY", "entry_faults", "config_faults",
+    "HEADER", "IMAGE", "DELTA", "CONTROL", "CONFIG", "SEQUENCER", "ENTRY", "entry_faults", "delta_faults",
+    "config_faults",
     "NET_COUNTERS", "RECORD_COUNTERS",
     "ROW_COUNTERS", "GEOMETRY", "APP_COUNTERS", "SYSTEM_STATUS", "STATUS_REPLY", "IMAGE_HEADER",
+    "DELTA_HEADER",
     "MAX_RECORD", "UDP_IP_OVERHEAD", "record_limit", "frame_newer",
     "register_wire", "registers_bits", "register_faults",
 ]
@@ -33,7 +35,7 @@ from .wire import size
 MAGIC = 0x444D
 #: Protocol version this tree speaks; records with any other version are dropped and counted.
 #: ``magic`` and ``version`` keep their places in every version, so that a projector can tell.
-VERSION = 6
+VERSION = 7
 #: IPv4 and UDP headers around a record: a record fills an MTU less these.
 UDP_IP_OVERHEAD = 28
 #: Largest record: a UDP payload inside a 9000-byte IP MTU (9000 - 20 IPv4 - 8 UDP).
@@ -47,6 +49,7 @@ class RecordType(_enum.IntEnum):
     STATUS_REPLY = 4
     SEQUENCER = 5
     ENTRY = 6
+    DELTA = 7
 
 
 class Action(_enum.IntFlag):
@@ -67,15 +70,21 @@ HEADER = [
 ]
 
 #: Image record body (after :data:`HEADER`), followed by its pixel bytes: the rest of the
-#: datagram, consecutive pixels of the frame (row by row, left to right) from ``offset``.
-#: A whole frame carries every row (``carried`` 0, ``base`` unused). A delta frame carries only
-#: the rows that differ from ``base``, a whole frame the projector holds; it takes every other row,
-#: and its bit depth, from that frame. Every record of one frame has the same ``base`` and
-#: ``carried``.
+#: datagram, consecutive pixels of a whole frame (row by row, left to right) from ``offset``.
 IMAGE = [
     ("frame", 16),       # frame id (serial-number order: see frame_newer)
-    ("base", 16),        # a delta: the whole frame whose rows it keeps where it carries none
-    ("carried", 16),     # a delta: how many distinct rows it carries (1..rows); 0: a whole frame
+    ("offset", 24),      # position of the first pixel carried: row * columns + column
+]
+
+#: Delta record body (after :data:`HEADER`), followed by its pixel bytes as an image record's.
+#: A delta frame carries only the rows that differ from ``base``, a whole frame the projector
+#: holds; it takes every other row, and its bit depth, from that frame. Every record of one
+#: frame has the same ``base`` and ``carried``. A record type of its own, so that a whole
+#: frame's records do not carry these four bytes (a 1,500-byte MTU's record keeps 1,462 pixels).
+DELTA = [
+    ("frame", 16),       # frame id (serial-number order: see frame_newer)
+    ("base", 16),        # the whole frame whose rows it keeps where it carries none
+    ("carried", 16),     # how many distinct rows it carries (1..rows)
     ("offset", 24),      # position of the first pixel carried: row * columns + column
 ]
 
@@ -141,17 +150,17 @@ NET_COUNTERS = [
 
 #: Counters kept by the protocol parser (records, by outcome).
 RECORD_COUNTERS = [
-    ("records_image", 32),
+    ("records_image", 32),     # image and delta records
     ("records_control", 32),   # control records applied
     ("records_sequencer", 32), # sequencer records passed on (applied when the sequencer rests)
     ("records_status", 32),
     ("drop_app_magic", 32),    # not a record of this protocol
     ("drop_app_version", 32),
     ("drop_app_type", 32),
-    ("drop_app_empty", 32),    # an image record without pixels
+    ("drop_app_empty", 32),    # an image or delta record without pixels
     ("drop_app_length", 32),   # the datagram shorter than its type's header, or not its type's size
     ("drop_app_rows", 32),     # pixels beyond the frame
-    ("drop_app_value", 32),    # a control, sequencer or entry record with a value it cannot obey
+    ("drop_app_value", 32),    # a control, sequencer, entry record with a value it cannot obey; a delta of no rows
     ("records_entry", 32),     # sequence entry records written to the table
     ("sequence_gaps", 32),     # records whose sequence number was not the previous + 1
 ]
@@ -278,6 +287,13 @@ def register_faults(wire, row_cycles, clear_row_cycles):
     return faults
 
 
+def delta_faults(wire):
+    """Why a delta record cannot be taken (``{check: condition}``, as :func:`register_faults`):
+    it carries no rows (a whole frame goes as image records). A count beyond the frame's rows is
+    the store's to refuse with the frame's rows (``store_rows_refused``)."""
+    return {"carried": wire["carried"] == 0}
+
+
 def entry_faults(wire, sequence_length):
     """Why an entry record cannot be written (``{check: condition}``, as
     :func:`register_faults`): its index beyond the table, a slot outside the sequence in force
@@ -307,6 +323,8 @@ def config_faults(wire, applies):
 
 #: Bytes of an image record before its pixels.
 IMAGE_HEADER = size(HEADER) + size(IMAGE)
+#: Bytes of a delta record before its pixels.
+DELTA_HEADER = size(HEADER) + size(DELTA)
 
 
 def record_limit(mtu):

@@ -13,7 +13,7 @@ import pytest
 from host import Client, ClientError, cli, codec, levels
 from sim.models.net import Model
 from sim.models.slots import SlotPolicy
-from spec import records, wire
+from spec import records
 from spec.facts import DMDS, TEST_DMD
 from spec.registers import TriggerMode
 
@@ -53,8 +53,8 @@ class FakeProjector:
             self.received.append(raw)
             replies_before, rows_before = len(self.model.replies), len(self.model.rows)
             if self.model.record(raw) == "image":
-                body = wire.unpack(records.IMAGE, raw[wire.size(records.HEADER):])
-                self.kinds[body["frame"]] = (body["base"], body["carried"])
+                body = codec.decode(raw)[1]
+                self.kinds[body["frame"]] = (body.get("base", 0), body.get("carried", 0))
             for frame, row, data in self.model.rows[rows_before:]:
                 complete = self.store.counters["frames_complete"]
                 base, carried = self.kinds[frame]
@@ -107,7 +107,7 @@ def test_send_image_and_status(projector):
         sent = client.send_image(image, frame=3)
         client.control(armed=1, software_trigger=True)
         status = client.status()
-    # 12,288 pixels in records of 1,458 (a 1500-byte MTU): 9 records, rows split between them
+    # 12,288 pixels in records of 1,462 (a 1500-byte MTU): 9 records, rows split between them
     assert (sent.frame, sent.depth, sent.records, sent.error_lsb) == (3, 8, 9, 0.0)
     assert status["records_image"] == 9 and status["records_control"] == 2   # the depth, then arming
     assert status["rows"] == TEST_DMD.rows and status["sequence_gaps"] == 0 and status["rows_incomplete"] == 0
@@ -127,16 +127,16 @@ def test_records_fill_the_path_mtu(projector):
     with Client("127.0.0.1", projector.port, mtu=2000) as client:
         client.send_image(image)
     sizes = [len(raw) for raw in projector.received if raw[3] == records.RecordType.IMAGE]
-    # 12,288 pixels: 8,958 + 3,330 in jumbo records, 6 x 1,958 + 540 in records for a 2,000-byte MTU,
-    # each with its 14-byte header
-    assert sizes == [8972, 3344] + [1972] * 6 + [554]
+    # 12,288 pixels: 8,962 + 3,326 in jumbo records, 6 x 1,962 + 516 in records for a 2,000-byte MTU,
+    # each with its 10-byte header
+    assert sizes == [8972, 3336] + [1972] * 6 + [526]
 
 
 def test_a_record_too_large_for_the_path_is_a_clear_error(projector):
     """The don't-fragment flag is set: a record larger than the path allows is refused by the
     system, and the client says what to do."""
     with Client("127.0.0.1", projector.port, check=False) as client:
-        with pytest.raises(ClientError, match="a 65604-byte record does not fit the path .* give mtu="):
+        with pytest.raises(ClientError, match="a 65600-byte record does not fit the path .* give mtu="):
             client.send_records([codec.image_record(1, 0, bytes(65590))])
 
 

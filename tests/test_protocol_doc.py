@@ -24,6 +24,7 @@ def table_rows(table, start):
 def test_doc_tables_match_fields():
     header = wire.size(records.HEADER)
     expected = (table_rows(records.HEADER, 0) + table_rows(records.IMAGE, header)
+                + table_rows(records.DELTA, header)
                 + table_rows(records.CONTROL, header) + table_rows(records.SEQUENCER, header)
                 + table_rows(records.ENTRY, header) + table_rows(records.STATUS_REPLY, header))
     assert doc_rows() == expected

@@ -26,7 +26,8 @@ def test_pack_rejects_bad_values():
         wire.pack(records.HEADER, {"colour": 1})
 
 
-@pytest.mark.parametrize("table", [records.HEADER, records.IMAGE, records.CONTROL, records.STATUS_REPLY])
+@pytest.mark.parametrize("table", [records.HEADER, records.IMAGE, records.DELTA, records.CONTROL,
+                                   records.STATUS_REPLY])
 def test_gateware_view_reads_host_bytes(table):
     """The struct view the gateware puts on received bytes reads what the host packed, and the
     bytes the gateware writes are what the host unpacks."""
@@ -40,14 +41,17 @@ def test_gateware_view_reads_host_bytes(table):
     assert isinstance(layout(table), data.StructLayout)
 
 
-@pytest.mark.parametrize("mtu, pixels", [(1500, 1458), (9000, 8958)])
+@pytest.mark.parametrize("mtu, pixels", [(1500, 1462), (9000, 8962)])
 def test_record_sizes_fill_the_mtu(mtu, pixels):
-    """A record fills the MTU less the IPv4 and UDP headers; its own header is 14 bytes."""
-    assert records.IMAGE_HEADER == 14
-    assert records.record_limit(mtu) == mtu - 28
-    assert codec.pixels_per_record(records.record_limit(mtu)) == pixels
-    assert len(codec.image_records(np.zeros((16, 1024), np.uint8), 0, limit=records.record_limit(mtu))[0]) == \
-        records.record_limit(mtu)
+    """A record fills the MTU less the IPv4 and UDP headers; its own header is 10 bytes for a
+    whole frame's image record, 14 for a delta record (which names its base and row count)."""
+    assert (records.IMAGE_HEADER, records.DELTA_HEADER) == (10, 14)
+    limit = records.record_limit(mtu)
+    assert limit == mtu - 28
+    assert codec.pixels_per_record(limit) == pixels and codec.pixels_per_record(limit, delta=True) == pixels - 4
+    image = np.arange(16 * 1024, dtype=np.uint32).astype(np.uint8).reshape(16, 1024)
+    assert len(codec.image_records(image, 0, limit=limit)[0]) == limit
+    assert len(codec.image_records(image, 1, limit=limit, base=0, rows=range(16))[0]) == limit
 
 
 @pytest.mark.parametrize("mtu", [1500, 9000])
@@ -64,7 +68,7 @@ def test_image_records_round_trip(mtu):
     assert bytes(rebuilt) == image.tobytes()
 
 
-@pytest.mark.parametrize("pixels", [100, 1024, codec.pixels_per_record(records.record_limit(1500))])
+@pytest.mark.parametrize("pixels", [100, 1024, codec.pixels_per_record(records.record_limit(1500), delta=True)])
 def test_delta_records_carry_the_changed_rows(pixels):
     """A delta frame's records carry exactly the rows that differ from its base, each run of
     consecutive rows in consecutive records (rows split as a whole frame's), every record naming
@@ -94,8 +98,13 @@ def test_delta_records_carry_the_changed_rows(pixels):
 
 
 def test_whole_frame_records_name_no_base():
-    bodies = [codec.decode(record)[1] for record in codec.image_records(np.ones((4, 8), np.uint8), 3, pixels=5)]
-    assert [(b["frame"], b["base"], b["carried"]) for b in bodies] == [(3, 0, 0)] * 7
+    """A whole frame goes as image records (type 1: no base, no row count), a delta as delta
+    records (type 7)."""
+    decoded = [codec.decode(record) for record in codec.image_records(np.ones((4, 8), np.uint8), 3, pixels=5)]
+    assert [(h["type"], b) for h, b, _ in decoded] == \
+        [(records.RecordType.IMAGE, {"frame": 3, "offset": 5 * i}) for i in range(7)]
+    delta = codec.image_records(np.ones((4, 8), np.uint8), 4, pixels=5, base=3, rows=[2])
+    assert [codec.decode(record)[0]["type"] for record in delta] == [records.RecordType.DELTA] * 2
 
 
 @pytest.mark.parametrize("kwargs, message", [

@@ -33,7 +33,7 @@ def test_system_small_geometry():
     assert status["store_frames_abandoned"] == 1
     # bad frames interleaved with each of the scene's frames and the first fault frame
     assert status["mac_bad_fcs"] == status["drop_udp_port"] == n + 1
-    assert status["drop_app_value"] == 4 * (n + 1) and status["drop_app_length"] == n + 1
+    assert status["drop_app_value"] == 5 * (n + 1) and status["drop_app_length"] == n + 1
     assert status["records_sequencer"] == 2 and status["records_control"] == 2
 
 

@@ -2,14 +2,16 @@
 
 One UDP datagram carries one record (see ``docs/protocol.md``). The parser collects the common
 header and the type's own header, checks them all against each other, against the datagram's
-length and against the DMD geometry, and only then acts: an image record's rows go to the
-row assembler (:class:`~gateware.protocol.rows.RowAssembler`) as pixels with their position in
+length and against the DMD geometry, and only then acts: an image or delta record's pixels go
+to the row assembler (:class:`~gateware.protocol.rows.RowAssembler`) as pixels with their position in
 the frame, a control record updates :attr:`Parser.settings`, a sequencer record's register set
 leaves whole on :attr:`Parser.registers`, a sequence entry record on :attr:`Parser.entries`, a
 status query asks
 :class:`~gateware.protocol.status.StatusReply` for an answer. A record that fails a check is
 consumed and counted under its cause and has no other effect.
 """
+
+from types import SimpleNamespace
 
 from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
@@ -31,10 +33,11 @@ CONFIG_LAYOUT = layout(records.CONFIG)
 ENTRY_LAYOUT = layout(records.ENTRY)
 _HEADER = wire.size(records.HEADER)
 _IMAGE_END = _HEADER + wire.size(records.IMAGE)
+_DELTA_END = _HEADER + wire.size(records.DELTA)
 _CONTROL_END = _HEADER + wire.size(records.CONTROL)
 _SEQUENCER_END = _HEADER + wire.size(records.SEQUENCER)
 _ENTRY_END = _HEADER + wire.size(records.ENTRY)
-_CAPTURED = max(_IMAGE_END, _CONTROL_END, _SEQUENCER_END, _ENTRY_END)
+_CAPTURED = max(_IMAGE_END, _DELTA_END, _CONTROL_END, _SEQUENCER_END, _ENTRY_END)
 _SEQUENCE_BITS = dict(records.HEADER)["sequence"]
 
 
@@ -67,7 +70,7 @@ class Parser(wiring.Component):
     datagrams : In(stream.Signature(Datagram))
         Committed UDP payloads from :class:`gateware.net.stack.Stack`.
     pieces : Out(stream.Signature(piece_layout(dmd)))
-        The pixels of valid image records, one per transfer, in order, each with its frame id
+        The pixels of valid image and delta records, one per transfer, in order, each with its frame id
         and position in the frame, where its record ends and whether it is the record's first.
     settings : Out(layout(records.CONFIG))
         The configuration registers; control records update the fields they select.
@@ -84,7 +87,8 @@ class Parser(wiring.Component):
     queries : Out(stream.Signature(Query))
         Valid status queries, for the status reply.
     counters : Out(layout(records.RECORD_COUNTERS))
-        Records accepted per type, dropped per cause, sequence gaps.
+        Records accepted per type (image and delta records together), dropped per cause,
+        sequence gaps.
     """
 
     def __init__(self, dmd, config, *, beats=1):
@@ -104,11 +108,11 @@ class Parser(wiring.Component):
     #: Why a record is dropped, in the order the checks are made (``drop_app_<cause>``).
     _CAUSES = ["magic", "version", "type", "empty", "length", "rows", "value"]
 
-    def _cause(self, m, header, image, control, sequencer, entry, length, needed):
+    def _cause(self, m, header, pixels, delta, control, sequencer, entry, length, needed):
         """The first check the record in ``captured`` fails: 1 + its index in :attr:`_CAUSES`,
-        or 0 when it passes every one."""
+        or 0 when it passes every one. ``pixels``: where an image or delta record's pixels go."""
         dmd = self._dmd
-        is_image = header.type == RecordType.IMAGE
+        is_image = (header.type == RecordType.IMAGE) | (header.type == RecordType.DELTA)
         cause = Signal(range(8))
         causes = self._CAUSES
         names = [name for name, _ in records.CONFIG]
@@ -121,7 +125,7 @@ class Parser(wiring.Component):
             m.d.comb += cause.eq(1 + causes.index("version"))
         with m.Elif(Cat(header.type == kind for kind in (RecordType.IMAGE, RecordType.CONTROL,
                                                          RecordType.STATUS_QUERY, RecordType.SEQUENCER,
-                                                         RecordType.ENTRY)).any() == 0):
+                                                         RecordType.ENTRY, RecordType.DELTA)).any() == 0):
             m.d.comb += cause.eq(1 + causes.index("type"))
         with m.Elif(length < needed):
             m.d.comb += cause.eq(1 + causes.index("length"))
@@ -129,8 +133,10 @@ class Parser(wiring.Component):
             m.d.comb += cause.eq(1 + causes.index("empty"))
         with m.Elif(~is_image & (length != needed)):
             m.d.comb += cause.eq(1 + causes.index("length"))
-        with m.Elif(is_image & (image.offset + (length - _IMAGE_END) > dmd.rows * dmd.columns)):
+        with m.Elif(is_image & (pixels.until > dmd.rows * dmd.columns)):
             m.d.comb += cause.eq(1 + causes.index("rows"))
+        with m.Elif((header.type == RecordType.DELTA) & Cat(records.delta_faults(delta).values()).any()):
+            m.d.comb += cause.eq(1 + causes.index("value"))
         with m.Elif((header.type == RecordType.CONTROL) & Cat(records.config_faults(control, applies).values()).any()):
             m.d.comb += cause.eq(1 + causes.index("value"))
         with m.Elif((header.type == RecordType.ENTRY)
@@ -141,6 +147,23 @@ class Parser(wiring.Component):
                                                     dmd.clear_row_cycles).values()).any()):
             m.d.comb += cause.eq(1 + causes.index("value"))
         return cause
+
+    def _pixels(self, m, header, image, delta, length, needed):
+        """Where an image or delta record's pixels go: ``offset``, ``until`` (one past the last),
+        and the delta's ``base`` and ``carried`` (both 0 for a whole frame's image record; a
+        row count beyond the frame is kept as rows + 1, for the store to refuse)."""
+        piece = self.pieces.payload
+        # (``until`` as wide as the sum: the frame check must not see it wrap)
+        out = SimpleNamespace(offset=Signal.like(image.offset), until=Signal(len(image.offset) + 1),
+                              base=Signal.like(piece.base), carried=Signal.like(piece.carried))
+        rows = self._dmd.rows
+        with m.If(header.type == RecordType.DELTA):
+            m.d.comb += [out.offset.eq(delta.offset), out.base.eq(delta.base),
+                         out.carried.eq(Mux(delta.carried > rows, rows + 1, delta.carried))]
+        with m.Else():
+            m.d.comb += out.offset.eq(image.offset)
+        m.d.comb += out.until.eq(out.offset + (length - needed))
+        return out
 
     def elaborate(self, platform):
         m = Module()
@@ -157,6 +180,7 @@ class Parser(wiring.Component):
                              byte_slice(captured, _CAPTURED, first, wire.size(table)))
         header = part(records.HEADER, 0)
         image = part(records.IMAGE, _HEADER)
+        delta = part(records.DELTA, _HEADER)
         control = part(records.CONTROL, _HEADER)
         sequencer = part(records.SEQUENCER, _HEADER)
         entry = part(records.ENTRY, _HEADER)
@@ -181,6 +205,8 @@ class Parser(wiring.Component):
         with m.Switch(header.type):
             with m.Case(RecordType.IMAGE):
                 m.d.comb += needed.eq(_IMAGE_END)
+            with m.Case(RecordType.DELTA):
+                m.d.comb += needed.eq(_DELTA_END)
             with m.Case(RecordType.CONTROL):
                 m.d.comb += needed.eq(_CONTROL_END)
             with m.Case(RecordType.SEQUENCER):
@@ -189,15 +215,8 @@ class Parser(wiring.Component):
                 m.d.comb += needed.eq(_ENTRY_END)
             with m.Default():
                 m.d.comb += needed.eq(_HEADER)
-        # one past the image record's last pixel
-        until = Signal.like(self.pieces.payload.until)
-        m.d.comb += until.eq(image.offset + (length - _IMAGE_END))
-        # a delta's row count beyond the frame is kept as rows + 1, for the store to refuse
-        carried = Signal.like(self.pieces.payload.carried)
-        rows = self._dmd.rows
-        m.d.comb += carried.eq(Mux(image.carried > rows, rows + 1, image.carried))
-
-        cause = self._cause(m, header, image, control, sequencer, entry, length, needed)
+        pixels = self._pixels(m, header, image, delta, length, needed)
+        cause = self._cause(m, header, pixels, delta, control, sequencer, entry, length, needed)
         causes = self._CAUSES
 
         sequence_seen = Signal()
@@ -227,8 +246,8 @@ class Parser(wiring.Component):
                         bump("sequence_gaps")
                     m.d.sync += [sequence_seen.eq(1), sequence_last.eq(header.sequence)]
                     with m.Switch(header.type):
-                        with m.Case(RecordType.IMAGE):
-                            m.d.sync += [position.eq(image.offset), first.eq(1)]
+                        with m.Case(RecordType.IMAGE, RecordType.DELTA):
+                            m.d.sync += [position.eq(pixels.offset), first.eq(1)]
                             m.next = "PIXELS"
                         with m.Case(RecordType.CONTROL):
                             bump("records_control")
@@ -253,10 +272,10 @@ class Parser(wiring.Component):
                     self.pieces.valid.eq(self.datagrams.valid),
                     self.pieces.payload.data.eq(beat.data),
                     self.pieces.payload.frame.eq(image.frame),
-                    self.pieces.payload.base.eq(image.base),
-                    self.pieces.payload.carried.eq(carried),
+                    self.pieces.payload.base.eq(pixels.base),
+                    self.pieces.payload.carried.eq(pixels.carried),
                     self.pieces.payload.position.eq(position),
-                    self.pieces.payload.until.eq(until),
+                    self.pieces.payload.until.eq(pixels.until),
                     self.pieces.payload.first.eq(first),
                     self.datagrams.ready.eq(self.pieces.ready),
                 ]

@@ -1,11 +1,12 @@
 """Ethernet ingest figures.
 
 End to end (:func:`port_at_line_rate`): the whole Ethernet side (:class:`gateware.protocol.port.
-EthernetPort`, GMII MAC + stack + protocol) as generated Verilog under Verilator and cocotb, an
-XGA image in image records as large as the MTU, back to back at the minimum gap on the GMII
+EthernetPort`, GMII MAC + stack + protocol) as generated Verilog under Verilator and cocotb, XGA
+images in image records as large as the MTU, back to back at the minimum gap on the GMII
 receive pins (:mod:`sim.tb.ethernet_bench`), for an ordinary 1500-byte MTU and for jumbo frames
 (9,000). This gives the payload rate (pixel bytes over the line's bytes, preamble, FCS and gap
-included, over a whole image), the XGA image rate, the drops and the commit latency.
+included: an image's pixels over the time between two images' first pixels handed on), the XGA
+image rate, the drops and the commit latency.
 
 Stack alone (:func:`endpoint_at_line_rate`, Amaranth simulator): the endpoint fed at GMII
 timing: one byte per cycle, and between frames the 8 preamble/SFD, 4 FCS and 12 inter-frame gap

@@ -48,6 +48,12 @@ def _image_body(offset=0, count=COLUMNS):
     return wire.pack(records.IMAGE, {"frame": 2, "offset": offset}) + bytes(count)
 
 
+def _delta(offset=0, count=COLUMNS, carried=1):
+    """A delta record of frame 3 on base 2 (type and body)."""
+    body = wire.pack(records.DELTA, {"frame": 3, "base": 2, "carried": carried, "offset": offset})
+    return {"record_type": records.RecordType.DELTA, "body": body + bytes(count)}
+
+
 #: A register set the sequencer can obey (a plan for the test DMD), as the record's wire values.
 PLAN = schedule.plan(DMD, 200e6, t_rst_s=200e-9, t_settle_s=300e-9, reset_mode=ResetMode.DUAL)
 GOOD_WIRE = records.register_wire(PLAN.params.registers(DMD))
@@ -88,6 +94,10 @@ BAD_RECORDS = {
     "status_query_too_long": (codec.status_query() + b"\0", "drop_app_length"),
     "pixels_beyond_frame": (_record(body=_image_body(offset=PIXELS - COLUMNS + 1)), "drop_app_rows"),
     "offset_beyond_frame": (_record(body=_image_body(offset=PIXELS, count=1)), "drop_app_rows"),
+    "delta_without_pixels": (_record(**_delta(count=0)), "drop_app_empty"),
+    "truncated_delta_header": (_record(**_delta())[:HEADER + 8], "drop_app_length"),
+    "delta_pixels_beyond_frame": (_record(**_delta(offset=PIXELS - COLUMNS + 1)), "drop_app_rows"),
+    "delta_without_rows": (_record(**_delta(carried=0)), "drop_app_value"),
     "bit_depth_out_of_range": (codec.control_record(bit_depth=9, armed=1), "drop_app_value"),
     "armed_not_a_bit": (codec.control_record(armed=2), "drop_app_value"),
     "sequence_length_zero": (codec.control_record(sequence_length=0), "drop_app_value"),

@@ -143,6 +143,7 @@ class Model:
     def _record(self, data, peer):
         header_size = wire.size(records.HEADER)
         sizes = {RecordType.IMAGE: records.IMAGE_HEADER,
+                 RecordType.DELTA: records.DELTA_HEADER,
                  RecordType.CONTROL: header_size + wire.size(records.CONTROL),
                  RecordType.SEQUENCER: header_size + wire.size(records.SEQUENCER),
                  RecordType.ENTRY: header_size + wire.size(records.ENTRY),
@@ -158,15 +159,20 @@ class Model:
             return "drop_app_type"
         if len(data) < sizes[kind]:
             return "drop_app_length"
-        if kind == RecordType.IMAGE and len(data) == sizes[kind]:
+        has_pixels = kind in (RecordType.IMAGE, RecordType.DELTA)
+        if has_pixels and len(data) == sizes[kind]:
             return "drop_app_empty"
-        if kind != RecordType.IMAGE and len(data) != sizes[kind]:
+        if not has_pixels and len(data) != sizes[kind]:
             return "drop_app_length"
-        if kind == RecordType.IMAGE:
-            image = wire.unpack(records.IMAGE, data[header_size:])
+        if has_pixels:
+            image = wire.unpack(records.IMAGE if kind == RecordType.IMAGE else records.DELTA,
+                                data[header_size:])
             pixels = data[sizes[kind]:]
             if image["offset"] + len(pixels) > self.dmd.rows * self.dmd.columns:
                 return "drop_app_rows"
+            # (the protocol page's rule: a delta carries at least one row)
+            if kind == RecordType.DELTA and image["carried"] == 0:
+                return "drop_app_value"
         if kind == RecordType.CONTROL:
             control = wire.unpack(records.CONTROL, data[header_size:])
             names = [name for name, _ in records.CONFIG]
@@ -195,7 +201,7 @@ class Model:
         if self._sequence is not None and head["sequence"] != (self._sequence + 1) & mask:
             self.count("sequence_gaps")
         self._sequence = head["sequence"]
-        if kind == RecordType.IMAGE:
+        if has_pixels:
             self.count("records_image")
             tag = (1 << self.frame_bits) - 1
             for frame, row, row_bytes in self.assembler.record(image["frame"], image["offset"], pixels):

@@ -184,7 +184,7 @@ def image_frames(picture, frame, rows_per_record, rows, *, pixels=None):
 
 @cocotb.test()
 async def good_traffic_back_to_back(dut):
-    """Image records of 1 and 3 rows and of 1,458 pixels (a 1500-byte MTU's, rows split), ICMP
+    """Image records of 1 and 3 rows and of 1,462 pixels (a 1500-byte MTU's, rows split), ICMP
     echoes of random size, ARP, status queries and 9,018-byte frames for another port, back to
     back at the minimum gap: 64 to 9,018 bytes on the line. Every row arrives intact, every reply
     is right, nothing is dropped for room."""
@@ -226,9 +226,17 @@ def _with_header(record, **changes):
 
 
 def _with_image_fields(record, **changes):
-    size, end = wire.size(records.HEADER), wire.size(records.HEADER) + wire.size(records.IMAGE)
+    size, end = wire.size(records.HEADER), records.IMAGE_HEADER
     body = {**wire.unpack(records.IMAGE, record[size:end]), **changes}
     return record[:size] + wire.pack(records.IMAGE, body) + record[end:]
+
+
+def _as_delta(record, carried):
+    """``record`` (a whole frame's image record) as a delta record of the same pixels."""
+    size, end = wire.size(records.HEADER), records.IMAGE_HEADER
+    head = {**wire.unpack(records.HEADER, record[:size]), "type": records.RecordType.DELTA}
+    body = {**wire.unpack(records.IMAGE, record[size:end]), "base": 0, "carried": carried}
+    return wire.pack(records.HEADER, head) + wire.pack(records.DELTA, body) + record[end:]
 
 
 def bad_frames(dmd, record):
@@ -251,6 +259,7 @@ def bad_frames(dmd, record):
         "image_without_pixels": (record[:records.IMAGE_HEADER], "drop_app_empty"),
         "truncated_header": (record[:wire.size(records.HEADER) - 1], "drop_app_length"),
         "pixels_beyond_frame": (_with_image_fields(record, offset=dmd.rows * dmd.columns - 1), "drop_app_rows"),
+        "delta_without_rows": (_as_delta(record, carried=0), "drop_app_value"),
     }
     for name, (bad, counter) in malformed.items():
         out.append((name, gmii(frames.udp(A, bad)), ("app", counter)))

@@ -1,13 +1,16 @@
 """cocotb benchmark run of the whole Ethernet side (:class:`gateware.protocol.port.EthernetPort`) on
-its generated Verilog: one XGA image in image records as large as the MTU (parameter ``mtu``)
-sent back to back at the minimum gap on the GMII receive pins, then the first record of the next
-image; ``sync`` at 125 MHz shifted 0.7 ns from the PHY clock, the pixel consumer always ready.
-Writes its figures as JSON to the ``out`` parameter.
+its generated Verilog: two XGA images in image records as large as the MTU (parameter ``mtu``)
+sent back to back at the minimum gap on the GMII receive pins, then the first record of a third;
+``sync`` at 125 MHz shifted 0.7 ns from the PHY clock, the pixel consumer always ready. Writes
+its figures as JSON to the ``out`` parameter.
 
-Payload rate: the pixels of the first image over the line time from its first pixel handed on to
-the next image's first pixel handed on (both records start a row, so the pipeline's latency is the
-same at both ends): the line's time for every record of a whole image, preamble, FCS and gap
-included, the last (short) record too.
+Payload rate: the pixels of one image over the time from the second image's first pixel handed
+on to the third's: a stream's period, the line's time for every record of a whole image
+(preamble, FCS and gap included, the last short record too). It is taken between the second and
+the third image, not from the first, because each image's start waits behind the one before it
+in the same way (its last record completes a row split across two records, and that row goes
+out whole before the record's own: a drain the first image, with nothing ahead of it, does
+not see).
 
 Commit latency: for each record that starts a row, the ``sync`` rising edges from the one after
 the receive MAC samples the record's last FCS byte (the ``gmii_rx`` edge after the source drives
@@ -16,8 +19,7 @@ first transfer is the earliest effect of the record outside the block and the mo
 starts flowing on: the stack holds the frame until its FCS verdict, so nothing of it leaves before.
 The first record's (``latency_first``) is the pipeline's own: nothing is ahead of it. A later
 record that starts a row may wait behind the rows before it (``latency_max``): a row split across
-the two records before it goes on only once its last piece has come, and the next image's record
-comes right after a shorter one that is still flowing out.
+the two records before it goes on only once its last piece has come.
 """
 
 import json
@@ -42,12 +44,14 @@ async def line_rate(dut):
     limit = records.record_limit(p["mtu"])
     picture = np.random.default_rng(8).integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8)
     encoded = codec.image_records(picture, 1, limit=limit)
-    following = codec.image_records(picture[:1], 2, limit=limit, sequence=len(encoded))[0]
+    n = len(encoded)
+    second = codec.image_records(picture, 2, limit=limit, sequence=n)
+    following = codec.image_records(picture, 3, limit=limit, sequence=2 * n)[0]
     fcs_sampled = []
-    gmii_frames = [gmii(frames.udp(A, r)) for r in encoded + [following]]
+    gmii_frames = [gmii(frames.udp(A, r)) for r in encoded + second + [following]]
     for frame in gmii_frames:
         frame.tx_complete = lambda sent: fcs_sampled.append(sent.sim_time_end + GMII_PS)
-    await bench.send(gmii_frames, timeout_ms=100)
+    await bench.send(gmii_frames, timeout_ms=200)
     await bench.settle()
 
     got = bench.counters()
@@ -56,11 +60,12 @@ async def line_rate(dut):
     arrived = set(delivered)
 
     def rows_of(i):
-        """The rows record ``i`` carries a piece of (the last one: the next image's row 0)."""
-        if i == len(encoded):
-            return [(2, 0)]
-        first, end = i * pixels, min((i + 1) * pixels, picture.size)
-        return [(1, row) for row in range(first // dmd.columns, -(-end // dmd.columns))]
+        """The rows record ``i`` carries a piece of (the last one: the third image's row 0)."""
+        image, j = divmod(i, n)
+        if image == 2:
+            return [(3, 0)]
+        first, end = j * pixels, min((j + 1) * pixels, picture.size)
+        return [(image + 1, row) for row in range(first // dmd.columns, -(-end // dmd.columns))]
 
     # a record is intact when every row it carries a piece of arrived whole (rows are handed on
     # whole: a lost record loses the rows it touches)
@@ -68,12 +73,11 @@ async def line_rate(dut):
                  for i in range(len(gmii_frames)))
     row_start = {(frame, row): t for (frame, row, _data), t in zip(delivered, bench.row_starts, strict=True)}
     # the records that start a row (their first pixel is the row's), and when that pixel left
-    starting = {i: rows_of(i)[0] for i in range(len(gmii_frames))
-                if i == len(encoded) or i * pixels % dmd.columns == 0}
+    starting = {i: rows_of(i)[0] for i in range(len(gmii_frames)) if i % n * pixels % dmd.columns == 0}
     latency = {i: math.ceil((row_start[row] - fcs_sampled[i]) / sync_ps) for i, row in starting.items()
                if row in row_start}
     latencies = list(latency.values())
-    span = row_start.get((2, 0), 0) - row_start.get((1, 0), 0)
+    span = row_start.get((3, 0), 0) - row_start.get((2, 0), 0)
     with open(p["out"], "w") as f:
         json.dump({
             "records": len(gmii_frames), "intact": intact, "frame_bytes": len(gmii_frames[0].data) - 8,

@@ -267,6 +267,8 @@ def bad_records(system, picture):
         codec.control_record(system.next_sequence(), bit_depth=9),
         wire.pack(records.HEADER, {**head, "version": records.VERSION + 1}) + image[n:],
         image[:n] + wire.pack(records.IMAGE, {**body, "offset": system.dmd.rows * system.dmd.columns}) + image[end:],
+        wire.pack(records.HEADER, {**head, "type": records.RecordType.DELTA})          # a delta of no rows
+        + wire.pack(records.DELTA, {**body, "base": 0, "carried": 0}) + image[end:],
     ]
 
 
