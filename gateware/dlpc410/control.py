@@ -307,13 +307,16 @@ class FrameControl(wiring.Component):
         periodic = regs.trigger == TriggerMode.PERIODIC
 
         # the reload bound (spec.schedule.reload_cycles), from the registers: a product and two
-        # sums, each registered (the registers hold still)
-        row_period, product = Signal(8), Signal(20)
-        lead, bound = Signal(17), Signal(21)
+        # sums, each registered (the registers hold still); no carry chain over 16 bits: the
+        # product from the rows' low and high bytes, the sums in limbs
+        rows = flush_rows(dmd) + dmd.rows
+        row_period, by_low, by_high, product = Signal(8), Signal(16), Signal(12), Signal(21)
         m.d.sync += [row_period.eq(Mux(regs.row_period > R, regs.row_period, R)),
-                     product.eq(row_period * (flush_rows(dmd) + dmd.rows)),
-                     lead.eq(regs.reload_lead + reload_cycles(dmd, self._beats, 0, 0)),
-                     bound.eq(product + lead)]
+                     by_low.eq(row_period * (rows & 0xFF)), by_high.eq(row_period * (rows >> 8)),
+                     product.eq(Cat(by_low[:8], by_low[8:] + by_high))]
+        lead, _ = pipelined_sum(m, [regs.reload_lead] * 2, lambda k: Const(reload_cycles(dmd, self._beats, 0, 0), 16),
+                                0, "lead")
+        bound, _ = pipelined_sum(m, [product] * 2, lambda k: Cat(lead, Const(0, 4)), 0, "bound")
 
         # the interval of each trigger counted
         m.submodules.since = since = Counter(DURATION_BITS, restart_value=1)

@@ -9,11 +9,13 @@ older one not yet sent; from there they cross through a small :class:`amaranth.l
 telling the sequencer to load its first plane again under the new registers.
 """
 
-from amaranth import Module, Signal
+from amaranth import DomainRenamer, Module, Signal
 from amaranth.lib import fifo, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from gateware.registers import Registers
+
+from ..counter import Counter
 
 __all__ = ["RegisterCrossing"]
 
@@ -72,7 +74,9 @@ class RegisterCrossing(wiring.Component):
             m.d.sync += full.eq(0)
 
         # ---- dmd: applied whole, while the sequencer rests ----
+        m.submodules.applied = applied = DomainRenamer({"sync": "dmd"})(Counter(len(self.applied)))
+        m.d.comb += [self.applied.eq(applied.count), applied.inc.eq(out.valid & self.at_rest)]
         with m.If(out.valid & self.at_rest):
             m.d.comb += [out.ready.eq(1), self.reload.eq(1)]
-            m.d.dmd += [self.regs.eq(out.payload), self.applied.eq(self.applied + 1)]
+            m.d.dmd += self.regs.eq(out.payload)
         return m
