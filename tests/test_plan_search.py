@@ -39,8 +39,9 @@ def test_the_finders_plan_plays_at_its_period_on_the_gateware(test_name):
     others exact in every level (global) or the rule model silent (phased)."""
     found = plan_search.find(TEST_DMD, 200e6, workers=1, trigger_hold=True, **FAST)
     assert found.best.order == PlaneOrder.MSB_FIRST
-    period, _ = measured_rate("test", found.best.reset_mode.name, True, 200e6, plan=found.plan, name=test_name)
+    period, _, error = measured_rate("test", found.best.reset_mode.name, True, 200e6, plan=found.plan, name=test_name)
     assert period == found.plan.frame_cycles
+    assert error in (None, 0.0)      # global: every level of the frame exact
 
 
 def test_cli_configure_best_prints_the_search_and_sends_the_fastest(capsys):

@@ -10,16 +10,15 @@ Each figure is given in cycles or Hz at 200 MHz DCLK, and again at 400 MHz (``_4
 that come from the schedule model's plans end in ``_model``; the measured rate of frames played
 back to back on the gateware is ``sys.xga_rate_hz_measured`` (:mod:`sim.bench.system_xga`).
 
-Grey error (:func:`gray_error_table`): the schedule model's global MSB-first 8-bit frame of the
-ramp image on the DLP7000 (the case the cocotb test proves equal to the gateware, command for
-command and pixel for pixel, on full XGA) is played through the rule-checking DLPC410 model
-with the facts' RST_ACTIVE and settle times (so every plan is also checked against every rule),
-and the camera model (4 us crossover ramp) integrates a window as long as the frame's light
-(first pulse to the end of the last mirror motion), shifted by a misalignment from the first
-pulse. LSB times from the shortest legal one up to 16 times it; ``build/seq_gray_error.csv``
-and ``build/seq_gray_error.png``. ``seq.gray_error_lsb_at_max_rate_phased``: the same at the
-fastest single-block plan (loose RST_ACTIVE reading, the phased mode the cocotb test runs on
-XGA), window holding the frame.
+Grey error (:func:`gray_error_table`): a global MSB-first 8-bit frame of the ramp image on the
+DLP7000, played by the sequencer's generated Verilog (:mod:`sim.seq_rig`), its pins replayed
+through the rule-checking DLPC410 model with the facts' RST_ACTIVE and settle times (so every
+plan is also checked against every rule), and the camera model (4 us crossover ramp)
+integrates a window as long as the frame's light (first pulse to the end of the last mirror
+motion), shifted by a misalignment from the first pulse. LSB times from the shortest legal one
+up to 16 times it; ``build/seq_gray_error.csv`` and ``build/seq_gray_error.png``.
+``seq.gray_error_lsb_at_max_rate_phased``: the same at the fastest single-block plan (loose
+RST_ACTIVE reading, the phased mode the cocotb test runs on XGA), window holding the frame.
 """
 
 import numpy as np
@@ -28,8 +27,7 @@ from gateware.dlpc410.trigger import PIN_TO_STROBE
 from sim.bench.tables import pyplot, write_table
 from sim.harness.paths import build_dir
 from sim.models.camera import Camera, to_lsb
-from sim.models.dlpc410 import Dlpc410
-from sim.models.dlpc410_driver import Driver, play_schedule
+from sim.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import run_bench
 from spec import schedule
@@ -133,31 +131,31 @@ MISALIGN_US = (-5, -1, 0, 1, 5, 20)
 MISALIGN_FIGURE_US = 1
 
 
-def played_frame(plan):
-    """One triggered frame of ``plan`` (schedule model) played through the DLPC410 model: the
-    model, the frame's first and last pulse cycles, and the image shown."""
+def played_frame(plan, dclk, name):
+    """One triggered frame of ``plan`` played by the sequencer's generated Verilog (:mod:`sim.seq_rig`,
+    the store stand-in feeding rows at the DDR2's row rate for ``dclk``), its pins replayed through
+    the rule-checking DLPC410 model: the model, the frame's first and last pulse cycles, and the
+    image stored."""
     p = plan.params
-    frame = schedule.Frame(0, 8)
-    result = schedule.simulate(XGA, p, [frame], [schedule.ready_cycle(XGA, p, frame)])
-    model = Dlpc410(XGA, beats=p.beats, clock_hz=schedule.FABRIC_HZ, init_cycles=16,
-                    strict_rst_active=p.strict_rst)
-    driver = Driver(XGA, p.beats)
-    driver.start(16)
-    image = ramp_image(XGA, 0)
-    play_schedule(driver, XGA, p, result, {0: image}, model.ecp2_cycles + 16)
-    model.run(driver.items)
-    pulses = [c.cycle for c in model.log if c.kind == "pulse"]
-    return model, pulses[0], pulses[-1], image
+    ready = max(g.loaded_at for g in schedule.simulate(XGA, p, [schedule.Frame(0, 8)]).groups)
+    # on past the last pulse's mirror motion (a 4 us crossover) and beyond a window shifted late
+    cycles = ready + plan.frame_cycles + round((10 + max(MISALIGN_US)) * 1e-6 * schedule.FABRIC_HZ)
+    run = run_rig(XGA, p, [(0, 8)], pins=[ready - PIN_TO_STROBE], cycles=cycles,
+                  store_words=schedule.row_rate_words(XGA, dclk), name=name)
+    (first, last), = run.frames()
+    return run.model, first, last, ramp_image(XGA, 0)
 
 
 def gray_error_table(dclk=200e6):
-    """Rows of (lsb cycles, frame cycles, rate Hz, misalignment us, max LSB, RMS LSB)."""
-    fastest = schedule.plan(XGA, dclk)
+    """Rows of (lsb cycles, frame cycles, rate Hz, misalignment us, max LSB, RMS LSB), each LSB
+    time's frame played on the gateware."""
+    words = schedule.row_rate_words(XGA, dclk)
+    fastest = schedule.plan(XGA, dclk, words_per_cycle=words)
     rows = []
     for factor in LSB_FACTORS:
         plan = fastest if factor == 1 else schedule.plan(
-            XGA, dclk, exposure_s=factor * fastest.params.lsb / schedule.FABRIC_HZ)
-        model, first, last, image = played_frame(plan)
+            XGA, dclk, words_per_cycle=words, exposure_s=factor * fastest.params.lsb / schedule.FABRIC_HZ)
+        model, first, last, image = played_frame(plan, dclk, f"bench_gray_error_{factor:g}")
         camera = Camera(model)
         span = last + camera.delay + camera.ramp - first
         for us in MISALIGN_US:
@@ -203,12 +201,13 @@ def gray_error_figures():
     aligned = next(r for r in at_max if r[3] == 0)
     off = next(r for r in at_max if r[3] == MISALIGN_FIGURE_US)
     # phased (single-block pulses, loose RST_ACTIVE reading: the cocotb test's mode on XGA)
-    phased = schedule.plan(XGA, 200e6, reset_mode=ResetMode.SINGLE, strict_rst=False)
-    model, first, last, image = played_frame(phased)
+    phased = schedule.plan(XGA, 200e6, reset_mode=ResetMode.SINGLE, strict_rst=False,
+                           words_per_cycle=schedule.row_rate_words(XGA, 200e6))
+    model, first, last, image = played_frame(phased, 200e6, "bench_gray_error_phased")
     camera = Camera(model)
     seen = to_lsb(camera.image(first, last + camera.delay + camera.ramp), phased.params.lsb)
     return {
-        "seq.gray_error_lsb_at_max_rate_phased": (float(np.abs(seen - image).max()), "LSB"),
+        "seq.gray_error_lsb_at_max_rate_phased": (float(np.abs(seen - image[:, :XGA.visible_columns]).max()), "LSB"),
         "seq.gray_error_lsb_at_max_rate": (aligned[4], "LSB"),
         "seq.gray_error_rms_lsb_at_max_rate": (aligned[5], "LSB"),
         f"seq.gray_error_rms_lsb_misaligned_{MISALIGN_FIGURE_US}us": (off[5], "LSB"),
