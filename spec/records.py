@@ -33,7 +33,7 @@ from .wire import size
 MAGIC = 0x444D
 #: Protocol version this tree speaks; records with any other version are dropped and counted.
 #: ``magic`` and ``version`` keep their places in every version, so that a projector can tell.
-VERSION = 6
+VERSION = 7
 #: IPv4 and UDP headers around a record: a record fills an MTU less these.
 UDP_IP_OVERHEAD = 28
 #: Largest record: a UDP payload inside a 9000-byte IP MTU (9000 - 20 IPv4 - 8 UDP).
@@ -104,6 +104,8 @@ SEQUENCER = [(f.name, -(-f.bits // 8) * 8) for f in _registers.FIELDS]
 #: ``slot`` with a least significant plane of ``lsb`` cycles (0: the sequencer register's), at
 #: least ``dark`` cycles dark after it before a frame that follows it, and it ``follow``s the
 #: frame before it with no trigger (1) or waits for one (0); ``camera_off`` 1: no camera trigger.
+#: It shows ``depth`` of its frame's planes (0: all of them) after leaving out the ``skip`` most
+#: significant ones, as a ``depth``-bit image.
 ENTRY = [
     ("index", 16),
     ("slot", 8),
@@ -112,6 +114,7 @@ ENTRY = [
     ("follow", 8),
     ("camera_off", 8),
     ("depth", 8),
+    ("skip", 8),
 ]
 
 #: Counters kept by the network stack (frames, by outcome).
@@ -212,7 +215,8 @@ SYSTEM_STATUS = [
     ("frames_period_short", 32),       # frames the periodic trigger started whose planes outlast its period
     ("store_rows_no_base", 32),        # rows of a delta refused: its base is not a whole frame the store holds
     ("triggers_after_end", 32),        # triggers ignored: a sequence played once had ended
-    ("sequence_entries_skipped", 32),  # sequence entries skipped: their slot is outside the sequence
+    ("sequence_entries_skipped", 32),  # sequence entries skipped: their slot is outside the sequence,
+                                       # or their planes outside their frame
 ]
 
 #: Status reply body (after :data:`HEADER`).
@@ -281,7 +285,8 @@ def register_faults(wire, row_cycles, clear_row_cycles):
 def entry_faults(wire, sequence_length):
     """Why an entry record cannot be written (``{check: condition}``, as
     :func:`register_faults`): its index beyond the table, a slot outside the sequence in force
-    (``sequence_length``), an odd time, a flag other than 0 or 1, a bit depth over 8."""
+    (``sequence_length``), an odd time, a flag other than 0 or 1, a bit depth over 8, more than
+    7 planes left out (whether its planes are in its frame is known only when it plays)."""
     return {
         "index": wire["index"] >= ENTRIES,
         "slot": wire["slot"] >= sequence_length,
@@ -290,6 +295,7 @@ def entry_faults(wire, sequence_length):
         "follow": wire["follow"] > 1,
         "camera_off": wire["camera_off"] > 1,
         "depth": wire["depth"] > 8,
+        "skip": wire["skip"] > 7,
     }
 
 

@@ -1,9 +1,10 @@
 """The plane order, in the arithmetic the sequencer's parts share.
 
 A frame of ``depth`` planes shows its planes in the order of the registers: the exponent of the
-plane at display position ``j`` (the plane of weight ``2**e``), and the stored plane it reads
-(planes ``8 - depth .. 7`` of a slot, most significant last). Both are small tables of
-``depth`` and ``j``, written as lookups, not sums, so no carry chain is made for them.
+plane at display position ``j`` (the plane of weight ``2**e``), a small table of ``depth`` and
+``j`` written as a lookup, not a sum, so that no carry chain is made for it; and the stored plane
+it reads: ``e`` above the frame's lowest stored plane (the store's answer, worked out there from
+the frame's depth and its sequence entry), a 3-bit sum with no carry out, one LUT a bit.
 """
 
 from amaranth import Array, Signal
@@ -35,9 +36,7 @@ def exponent(m, regs, j, depth, name):
     return e
 
 
-_STORED = _table(lambda depth, e: 8 - depth + e)
-
-
-def stored_plane(depth, e):
-    """The stored plane (0..7) of exponent ``e`` in a frame of ``depth`` planes: ``8 - depth + e``."""
-    return _STORED[depth][e]
+def stored_plane(low_plane, e):
+    """The stored plane (0..7) of exponent ``e`` in a frame whose least significant plane is
+    stored plane ``low_plane``."""
+    return (low_plane + e)[:3]

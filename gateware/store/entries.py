@@ -4,7 +4,9 @@ A stored sequence plays its slots in order unless the control record names a num
 then it plays entries ``0 .. entries - 1`` of this table, each the frame of a slot (any slot of
 the sequence, as often as wanted) with its own least significant plane's time, dark time,
 trigger (wait for one, or follow the frame before), camera trigger
-(:class:`~gateware.store.layouts.Showing`) and bit depth (its frame's most significant planes).
+(:class:`~gateware.store.layouts.Showing`), and the planes of its frame it shows: ``depth`` of
+them below the ``skip`` most significant, as a ``depth``-bit image (the slot table works out
+which stored planes those are when the entry plays, :mod:`gateware.store.slot_table`).
 The table is written one entry record at a time (:data:`spec.records.ENTRY`) and read by the
 slot table at its play position, in the same cycle.
 """
@@ -26,13 +28,15 @@ ENTRY_BITS = (ENTRIES - 1).bit_length()
 
 class Entry(data.Struct):
     """One step of a sequence: the slot it shows and how (the entry record's fields; ``depth``:
-    its frame's most significant planes shown, 0 or more than the frame has: all)."""
+    the planes shown, 0: all below those left out, and with ``skip`` 0 also more than the frame
+    has; ``skip``: its frame's most significant planes left out)."""
     slot: SLOT_BITS
     lsb: SHOW_BITS
     dark: SHOW_BITS
     follow: 1
     camera_off: 1
     depth: 4
+    skip: 3
 
 
 class EntryTable(wiring.Component):
