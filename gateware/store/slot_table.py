@@ -450,8 +450,7 @@ def _entry_planes(m, entry, frame_depth):
         m.d.comb += [shown.eq(frame_depth - entry.skip), low.eq(8 - frame_depth),
                      missing.eq(entry.skip >= frame_depth)]
     with m.Else():
-        m.d.comb += [shown.eq(entry.depth), low.eq(8 - entry.skip - entry.depth),
-                     missing.eq(entry.skip + entry.depth > frame_depth)]
+        m.d.comb += [shown.eq(entry.depth), low.eq(entry.low_plane), missing.eq(entry.need > frame_depth)]
     return shown, low, missing
 
 
