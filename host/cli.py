@@ -115,8 +115,8 @@ def main(argv=None):
     play.add_argument("images", nargs="+", help=".npy or image files, grey: frame k goes to slot k")
     play.add_argument("--entries", required=True,
                       help="JSON file: a list of entries, each {\"slot\": k} with optional \"lsb\", \"dark\" "
-                           "(cycles), \"follow\", \"camera\", \"depth\" (its frame's most significant planes; "
-                           "see docs/protocol.md)")
+                           "(cycles), \"follow\", \"camera\", \"depth\" (planes shown, the most significant "
+                           "below the \"skip\" left out; see docs/protocol.md)")
     play.add_argument("--once", action="store_true", help="play the entries once (default: in a loop)")
     play.add_argument("--depth", type=int, default=None, help="bit depth, 1..8 (default: as send chooses)")
     play.add_argument("--rate", type=float, default=100e6, help="pacing in bytes per second")

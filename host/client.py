@@ -85,6 +85,20 @@ def period_fault(plan):
             f"{plan.trigger_cycles} cycles ({plan.rate_hz:.1f} frames/s): every frame would outlast it")
 
 
+def _planes_missing(depth, skip, frame_depth):
+    """Why an entry showing ``depth`` planes below the ``skip`` most significant cannot be shown
+    of a frame of ``frame_depth`` bits (None if it can): the projector's rule
+    (``docs/protocol.md``, Sequence entry record)."""
+    if depth + skip > 8:
+        return f"depth {depth} below {skip} planes left out is more than the 8 bits a frame has"
+    if depth == 0 or (skip == 0 and depth >= frame_depth):
+        if skip >= frame_depth:
+            return f"skip {skip} leaves no plane of its {frame_depth}-bit frame"
+    elif skip + depth > frame_depth:
+        return f"depth {depth} below {skip} planes left out is more than its {frame_depth}-bit frame has"
+    return None
+
+
 class ClientError(RuntimeError):
     """The projector did not answer, refused or lost what was sent, or cannot be reached as asked.
 
@@ -363,10 +377,13 @@ class Client:
     def play_sequence(self, images, entries, *, loop=True, depth=None, tolerance=0.5):
         """Store ``images`` as a sequence (frame ``k`` in slot ``k``) and play it by an entry
         table: ``entries``, each a dict of :func:`host.codec.entry_record`'s settings with its
-        ``slot`` (``lsb``, ``dark``, ``follow``, ``camera``; see ``docs/protocol.md``), in a loop
-        or once. The table and the control record that plays it go first, then the frames, so
-        that the projector gives out nothing before both are in; each frame is checked as
-        :meth:`send_image` checks it. Returns the :class:`Sent` of each image."""
+        ``slot`` (``lsb``, ``dark``, ``follow``, ``camera``, ``depth``, ``skip``; see
+        ``docs/protocol.md``), in a loop or once. The table and the control record that plays it
+        go first, then the frames, so that the projector gives out nothing before both are in;
+        each frame is checked as :meth:`send_image` checks it. An entry the projector would drop,
+        or skip when it plays (planes its frame is not sent with: each frame goes at the depth
+        :meth:`send_image` chooses), is refused before anything is sent. Returns the
+        :class:`Sent` of each image."""
         if not 2 <= len(images) <= 16:
             raise ClientError(f"a stored sequence holds 2 to 16 frames, not {len(images)}")
         if not 1 <= len(entries) <= records.ENTRIES:
@@ -375,11 +392,15 @@ class Client:
         if outside:
             raise ClientError(f"entries name slots {outside} outside the sequence of {len(images)} frames")
         settings = [{k: v for k, v in entry.items() if k != "slot"} for entry in entries]
+        depths = [levels.quantise(image, depth, tolerance=tolerance).depth for image in images]
         for index, (entry, extra) in enumerate(zip(entries, settings, strict=True)):
             try:            # checked before anything is sent
                 codec.entry_record(index, entry["slot"], **extra)
             except ValueError as error:
                 raise ClientError(f"entry {index}: {error}") from None
+            missing = _planes_missing(extra.get("depth", 0), extra.get("skip", 0), depths[entry["slot"]])
+            if missing:
+                raise ClientError(f"entry {index}: {missing}; the projector would skip it")
         self.control(sequence_length=len(images))
         for index, (entry, extra) in enumerate(zip(entries, settings, strict=True)):
             self._send(codec.entry_record(index, entry["slot"], self._next(), **extra))

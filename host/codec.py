@@ -138,16 +138,18 @@ def sequencer_record(registers, sequence=0, *, dmd=None, beats=1):
     return header(RecordType.SEQUENCER, sequence) + body
 
 
-def entry_record(index, slot, sequence=0, *, lsb=0, dark=0, follow=False, camera=True, depth=0):
+def entry_record(index, slot, sequence=0, *, lsb=0, dark=0, follow=False, camera=True, depth=0, skip=0):
     """A sequence entry record: entry ``index`` shows the frame of ``slot`` with a least
     significant plane of ``lsb`` cycles (0: the sequencer's register), at least ``dark`` cycles
     dark after it before a frame that follows it, following the frame before it with no trigger
-    (``follow``) or waiting for one, with a camera trigger or none, at ``depth`` bits (its
-    frame's most significant planes; 0: all the frame has). Raises :class:`ValueError` on what
-    the projector would drop (:func:`spec.records.entry_faults`, but the slot's check against
-    the sequence in force)."""
+    (``follow``) or waiting for one, with a camera trigger or none, at ``depth`` bits: its
+    frame's most significant planes after leaving out ``skip`` of them (``depth`` 0: all the
+    frame has below those). Raises :class:`ValueError` on what the projector would drop
+    (:func:`spec.records.entry_faults`, but the slot's check against the sequence in force);
+    whether the planes are in the frame is the projector's to see when the entry plays (it skips
+    the entry if not: :meth:`host.client.Client.play_sequence` checks it against the frames)."""
     fields = {"index": index, "slot": slot, "lsb": lsb, "dark": dark, "follow": int(follow),
-              "camera_off": int(not camera), "depth": depth}
+              "camera_off": int(not camera), "depth": depth, "skip": skip}
     failed = [check for check, bad in records.entry_faults(fields, 1 << 8).items() if bad]
     if failed:
         raise ValueError(f"the projector cannot take this entry: {', '.join(failed)}")

@@ -113,6 +113,8 @@ SEQUENCER = [(f.name, -(-f.bits // 8) * 8) for f in _registers.FIELDS]
 #: ``slot`` with a least significant plane of ``lsb`` cycles (0: the sequencer register's), at
 #: least ``dark`` cycles dark after it before a frame that follows it, and it ``follow``s the
 #: frame before it with no trigger (1) or waits for one (0); ``camera_off`` 1: no camera trigger.
+#: It shows ``depth`` of its frame's planes (0: all of them) after leaving out the ``skip`` most
+#: significant ones, as a ``depth``-bit image.
 ENTRY = [
     ("index", 16),
     ("slot", 8),
@@ -121,6 +123,7 @@ ENTRY = [
     ("follow", 8),
     ("camera_off", 8),
     ("depth", 8),
+    ("skip", 8),
 ]
 
 #: Counters kept by the network stack (frames, by outcome).
@@ -221,7 +224,8 @@ SYSTEM_STATUS = [
     ("frames_period_short", 32),       # frames the periodic trigger started whose planes outlast its period
     ("store_rows_no_base", 32),        # rows of a delta refused: its base is not a whole frame the store holds
     ("triggers_after_end", 32),        # triggers ignored: a sequence played once had ended
-    ("sequence_entries_skipped", 32),  # sequence entries skipped: their slot is outside the sequence
+    ("sequence_entries_skipped", 32),  # sequence entries skipped: their slot is outside the sequence,
+                                       # or their planes outside their frame
 ]
 
 #: Status reply body (after :data:`HEADER`).
@@ -297,7 +301,8 @@ def delta_faults(wire):
 def entry_faults(wire, sequence_length):
     """Why an entry record cannot be written (``{check: condition}``, as
     :func:`register_faults`): its index beyond the table, a slot outside the sequence in force
-    (``sequence_length``), an odd time, a flag other than 0 or 1, a bit depth over 8."""
+    (``sequence_length``), an odd time, a flag other than 0 or 1, a bit depth over 8, more than
+    7 planes left out (whether its planes are in its frame is known only when it plays)."""
     return {
         "index": wire["index"] >= ENTRIES,
         "slot": wire["slot"] >= sequence_length,
@@ -306,6 +311,7 @@ def entry_faults(wire, sequence_length):
         "follow": wire["follow"] > 1,
         "camera_off": wire["camera_off"] > 1,
         "depth": wire["depth"] > 8,
+        "skip": wire["skip"] > 7,
     }
 
 

@@ -193,7 +193,8 @@ class Params:
 class Frame:
     """A frame the store offers: its slot, bit depth and occupancy (blocks,) bytes, bit k =
     stored plane k has a bit set in the block (:func:`sim.models.bitplane.occupancy`); and how
-    a sequence entry shows it (the defaults: as the registers say)."""
+    a sequence entry shows it (the defaults: as the registers say). It shows stored planes
+    ``8 - depth - skip .. 7 - skip`` (``skip``: a sequence entry's planes left out above them)."""
     slot: int
     depth: int
     occupancy: tuple = None      # None: every block full
@@ -205,6 +206,11 @@ class Frame:
     camera_off: bool = False     # no camera trigger for it
     last: bool = False           # the last entry of a sequence played once: nothing follows it,
                                  # and triggers after it starts are ignored (``ended``)
+    skip: int = 0                # its stored planes left out above those it shows
+
+    def stored_plane(self, e):
+        """The stored plane of the plane of weight ``2**e``."""
+        return 8 - self.depth - self.skip + e
 
     def occupied(self, plane, block):
         return self.occupancy is None or bool((self.occupancy[block] >> plane) & 1)
@@ -354,7 +360,7 @@ class _Model:
         ops = []
         for b in self.grp[g]:
             if j is not None:
-                plane = 8 - frame.depth + self.exps_of(fi)[j]
+                plane = frame.stored_plane(self.exps_of(fi)[j])
                 if self.p.source == Source.PRNG or frame.occupied(plane, b):
                     ops += [("row", r) for r in range(b * dmd.rows_per_block, (b + 1) * dmd.rows_per_block)]
                     continue
@@ -634,7 +640,8 @@ def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
 
 def level_light(dmd, p, result, images):
     """On-cycles per pixel from the model's pulses: {frame index: (rows, columns) int array},
-    ``images[i]`` being the 8-bit image of the i-th frame taken (planes 8-depth..7 shown)."""
+    ``images[i]`` being the 8-bit image of the i-th frame taken (the planes it shows:
+    :meth:`Frame.stored_plane`)."""
     grp = groups(dmd, p.reset_mode)
     light = {}
     by_group = {}
@@ -646,7 +653,7 @@ def level_light(dmd, p, result, images):
             if kind != "plane":
                 continue
             img = np.asarray(images[fi], dtype=np.int64)
-            bit = (img[rows] >> (8 - result.shown[fi].depth + e)) & 1
+            bit = (img[rows] >> result.shown[fi].stored_plane(e)) & 1
             acc = light.setdefault(fi, np.zeros(img.shape, dtype=np.int64))
             acc[rows] += bit * (t2 - t)
     return light

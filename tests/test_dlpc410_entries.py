@@ -2,14 +2,16 @@
 sequencer's generated Verilog (:mod:`sim.seq_rig`, TEST_DMD): each frame's own least significant
 plane's time, frames that follow the one before with no trigger after its dark time, a frame
 without a camera trigger, and the last frame of a sequence played once, after which a trigger is
-ignored and counted. The command stream equals the schedule model's cycle for cycle (the model
-takes the same settings, :class:`spec.schedule.Frame`), every DLPC410 rule holds, and the camera
-sees each frame's every level at its own exposure."""
+ignored and counted; and entries that show some of their frame's planes (``skip``). The command
+stream equals the schedule model's cycle for cycle (the model takes the same settings,
+:class:`spec.schedule.Frame`), every DLPC410 rule holds, and the camera sees each frame's every
+level at its own exposure."""
 
 import numpy as np
 import pytest
 
 from gateware.dlpc410.trigger import PIN_TO_STROBE
+from sim.models import bitplane
 from sim.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import frame_lights
@@ -69,10 +71,51 @@ def test_entries_show_each_frame_as_its_entry_says(mode, test_name):
     # pulse to its last (each of these frames ends dark), in the rule model's cycles
     if mode != ResetMode.GLOBAL:
         return
-    pins = schedule.DECISION_TO_PINS - run.shift       # a decision's cycle to its pins' in the rule model
-    windows = [(min(t for t, _g, kind, fi, _e in model.pulses if fi == k and kind == "plane") + pins - 1,
-                max(t for t, _g, _kind, fi, _e in model.pulses if fi == k) + pins) for k in range(4)]
-    for light, (slot, depth, showing) in zip(frame_lights(run.model, windows), frames, strict=True):
+    for light, (slot, depth, showing) in zip(_lights(run, model, len(frames)), frames, strict=True):
         lsb = showing.get("lsb") or p.lsb
         expect = (ramp_image(DMD, slot).astype(np.int64) >> (8 - depth)) * lsb
         assert np.array_equal(light, expect), f"slot {slot}, {depth} bits"
+
+
+def _lights(run, model, frames):
+    """The camera's image of each of the first ``frames`` frames, global (a frame's pulses do not
+    overlap the next frame's): the window from its first pulse to its last (each of these frames
+    ends dark), in the rule model's cycles."""
+    pins = schedule.DECISION_TO_PINS - run.shift       # a decision's cycle to its pins' in the rule model
+    windows = [(min(t for t, _g, kind, fi, _e in model.pulses if fi == k and kind == "plane") + pins - 1,
+                max(t for t, _g, _kind, fi, _e in model.pulses if fi == k) + pins) for k in range(frames)]
+    return frame_lights(run.model, windows)
+
+
+@pytest.mark.verilog
+def test_entries_show_the_planes_they_pick(test_name):
+    """Entries that leave out their frame's most significant planes (``skip``, the DLPC350's bit
+    position), global, MSB first: an 8-bit frame, then following it with no trigger bits 3..4
+    of the other frame (a 2-bit image), bit 0 of the first and bits 1..4 of the other. The store
+    stand-in offers each with its lowest stored plane, as the store's answer gives it; the load
+    jobs read the planes from there and look their blocks up in them (block 0 of the other frame
+    has no bit 4 set: cleared, not loaded, for that plane), the commands equal the schedule
+    model's, and every pixel's light in each frame is the image bits its entry names, each at
+    its weight in the entry's depth (numpy, from the images)."""
+    p = schedule.plan(DMD, 200e6, depth=8, **FAST).params
+    images = {slot: ramp_image(DMD, slot) for slot in range(2)}
+    images[1][:DMD.rows_per_block] &= 0x0F
+    # (slot, depth, skip, showing)
+    frames = [(0, 8, 0, {}), (1, 2, 3, {"follow": 1}), (0, 1, 7, {"follow": 1}),
+              (1, 4, 3, {"follow": 1, "last": 1})]
+    occupancy = {slot: tuple(int(x) for x in bitplane.occupancy(image, DMD.rows_per_block))
+                 for slot, image in images.items()}
+    model_frames = [schedule.Frame(slot, depth, occupancy[slot], sequence=True, skip=skip, **showing)
+                    for slot, depth, skip, showing in frames]
+    first = max(g.loaded_at for g in schedule.simulate(DMD, p, model_frames[:1]).groups) + 10 - PIN_TO_STROBE
+    model = schedule.simulate(DMD, p, model_frames, [first + PIN_TO_STROBE])
+    assert len(model.frame_starts) == 4 and model.late == 0
+    end = model.pulses[-1][0] + 2000
+    run = run_rig(DMD, p, [(slot, depth, 0, 1, showing, skip) for slot, depth, skip, showing in frames], images,
+                  pins=[first], cycles=end, name=test_name)
+    horizon = run.status["now"] - 2 * DMD.dclk_per_row
+    assert [c for c in run.commands if c[0] < horizon] == [c for c in model.decoded() if c[0] < horizon]
+    assert (run.status["frames"], run.status["late"]) == (4, 0)
+    for light, (slot, depth, skip, _) in zip(_lights(run, model, len(frames)), frames, strict=True):
+        bits = (images[slot].astype(np.int64) >> (8 - depth - skip)) & ((1 << depth) - 1)
+        assert np.array_equal(light, bits * p.lsb), f"slot {slot}, {depth} bits below {skip}"

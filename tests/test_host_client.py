@@ -405,11 +405,13 @@ def test_configure_plans_with_the_measured_rst_active(projector, capsys):
 def test_play_sequence_sends_the_table_then_the_frames(projector):
     """``play_sequence``: the sequence mode, each entry record (checked by the reference model as
     the projector checks it), the control record that plays them once, then the frames; entries
-    the projector would drop are refused before anything is sent."""
+    the projector would drop, or skip for planes their frame is not sent with, are refused
+    before anything is sent."""
     rng = np.random.default_rng(5)
     images = [rng.integers(0, 256, SHAPE, dtype=np.uint8) for _ in range(2)]
     entries = [{"slot": 1}, {"slot": 0, "lsb": 400, "follow": True, "camera": False},
-               {"slot": 1, "dark": 90 * 2, "depth": 3}]
+               {"slot": 1, "dark": 90 * 2, "depth": 3}, {"slot": 0, "depth": 2, "skip": 3},
+               {"slot": 1, "depth": 1, "skip": 7}]
     with Client("127.0.0.1", projector.port, timeout=1.0, rate=50e6, mtu=1500) as client:
         with pytest.raises(ClientError, match="outside the sequence"):
             client.play_sequence(images, [{"slot": 2}])
@@ -417,17 +419,28 @@ def test_play_sequence_sends_the_table_then_the_frames(projector):
             client.play_sequence(images, [{"slot": 0, "lsb": 3}])
         with pytest.raises(ClientError, match="entry 1: .*depth"):
             client.play_sequence(images, [{"slot": 0}, {"slot": 1, "depth": 9}])
+        with pytest.raises(ClientError, match="entry 1: .*skip"):
+            client.play_sequence(images, [{"slot": 0}, {"slot": 1, "depth": 1, "skip": 8}])
+        with pytest.raises(ClientError, match="entry 0: .*8 bits a frame has"):
+            client.play_sequence(images, [{"slot": 0, "depth": 2, "skip": 7}])
+        # at 4 bits a frame keeps bits 4..7: bit 3 is not in it, nor anything below 4 planes
+        with pytest.raises(ClientError, match="entry 0: .*4-bit frame has; the projector would skip"):
+            client.play_sequence(images, [{"slot": 0, "depth": 1, "skip": 4}], depth=4)
+        with pytest.raises(ClientError, match="entry 1: skip 4 leaves no plane of its 4-bit frame"):
+            client.play_sequence(images, [{"slot": 0, "skip": 3}, {"slot": 1, "skip": 4}], depth=4)
         assert projector.received == []
         sent = client.play_sequence(images, entries, loop=False, depth=8)
     model = projector.model
-    assert [(e["slot"], e["lsb"], e["dark"], e["follow"], e["camera_off"], e["depth"]) for e in model.entries] == \
-        [(1, 0, 0, 0, 0, 0), (0, 400, 0, 1, 1, 0), (1, 0, 180, 0, 0, 3)]
-    assert model.counters["records_entry"] == 3 and model.counters["drop_app_value"] == 0
-    assert model.config["sequence_length"] == 2 and model.config["entries"] == 3 and model.config["loop"] == 0
+    assert [(e["slot"], e["lsb"], e["dark"], e["follow"], e["camera_off"], e["depth"], e["skip"])
+            for e in model.entries] == \
+        [(1, 0, 0, 0, 0, 0, 0), (0, 400, 0, 1, 1, 0, 0), (1, 0, 180, 0, 0, 3, 0), (0, 0, 0, 0, 0, 2, 3),
+         (1, 0, 0, 0, 0, 1, 7)]
+    assert model.counters["records_entry"] == 5 and model.counters["drop_app_value"] == 0
+    assert model.config["sequence_length"] == 2 and model.config["entries"] == 5 and model.config["loop"] == 0
     assert model.sequence_starts == 1
     kinds = [raw[3] for raw in projector.received]
-    assert kinds[:5] == [records.RecordType.CONTROL] + [records.RecordType.ENTRY] * 3 + [records.RecordType.CONTROL]
-    assert records.RecordType.IMAGE not in kinds[:5] and records.RecordType.IMAGE in kinds[5:]
+    assert kinds[:7] == [records.RecordType.CONTROL] + [records.RecordType.ENTRY] * 5 + [records.RecordType.CONTROL]
+    assert records.RecordType.IMAGE not in kinds[:7] and records.RecordType.IMAGE in kinds[7:]
     assert [s.frame for s in sent] == [0, 1]
 
 

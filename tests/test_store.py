@@ -71,6 +71,34 @@ class Bench:
         ctx.set(dut.frames.ready, 0)
         return int(payload.slot), int(payload.frame_id), int(payload.bit_depth)
 
+    async def write_entries(self, ctx, table, *, loop=0):
+        """Write ``table`` (dicts of :class:`~gateware.store.entries.Entry`'s fields) to the entry
+        table, entry ``k`` at index ``k``, and play it (``loop`` or once)."""
+        for index, entry in enumerate(table):
+            ctx.set(self.dut.entry_writes.payload, {"index": index, **entry})
+            ctx.set(self.dut.entry_writes.valid, 1)
+            await ctx.tick()
+        ctx.set(self.dut.entry_writes.valid, 0)
+        ctx.set(self.dut.entries, len(table))
+        ctx.set(self.dut.loop, loop)
+
+    async def answer(self, ctx, wait=None):
+        """Ask for a frame: the answer's payload, or None if none comes in ``wait`` cycles."""
+        dut = self.dut
+        ctx.set(dut.ask.valid, 1)
+        ctx.set(dut.frames.ready, 1)
+        for _ in range(wait or 100_000):
+            _, _, asked, valid, payload = await ctx.tick("dmd").sample(dut.ask.ready, dut.frames.valid,
+                                                                       dut.frames.payload)
+            if asked:
+                ctx.set(dut.ask.valid, 0)
+            if valid:
+                ctx.set(dut.frames.ready, 0)
+                return payload
+        ctx.set(dut.ask.valid, 0)
+        ctx.set(dut.frames.ready, 0)
+        return None
+
     async def release(self, ctx, slot):
         ctx.set(self.dut.release.payload, slot)
         ctx.set(self.dut.release.valid, 1)
@@ -871,34 +899,20 @@ def test_sequence_entries(test_name):
     got = []
 
     async def producer(ctx):
-        for index, (slot, lsb, dark, follow, camera_off, depth) in enumerate(table):
-            ctx.set(dut.entry_writes.payload, {"index": index, "slot": slot, "lsb": lsb, "dark": dark,
-                                                "follow": follow, "camera_off": camera_off, "depth": depth})
-            ctx.set(dut.entry_writes.valid, 1)
-            await ctx.tick()
-        ctx.set(dut.entry_writes.valid, 0)
-        ctx.set(dut.entries, len(table))
-        ctx.set(dut.loop, 0)
+        await bench.write_entries(ctx, [{"slot": slot, "lsb": lsb, "dark": dark, "follow": follow,
+                                         "camera_off": camera_off, "depth": depth}
+                                        for slot, lsb, dark, follow, camera_off, depth in table])
         await bench.feed_sequence(ctx, images, (0, 1, 2), depth=6)
 
     async def answer(ctx, wait=None):
         """The next answer's (slot, frame id, showing and bit depth), or None if none comes in
         ``wait`` cycles."""
-        ctx.set(dut.ask.valid, 1)
-        ctx.set(dut.frames.ready, 1)
-        for _ in range(wait or 100_000):
-            _, _, asked, valid, payload = await ctx.tick("dmd").sample(dut.ask.ready, dut.frames.valid,
-                                                                       dut.frames.payload)
-            if asked:
-                ctx.set(dut.ask.valid, 0)
-            if valid:
-                ctx.set(dut.frames.ready, 0)
-                s = payload.showing
-                return (int(payload.slot), int(payload.frame_id),
-                        tuple(int(x) for x in (s.lsb, s.dark, s.follow, s.camera_off, s.last, payload.bit_depth)))
-        ctx.set(dut.ask.valid, 0)
-        ctx.set(dut.frames.ready, 0)
-        return None
+        payload = await bench.answer(ctx, wait)
+        if payload is None:
+            return None
+        s = payload.showing
+        return (int(payload.slot), int(payload.frame_id),
+                tuple(int(x) for x in (s.lsb, s.dark, s.follow, s.camera_off, s.last, payload.bit_depth)))
 
     async def consumer(ctx):
         held = None
@@ -926,6 +940,53 @@ def test_sequence_entries(test_name):
                        (1, (60, 0, 1, 0, 1, 6))]
     # started again: entry 0; in a loop: entries 1, 2, (3 skipped) 4, 0, none marked last
     assert got[4:] == [(2, None), (0, 0), (0, 0), (1, 0), (2, 0)]
+
+
+def test_sequence_entries_pick_planes(test_name):
+    """Entries that leave out their frame's most significant planes (``skip``), of an 8-bit and a
+    4-bit frame: each answer gives the entry's depth and its lowest stored plane, and the planes
+    read from there up are the image bits the entry names (numpy's); an entry whose planes are
+    not all in its frame (skip + depth beyond the frame's, or no plane left below the skip) is
+    skipped and counted, as one whose slot is outside the sequence."""
+    bench = Bench(SHORT_DMD)
+    dut = bench.dut
+    images = [store_stim.random_image(SHORT_DMD, 1400 + f) for f in range(2)]
+    depths = (8, 4)                  # slot 0 keeps bits 0..7 of its image, slot 1 bits 4..7
+    # (slot, depth, skip, (lowest image bit, bits) shown or None: skipped)
+    table = [(0, 0, 0, (0, 8)), (0, 1, 7, (0, 1)), (0, 2, 3, (3, 2)), (0, 1, 3, (4, 1)), (0, 2, 7, None),
+             (1, 1, 3, (4, 1)), (1, 2, 3, None), (1, 0, 4, None), (1, 0, 2, (4, 2)), (1, 8, 0, (4, 4)),
+             (1, 3, 0, (5, 3)), (0, 2, 6, (0, 2))]
+
+    async def producer(ctx):
+        await bench.write_entries(ctx, [{"slot": slot, "depth": depth, "skip": skip} for slot, depth, skip, _ in table])
+        ctx.set(dut.sequence_length, len(images))
+        for f, depth in enumerate(depths):
+            ctx.set(dut.bit_depth, depth)
+            for _ in range(3):
+                await ctx.tick()
+            await bench.feed(ctx, images[f], f)
+
+    async def consumer(ctx):
+        held = None
+        for index, (slot, _, _, shown) in enumerate(table):
+            if shown is None:
+                continue
+            payload = await bench.answer(ctx)
+            lowest_bit, bits = shown
+            assert (int(payload.slot), int(payload.bit_depth)) == (slot, bits), f"entry {index}"
+            low = int(payload.low_plane)
+            for k in range(bits):
+                words = await bench.read(ctx, slot, low + k)
+                store_stim.check_plane(SHORT_DMD, images[slot] >> lowest_bit, k, words,
+                                       what=f"entry {index}'s plane {k}")
+            if held is not None and held != slot:
+                await bench.release(ctx, held)
+            held = slot
+        assert await bench.answer(ctx, wait=400) is None, "an answer after the last entry of a sequence played once"
+        assert bench.counters(ctx)["entries_skipped"] == sum(shown is None for *_, shown in table)
+        assert bench.counters(ctx)["bad_releases"] == 0
+
+    bench.run([producer, consumer], test_name, deadline=8e-4)
 
 
 @pytest.mark.parametrize("dmd,width", [("dlp7000", 128), ("dlp7000", 64), ("dlp9500", 128), ("dlp650lnir", 128),

@@ -40,7 +40,7 @@ def test_system_small_geometry():
 @pytest.mark.verilog
 def test_system_sequence_entries():
     """A sequence played by its entry table, end to end: configured over GMII, every pixel's
-    light each entry's frame at its own exposure and bit depth, a trigger after the last entry
+    light each entry's frame at its own exposure and planes, a trigger after the last entry
     ignored and counted (``sim/tb/system.py``, ``sequence_entries_play_as_their_table_says``)."""
     report = system.run("test", testcase="sequence_entries_play_as_their_table_says")
     assert report["latency_cycles"] <= 8

@@ -220,6 +220,7 @@ class FrameControl(wiring.Component):
             did.hold.eq(self.strobe & self.running & ~ended & ~(ready & ~holding_now) & holds),
             did.overrun.eq(self.strobe & self.running & ~ended & ~(ready & ~holding_now) & ~holds),
             begun.slot.eq(Mux(use_prng, 0, self.offer.slot)), begun.depth.eq(Mux(use_prng, 1, self.offer.depth)),
+            begun.low_plane.eq(Mux(use_prng, 7, self.offer.low_plane)),
             begun.showing.eq(Mux(use_prng, 0, self.offer.showing.as_value())), begun.take.eq(~use_prng),
         ]
 

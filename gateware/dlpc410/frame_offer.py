@@ -21,12 +21,14 @@ __all__ = ["FrameOffer", "Offer"]
 class Offer(data.Struct):
     """The frame the store offers now: ``valid`` when it has a bit depth the sequencer plays and
     no one is taking it; ``sequence`` when it is the next frame of a stored sequence (it does not
-    replace a frame waiting for its trigger); ``showing``, its sequence entry's settings."""
+    replace a frame waiting for its trigger); ``showing``, its sequence entry's settings;
+    ``low_plane``, the stored plane of its least significant plane."""
     valid: 1
     slot: SLOT_BITS
     depth: 4
     sequence: 1
     showing: Showing
+    low_plane: 3
 
 
 class FrameOffer(wiring.Component):
@@ -59,7 +61,7 @@ class FrameOffer(wiring.Component):
         m.d.sync += [held.valid.eq(frames.valid & ok & ~answered),
                      held.slot.eq(frames.payload.slot), held.depth.eq(depth),
                      held.sequence.eq(frames.payload.sequence),
-                     held.showing.eq(frames.payload.showing)]
+                     held.showing.eq(frames.payload.showing), held.low_plane.eq(frames.payload.low_plane)]
         m.d.comb += [self.offer.eq(held), self.offer.valid.eq(held.valid & ~answered),
                      frames.ready.eq(answered | (frames.valid & ~ok))]
         m.submodules.bad = bad = Counter(COUNTER_BITS)

@@ -1,5 +1,5 @@
-"""The frame each pulse group shows: its slot, bit depth and entry settings, and the newest frame
-taken, which a group takes next.
+"""The frame each pulse group shows: its slot, bit depth, lowest stored plane and entry settings,
+and the newest frame taken, which a group takes next.
 
 Group 0 takes the frame offered (``take``) when it moves on to a new frame; the others take the
 newest one taken when they move on (``advance``); a start or a retake gives every group, and the
@@ -15,8 +15,8 @@ from .layouts import event
 
 __all__ = ["GroupFrames", "FRAME"]
 
-#: A frame as a group shows it.
-FRAME = data.StructLayout({"slot": SLOT_BITS, "depth": 4, "showing": Showing})
+#: A frame as a group shows it: ``depth`` planes from stored plane ``low_plane`` up.
+FRAME = data.StructLayout({"slot": SLOT_BITS, "depth": 4, "low_plane": 3, "showing": Showing})
 
 #: The entry settings each group keeps of its frame (its follow flag is only read of the frame
 #: taken next).
@@ -68,7 +68,7 @@ class GroupFrames(wiring.Component):
 
         def give(g, frame):
             kept = self.frame[g]
-            return [kept.slot.eq(frame.slot), kept.depth.eq(frame.depth),
+            return [kept.slot.eq(frame.slot), kept.depth.eq(frame.depth), kept.low_plane.eq(frame.low_plane),
                     *(kept.showing[name].eq(frame.showing[name]) for name in _KEPT)]
         for g in range(G):
             with m.If(self.advance[g]):

@@ -3,7 +3,8 @@ is queued.
 
 The cycle after a pulse is applied, the group's new state (its frame, display position, dark)
 is registered as a job; a first plane queued (the frame taken next, position 0) replaces it in
-that cycle. The stored plane the job reads is worked out on the stage after, and the job leaves.
+that cycle. The stored plane the job reads (the plane's exponent above the frame's lowest stored
+plane) is worked out on the stage after, and the job leaves.
 """
 
 from amaranth import Cat, Module, Signal
@@ -61,6 +62,7 @@ class LoadJobs(wiring.Component):
         m = Module()
         dmd, G, gb = self._dmd, self._dmd.blocks, group_bits(self._dmd)
         job = Signal(load_job(dmd))
+        low_plane = Signal(3)                  # the job's frame's lowest stored plane
         pulsed, group, formed = Signal(), Signal(gb), Signal()
         m.d.sync += [pulsed.eq(self.pulse_any),
                      group.eq(Cat(Cat(self.pulse[g] for g in range(G) if g >> b & 1).any() for b in range(gb))),
@@ -68,14 +70,15 @@ class LoadJobs(wiring.Component):
         with m.If(pulsed):
             kept = self.frame[group]
             m.d.sync += [job.group.eq(group), job.slot.eq(kept.slot), job.depth.eq(kept.depth),
-                         job.pos.eq(self.pos[group]),
+                         low_plane.eq(kept.low_plane), job.pos.eq(self.pos[group]),
                          job.clear.eq(self.dark.bit_select(group, 1))]
         with m.If(self.queue_first.valid):
             m.d.sync += [job.group.eq(self.queue_first.payload), job.slot.eq(self.next.slot),
-                         job.depth.eq(self.next.depth), job.pos.eq(0), job.clear.eq(0)]
+                         job.depth.eq(self.next.depth), low_plane.eq(self.next.low_plane), job.pos.eq(0),
+                         job.clear.eq(0)]
         e = exponent(m, self.regs, job.pos, job.depth, "job_exp")
         out, valid = Signal(load_job(dmd)), Signal()
-        m.d.sync += [valid.eq(formed), out.eq(job), out.plane.eq(stored_plane(job.depth, e))]
+        m.d.sync += [valid.eq(formed), out.eq(job), out.plane.eq(stored_plane(low_plane, e))]
         m.d.comb += [self.jobs.valid.eq(valid), self.jobs.payload.eq(out),
                      self.due.eq(pulsed | formed | valid)]
         return m

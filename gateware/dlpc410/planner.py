@@ -40,7 +40,7 @@ __all__ = ["Planner", "START"]
 
 
 #: What the frame control's ``start`` begins: a frame, and whether it is the one offered.
-START = data.StructLayout({"slot": SLOT_BITS, "depth": 4, "showing": Showing, "take": 1})
+START = data.StructLayout({"slot": SLOT_BITS, "depth": 4, "low_plane": 3, "showing": Showing, "take": 1})
 
 
 class Planner(wiring.Component):
@@ -72,8 +72,8 @@ class Planner(wiring.Component):
     loaded : In(blocks)
         Bit g: the bus ends group g's load this cycle.
     start : In(event(START))
-        Every group begins the frame ``slot`` of ``depth`` planes, shown as ``showing`` says, at
-        its first plane; ``take``: that frame is the one offered.
+        Every group begins the frame ``slot`` of ``depth`` planes from stored plane ``low_plane``,
+        shown as ``showing`` says, at its first plane; ``take``: that frame is the one offered.
     retake : In(event(newer, abandon))
         A newer frame (``newer``: the one offered) or the same frame under new registers replaces
         what every group holds. ``abandon`` (the controller restarted): every group also leaves
@@ -205,6 +205,7 @@ class Planner(wiring.Component):
                                         | (self.retake.valid & self.retake.payload.newer)),
                      self.offer.eq(offers.offer), self.bad_frames.eq(offers.bad_frames),
                      frames.offered.slot.eq(offers.offer.slot), frames.offered.depth.eq(offers.offer.depth),
+                     frames.offered.low_plane.eq(offers.offer.low_plane),
                      frames.offered.showing.eq(offers.offer.showing)]
 
         # ---- the decision: what the pulse the bus chooses does (registered) ----
@@ -275,7 +276,7 @@ class Planner(wiring.Component):
         with m.If(self.start.valid):
             begin = self.start.payload
             m.d.comb += [every.valid.eq(1), every.payload.slot.eq(begin.slot), every.payload.depth.eq(begin.depth),
-                         every.payload.showing.eq(begin.showing)]
+                         every.payload.low_plane.eq(begin.low_plane), every.payload.showing.eq(begin.showing)]
             m.d.sync += [ended.eq(0), dark.eq(0)] + [pos[g].eq(0) for g in range(G)]
         abandon = self.retake.valid & self.retake.payload.abandon
         with m.If(self.retake.valid):

@@ -4,9 +4,12 @@ A stored sequence plays its slots in order unless the control record names a num
 then it plays entries ``0 .. entries - 1`` of this table, each the frame of a slot (any slot of
 the sequence, as often as wanted) with its own least significant plane's time, dark time,
 trigger (wait for one, or follow the frame before), camera trigger
-(:class:`~gateware.store.layouts.Showing`) and bit depth (its frame's most significant planes).
+(:class:`~gateware.store.layouts.Showing`), and the planes of its frame it shows: ``depth`` of
+them below the ``skip`` most significant, as a ``depth``-bit image (the slot table works out
+which stored planes those are when the entry plays, :mod:`gateware.store.slot_table`).
 The table is written one entry record at a time (:data:`spec.records.ENTRY`) and read by the
-slot table at its play position, in the same cycle.
+slot table at its play position, in the same cycle; what an entry's planes need of its frame is
+summed when it is written, so that the slot table only compares when it plays.
 """
 
 from amaranth import Module
@@ -26,13 +29,18 @@ ENTRY_BITS = (ENTRIES - 1).bit_length()
 
 class Entry(data.Struct):
     """One step of a sequence: the slot it shows and how (the entry record's fields; ``depth``:
-    its frame's most significant planes shown, 0 or more than the frame has: all)."""
+    the planes shown, 0: all below those left out, and with ``skip`` 0 also more than the frame
+    has; ``skip``: its frame's most significant planes left out), and for a ``depth`` other than
+    0 what its planes need: a frame of ``need`` planes at least, and its lowest stored plane."""
     slot: SLOT_BITS
     lsb: SHOW_BITS
     dark: SHOW_BITS
     follow: 1
     camera_off: 1
     depth: 4
+    skip: 3
+    need: 4           # skip + depth
+    low_plane: 3      # 8 - skip - depth (a frame of depth d is stored in planes 8-d..7)
 
 
 class EntryTable(wiring.Component):
@@ -63,7 +71,9 @@ class EntryTable(wiring.Component):
             self.entry_writes.ready.eq(1),
             write.en.eq(self.entry_writes.valid),
             write.addr.eq(record.index),
-            *(write.data[name].eq(record[name]) for name, _ in data.Layout.cast(Entry)),
+            *(write.data[name].eq(record[name]) for name, _ in ENTRY if name != "index"),
+            write.data.need.eq(record.skip + record.depth),
+            write.data.low_plane.eq(8 - record.skip - record.depth),
             read.addr.eq(self.index),
             self.entry.eq(read.data),
         ]

@@ -66,12 +66,15 @@ class Showing(data.Struct):
 class FrameInfo(data.Struct):
     """A complete frame the sequencer may show. A frame of a stored sequence (``sequence``) is
     the next one to show, in order; a streamed one is the newest, which replaces a frame
-    waiting for its trigger. ``showing``: its sequence entry's settings."""
+    waiting for its trigger. ``showing``: its sequence entry's settings. It is shown as a
+    ``bit_depth``-bit image of the slot's stored planes ``low_plane .. low_plane + bit_depth - 1``
+    (a frame of depth d is stored in planes 8-d..7; a sequence entry may show some of them)."""
     slot: SLOT_BITS
     frame_id: 16
-    bit_depth: 4      # 1..8 planes stored, most significant first: planes 8-bit_depth..7
+    bit_depth: 4      # 1..8 planes shown
     sequence: 1
     showing: Showing
+    low_plane: 3      # the stored plane of its least significant plane shown
 
 
 class OccupancySignature(wiring.Signature):

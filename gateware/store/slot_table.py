@@ -19,11 +19,15 @@ instead (its words stay, it is never given out) and freed once no delta uses it.
 
 A sequence with entries (``entries`` > 0) gives out the frame of each entry of the entry table
 (:mod:`gateware.store.entries`) in turn instead of its slots in order, with the entry's settings;
-an entry's slot may be shown already (the same frame twice in a row), at the entry's bit depth
-(its frame's most significant planes) when that is smaller. Played once (``loop``
-low), the last entry's answer says so and no answer follows until ``sequence_start`` (or a
-change of mode) plays the entries from the first again. An entry whose slot is outside the
-sequence is skipped and counted.
+an entry's slot may be shown already (the same frame twice in a row). An entry shows ``depth``
+of its frame's planes below the ``skip`` most significant (depth 0: all below them; with skip 0
+a depth beyond the frame's also means all): the answer gives that depth and the lowest stored
+plane shown (the store keeps a frame of depth d in planes 8-d..7), worked out here, where the
+frame's depth is known, so that the sequencer only adds a plane's exponent to it. Played once
+(``loop`` low), the last entry's answer says so and no answer follows until ``sequence_start``
+(or a change of mode) plays the entries from the first again. An entry that cannot be shown is
+skipped and counted: its slot is outside the sequence, or its planes are not all in its frame
+(skip + depth more than the frame's depth, or no plane left below the skipped ones).
 """
 
 from types import SimpleNamespace
@@ -315,7 +319,9 @@ class SlotTable(wiring.Component):
         entry = self.entry
         by_entry = sequence & (self.entries != 0)
         last_entry = play + 1 >= self.entries
-        skip = by_entry & ~finished & (entry.slot >= seq_len)
+        shown_depth, low_plane, missing = _entry_planes(m, entry, depth[entry.slot])
+        # (a frame's depth is known once every slot of the sequence holds its frame)
+        skip = by_entry & ~finished & ((entry.slot >= seq_len) | (loaded & missing))
         m.d.comb += self.entry_index.eq(play)
         answer_slot = Signal(SLOT_BITS)
         can_answer = Signal()
@@ -333,14 +339,12 @@ class SlotTable(wiring.Component):
             answer.slot.eq(answer_slot),
             answer.frame_id.eq(frame_id[answer_slot]),
             answer.bit_depth.eq(depth[answer_slot]),
+            answer.low_plane.eq(8 - depth[answer_slot]),
             answer.sequence.eq(sequence),
         ]
         with m.If(by_entry):
-            # an entry's depth: its frame's most significant planes (the reader takes planes
-            # 8 - depth .. 7 of a slot, the frame's own included)
-            with m.If((entry.depth != 0) & (entry.depth < depth[answer_slot])):
-                m.d.comb += answer.bit_depth.eq(entry.depth)
-            m.d.comb += [answer.showing.lsb.eq(entry.lsb), answer.showing.dark.eq(entry.dark),
+            m.d.comb += [answer.bit_depth.eq(shown_depth), answer.low_plane.eq(low_plane),
+                         answer.showing.lsb.eq(entry.lsb), answer.showing.dark.eq(entry.dark),
                          answer.showing.follow.eq(entry.follow), answer.showing.camera_off.eq(entry.camera_off),
                          answer.showing.last.eq(~self.loop & last_entry)]
 
@@ -432,6 +436,22 @@ class _Registers:
         self.recv_frame = Signal(frame_bits)
         self.last_valid = Signal()
         self.last_frame = Signal(frame_bits)
+
+
+def _entry_planes(m, entry, frame_depth):
+    """The planes ``entry`` shows of a frame of ``frame_depth`` planes (stored in planes
+    ``8 - frame_depth .. 7``): (its depth, its lowest stored plane, its planes are not all in the
+    frame)."""
+    shown, low, missing = Signal(4), Signal(3), Signal()
+    # all the frame has below the skipped planes (skip 0: a depth beyond the frame's too, as
+    # entries without a skip always meant it)
+    whole = (entry.depth == 0) | ((entry.skip == 0) & (entry.depth >= frame_depth))
+    with m.If(whole):
+        m.d.comb += [shown.eq(frame_depth - entry.skip), low.eq(8 - frame_depth),
+                     missing.eq(entry.skip >= frame_depth)]
+    with m.Else():
+        m.d.comb += [shown.eq(entry.depth), low.eq(entry.low_plane), missing.eq(entry.need > frame_depth)]
+    return shown, low, missing
 
 
 def _first_of(m, slots, condition):

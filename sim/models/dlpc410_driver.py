@@ -179,8 +179,7 @@ def play_schedule(driver, dmd, p, result, images, offset):
 
     def plane(fi, e):
         if (fi, e) not in planes:
-            depth = result.shown[fi].depth
-            planes[fi, e] = (np.asarray(images[fi]) >> (8 - depth + e)) & 1
+            planes[fi, e] = (np.asarray(images[fi]) >> result.shown[fi].stored_plane(e)) & 1
         return planes[fi, e]
 
     # the no-op rows a 1080p clear occupies come with the clear (Driver.clear)

@@ -61,7 +61,8 @@ GOOD_WIRE = records.register_wire(PLAN.params.registers(DMD))
 
 def entry_record(sequence=0, **fields):
     """A sequence entry record as it is (the projector's checks are what is under test)."""
-    values = {"index": 0, "slot": 0, "lsb": 0, "dark": 0, "follow": 0, "camera_off": 0, "depth": 0, **fields}
+    values = {"index": 0, "slot": 0, "lsb": 0, "dark": 0, "follow": 0, "camera_off": 0, "depth": 0, "skip": 0,
+              **fields}
     return _record(records.RecordType.ENTRY, body=wire.pack(records.ENTRY, values), sequence=sequence)
 
 
@@ -116,6 +117,7 @@ BAD_RECORDS = {
     "entry_follow_not_a_bit": (entry_record(follow=2), "drop_app_value"),
     "entry_camera_off_not_a_bit": (entry_record(camera_off=2), "drop_app_value"),
     "entry_depth_over_8": (entry_record(depth=9), "drop_app_value"),
+    "entry_skip_over_7": (entry_record(skip=8), "drop_app_value"),
     "entry_too_long": (entry_record() + b"\0", "drop_app_length"),
 }
 
@@ -169,10 +171,10 @@ def randomized_mix(count=260, seed=11):
             raw, bad = frames.udp(A, sequencer_record(seq, **changes)), False
             seq += 1
         elif roll < 0.78:
-            # entries, mostly good: the slot against the sequence in force, odd times, flags
+            # entries, mostly good: the slot against the sequence in force, odd times, flags, skips
             entry = entry_record(seq, index=rng.choice([0, 7, 255, 256]), slot=rng.choice([0, 0, 1, 2]),
                                  lsb=2 * rng.randrange(5) + (rng.random() < 0.2), dark=2 * rng.randrange(4),
-                                 follow=rng.choice([0, 1, 0, 1, 2]))
+                                 follow=rng.choice([0, 1, 0, 1, 2]), skip=rng.choice([0, 0, 3, 7, 8]))
             raw, bad = frames.udp(A, entry), False
             seq += 1
         else:

@@ -190,7 +190,7 @@ class Model:
             entry = wire.unpack(records.ENTRY, data[header_size:])
             if (entry["index"] > 255 or entry["slot"] >= self.config["sequence_length"] or entry["lsb"] % 2
                     or entry["dark"] % 2 or entry["follow"] > 1 or entry["camera_off"] > 1
-                    or entry["depth"] > 8):
+                    or entry["depth"] > 8 or entry["skip"] > 7):
                 return "drop_app_value"
         if kind == RecordType.SEQUENCER:
             registers = wire.unpack(records.SEQUENCER, data[header_size:])

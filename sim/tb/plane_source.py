@@ -52,15 +52,17 @@ class TableSignature(wiring.Signature):
 
 
 class OfferedFrame(data.Struct):
-    """An entry of the frame table: offer a frame of ``bit_depth`` planes in ``slot`` once the
-    sequencer's time base reaches ``ready`` (``sequence``: as the next frame of a stored
-    sequence), shown as ``showing`` says; entries after the last have ``valid`` low."""
+    """An entry of the frame table: offer a frame of ``bit_depth`` planes in ``slot`` from stored
+    plane ``low_plane`` up once the sequencer's time base reaches ``ready`` (``sequence``: as the
+    next frame of a stored sequence), shown as ``showing`` says; entries after the last have
+    ``valid`` low."""
     valid: 1
     slot: SLOT_BITS
     bit_depth: 4
     ready: TIME_BITS
     sequence: 1
     showing: Showing
+    low_plane: 3
 
 
 @dataclass
@@ -75,8 +77,10 @@ class Contents:
 
 def contents(dmd, frames, images=None, store_words=1):
     """The tables for ``frames`` (list of (slot, bit depth), (slot, bit depth, ready), (slot,
-    bit depth, ready, sequence) or (slot, bit depth, ready, sequence, showing): ``showing`` a
-    dict of :class:`~gateware.store.layouts.Showing`'s fields) and
+    bit depth, ready, sequence), (slot, bit depth, ready, sequence, showing): ``showing`` a
+    dict of :class:`~gateware.store.layouts.Showing`'s fields, or (slot, bit depth, ready,
+    sequence, showing, skip): the frame shows the stored planes ``8 - depth - skip .. 7 - skip``
+    as a sequence entry with that skip does) and
     ``images`` ({slot: 8-bit image}; None: :func:`ramp_image` in every slot with every block
     marked occupied, whatever the image holds); the planes ``store_words`` words an entry."""
     assert len(frames) <= MAX_FRAMES, f"at most {MAX_FRAMES} frames"
@@ -90,7 +94,9 @@ def contents(dmd, frames, images=None, store_words=1):
             [int(x) for x in bitplane.occupancy(image, dmd.rows_per_block)]
     offered = [OfferedFrame.const({"valid": 1, "slot": f[0], "bit_depth": f[1], "ready": f[2] if len(f) > 2 else 0,
                                    "sequence": f[3] if len(f) > 3 else 0,
-                                   "showing": f[4] if len(f) > 4 else {}}).as_value().value for f in frames]
+                                   "showing": f[4] if len(f) > 4 else {},
+                                   "low_plane": (8 - f[1] - (f[5] if len(f) > 5 else 0)) & 7}).as_value().value
+               for f in frames]
     words = planes.ravel()
     if store_words > 1:
         words = [sum(int(w) << (64 * i) for i, w in enumerate(words[k:k + store_words]))
@@ -162,6 +168,7 @@ class PlaneSource(wiring.Component):
                      self.frames.payload.slot.eq(entry.slot), self.frames.payload.bit_depth.eq(entry.bit_depth),
                      self.frames.payload.sequence.eq(entry.sequence),
                      self.frames.payload.showing.eq(entry.showing),
+                     self.frames.payload.low_plane.eq(entry.low_plane),
                      self.frames.payload.frame_id.eq(index)]
         with m.If(self.frames.valid & self.frames.ready):
             m.d.sync += index.eq(index + 1)

@@ -451,21 +451,22 @@ async def sequence_entries_play_as_their_table_says(dut):
     by an entry table of three of them, once, configured over GMII as a host does it (sequence
     mode, the entry records, the control record that plays them, then the frames): one trigger
     shows the three entries back to back (one at twice the exposure and without a camera
-    trigger, one at 4 bits: its frame's four most significant planes; the last two following
-    with no trigger), every pixel's light is each entry's frame at its own exposure and depth,
-    and a trigger after the last entry is ignored and counted."""
+    trigger, one at 4 bits below its frame's two most significant: bits 2..5; the last two
+    following with no trigger), every pixel's light is each entry's frame at its own exposure
+    and planes, and a trigger after the last entry is ignored and counted."""
     system = await System.started(dut)
     p, dmd, plan = system.p, system.dmd, system.plan
     rng = np.random.default_rng(p["seed"] + 7)
     images = [rng.integers(0, 256, (dmd.rows, dmd.columns), dtype=np.uint8) for _ in range(7)]
     lsb = plan.params.lsb
-    # (slot, lsb, follow, camera, depth): entry 0 waits for the trigger, the others follow
-    table = [(6, 0, False, True, 0), (0, 2 * lsb, True, False, 0), (3, 0, True, True, 4)]
+    # (slot, lsb, follow, camera, depth, skip): entry 0 waits for the trigger, the others follow
+    table = [(6, 0, False, True, 0, 0), (0, 2 * lsb, True, False, 0, 0), (3, 0, True, True, 4, 2)]
     await system.records([codec.sequencer_record(plan.params.registers(dmd), system.next_sequence(), dmd=dmd),
                           codec.control_record(system.next_sequence(), bit_depth=8, sequence_length=len(images),
                                                armed=1)])
     entries = [codec.entry_record(k, slot, system.next_sequence(), lsb=entry_lsb, follow=follow, camera=camera,
-                                  depth=depth) for k, (slot, entry_lsb, follow, camera, depth) in enumerate(table)]
+                                  depth=depth, skip=skip)
+               for k, (slot, entry_lsb, follow, camera, depth, skip) in enumerate(table)]
     await system.records([*entries, codec.control_record(system.next_sequence(), entries=len(table), loop=0,
                                                          sequence_start=True)])
     for slot, image in enumerate(images):
@@ -473,7 +474,7 @@ async def sequence_entries_play_as_their_table_says(dut):
     # the sequence's first entry is loaded once the store holds both frames: then one trigger
     await system.dmd_clock.cycles(2 * plan.frame_cycles)
     pin = await system.trigger()
-    span = sum((entry_lsb or lsb) * (2 ** (depth or 8) - 1) for _, entry_lsb, _, _, depth in table) \
+    span = sum((entry_lsb or lsb) * (2 ** (depth or 8) - 1) for _, entry_lsb, _, _, depth, _ in table) \
         + len(table) * plan.frame_cycles
     await system.dmd_clock.cycles(span)
     pulses = system.pulses_after(pin)
@@ -482,9 +483,9 @@ async def sequence_entries_play_as_their_table_says(dut):
     await system.dmd_clock.cycles(plan.frame_cycles)
     assert not system.pulses_after(late), "a trigger after a sequence played once showed a frame"
     light = Camera(system.dlpc, ramp_cycles=0).image(pulses[0].cycle, late)
-    # an entry at d bits shows its frame's d most significant planes: the value >> (8 - d)
-    expect = sum((images[slot].astype(np.int64) >> (8 - (depth or 8))) * (entry_lsb or lsb)
-                 for slot, entry_lsb, _, _, depth in table)
+    # an entry at d bits below s left out shows bits 8 - d - s .. 7 - s of its frame's values
+    expect = sum(((images[slot].astype(np.int64) >> (8 - (depth or 8) - skip)) & ((1 << (depth or 8)) - 1))
+                 * (entry_lsb or lsb) for slot, entry_lsb, _, _, depth, skip in table)
     assert np.array_equal(light, expect), f"max error {np.abs(light - expect).max() / lsb:.3g} LSB"
     status = await system.status()
     assert status["records_entry"] == len(table) and status["drop_app_value"] == 0, status
