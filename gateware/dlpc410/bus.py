@@ -116,10 +116,8 @@ class Bus(wiring.Component):
         clear_cycles = dmd.clear_row_cycles * R
 
         # after an operation is applied: cycles until the next decision may be made (the next
-        # operation's pins may follow its pins back to back), and the pins' own row cycles
+        # operation's pins may follow its pins back to back)
         remain = Signal(range(clear_cycles))
-        row_left = Signal(range(R))
-        noops = Signal(range(dmd.clear_row_cycles))
         spent = Signal(init=1)                 # ``remain`` is 0 (registered with it)
         # a decision on every other cycle: ``even``, and (should the time base stall, as it does
         # while the controller initialises) never on two cycles running
@@ -223,6 +221,19 @@ class Bus(wiring.Component):
         m.d.comb += self.loaded.eq(ends | Mux(op & dec.last & length_two, dec.load_group, 0))
 
         # ---- the command registers ----
+        self._command_registers(m, dec, op, remain=remain, spent=spent)
+        return m
+
+    def _command_registers(self, m, dec, op, *, remain, spent):
+        """The pins of the decision ``dec`` (``op``: it loads a row or clears a block), from the
+        cycle after it: the command held through its row cycles (a clear's no-op rows after it),
+        DVALID, the row's beats; and ``remain``, the cycles until the next decision may be made
+        (``spent``: none)."""
+        dmd, regs = self._dmd, self.regs
+        R = row_cycles(dmd, self._beats)
+        clear_cycles = dmd.clear_row_cycles * R
+        row_left = Signal(range(R))            # the pins' row cycle
+        noops = Signal(range(dmd.clear_row_cycles))
         cmd = self.command
         op_row = Signal()                      # the row cycle on the pins loads a row
         reading = dec.row | (op_row & (row_left != 0))
@@ -259,7 +270,6 @@ class Bus(wiring.Component):
         with m.Else():
             m.d.sync += [self.dvalid.eq(0), op_row.eq(0), cmd.rowmd.eq(RowMode.NOOP),
                          cmd.blkmd.eq(BlockMode.NOOP), cmd.rst2blkz.eq(1)]
-        return m
 
 
 def _lowest(bits):
