@@ -37,19 +37,25 @@ def _ethernet_port():
     return EthernetPort(DMDS["dlp7000"], **_ADDRESSES)
 
 
+def _xga_slots():
+    """The projector's frame slots for the DLP7000 (every XGA frame the DDR2 holds)."""
+    from gateware.top.system import slots_for
+    return slots_for(DMDS["dlp7000"])
+
+
 def _frame_slots():
     from gateware.store.slots import FrameSlots
-    return FrameSlots(DMDS["dlp7000"], slots=4)
+    return FrameSlots(DMDS["dlp7000"], slots=_xga_slots())
 
 
 def _writer():
     from gateware.store.writer import Writer
-    return Writer(DMDS["dlp7000"], slots=4)
+    return Writer(DMDS["dlp7000"], slots=_xga_slots())
 
 
 def _reader():
     from gateware.store.reader import Reader
-    return Reader(DMDS["dlp7000"], slots=4)
+    return Reader(DMDS["dlp7000"], slots=_xga_slots())
 
 
 def _read_widener():

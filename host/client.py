@@ -374,6 +374,12 @@ class Client:
         if "bit_depth" in config:
             self._depth = config["bit_depth"]
 
+    def sequence_frames(self):
+        """The most frames a stored sequence holds on this projector: every whole frame of its
+        DMD in the store's memory (170 XGA frames), up to the slots an entry record names (256)."""
+        status = self.status()
+        return records.sequence_frames(status["dmd_rows"], status["dmd_columns"])
+
     def play_sequence(self, images, entries, *, loop=True, depth=None, tolerance=0.5):
         """Store ``images`` as a sequence (frame ``k`` in slot ``k``) and play it by an entry
         table: ``entries``, each a dict of :func:`host.codec.entry_record`'s settings with its
@@ -384,8 +390,9 @@ class Client:
         or skip when it plays (planes its frame is not sent with: each frame goes at the depth
         :meth:`send_image` chooses), is refused before anything is sent. Returns the
         :class:`Sent` of each image."""
-        if not 2 <= len(images) <= 16:
-            raise ClientError(f"a stored sequence holds 2 to 16 frames, not {len(images)}")
+        held = self.sequence_frames()
+        if not 2 <= len(images) <= held:
+            raise ClientError(f"a stored sequence holds 2 to {held} frames of this DMD, not {len(images)}")
         if not 1 <= len(entries) <= records.ENTRIES:
             raise ClientError(f"an entry table holds 1 to {records.ENTRIES} entries, not {len(entries)}")
         outside = [e["slot"] for e in entries if not 0 <= e["slot"] < len(images)]

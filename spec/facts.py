@@ -173,6 +173,20 @@ class BlockMode(enum.IntEnum):
     MULTI = 0b11      # dual (RST2BLKZ=0), quad (RST2BLKZ=1, BLKAD=0qq0) or global (BLKAD=10xx)
 
 
+#: The frame store's memory: the Atlys's DDR2.
+MEMORY = {
+    "bytes": Fact(128 * 2**20, "B", "Micron MT47H64M16 (64 Mi x 16 bit); Digilent Atlys reference manual", "high",
+                  "the one DDR2 part on the board"),
+}
+
+
+def frames_held(rows, columns, *, memory_bytes=None):
+    """Whole 8-plane frames of ``rows`` x ``columns`` (a multiple of 64) the memory holds: the
+    DLP7000's 170, the DLP9500's 60 in 128 MiB."""
+    memory_bytes = MEMORY["bytes"].value if memory_bytes is None else memory_bytes
+    return int(memory_bytes) // (8 * rows * columns // 8)
+
+
 #: The Marvell 88E1111 PHY, as the management block (:mod:`gateware.mac.mdio`) needs it.
 PHY = {
     "mdc_max": Fact(2.5e6, "Hz", "802.3 22.2.2.13", "high", "the 88E1111 accepts up to 8.3 MHz"),

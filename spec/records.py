@@ -16,7 +16,7 @@ store's bit depth and sequence, arming, the network addresses.
 __all__ = [
     "MAGIC", "VERSION", "RecordType", "Action", "ENTRIES",
     "HEADER", "IMAGE", "DELTA", "CONTROL", "CONFIG", "SEQUENCER", "ENTRY", "entry_faults", "delta_faults",
-    "config_faults",
+    "config_faults", "sequence_frames",
     "NET_COUNTERS", "RECORD_COUNTERS",
     "ROW_COUNTERS", "GEOMETRY", "APP_COUNTERS", "SYSTEM_STATUS", "STATUS_REPLY", "IMAGE_HEADER",
     "DELTA_HEADER",
@@ -28,6 +28,7 @@ import enum as _enum
 import functools as _functools
 import operator as _operator
 
+from . import facts
 from . import registers as _registers
 from .wire import size
 
@@ -315,13 +316,22 @@ def entry_faults(wire, sequence_length):
     }
 
 
-def config_faults(wire, applies):
+def sequence_frames(rows, columns):
+    """The most frames a stored sequence holds on a DMD of ``rows`` x ``columns`` (on the bus):
+    every whole frame in the store's memory, up to the slots an entry record names (DLP7000 170,
+    DLP9500 60)."""
+    return min(1 << dict(ENTRY)["slot"], facts.frames_held(rows, columns))
+
+
+def config_faults(wire, applies, frames):
     """Why a control record cannot be applied (``{check: condition}``): a field it applies
-    (``applies(name)`` true) holds a value nothing obeys."""
+    (``applies(name)`` true) holds a value nothing obeys (a sequence longer than the ``frames``
+    the projector holds, :func:`sequence_frames`, included)."""
     return {
         "bit_depth": applies("bit_depth") & ((wire["bit_depth"] == 0) | (wire["bit_depth"] > 8)),
         "armed": applies("armed") & (wire["armed"] > 1),
-        "sequence_length": applies("sequence_length") & (wire["sequence_length"] == 0),
+        "sequence_length": applies("sequence_length") & ((wire["sequence_length"] == 0)
+                                                         | (wire["sequence_length"] > frames)),
         "entries": applies("entries") & (wire["entries"] > ENTRIES),
         "loop": applies("loop") & (wire["loop"] > 1),
     }

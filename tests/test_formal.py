@@ -90,7 +90,7 @@ def test_ready_paths():
 
 
 @pytest.mark.parametrize("check", [
-    *[c for c in blocks.checks() if c.block == "Countdown"],
+    *[c for c in blocks.checks() if c.block in ("Countdown", "SlotStates")],
     *[c for c in store.store_checks()],
 ], ids=lambda c: c.key)
 def test_checks_quick(check):
@@ -194,3 +194,10 @@ def test_sequencer_phased_settle_rule():
     result = _first_failure(check, lambda: sequencer.phased_settle_top(extra=1), 35)
     assert result.failed == ["a load sooner than t_rst + t_settle after a pulse"]
     assert result.step == 34 and result.step > check.quick, result.step
+
+
+def test_slot_states_last_write_wins_is_proven():
+    """The sequence slots' states (two writers built of one-writer memories, XOR halves): each
+    slot reads what was last written to it, by k-induction."""
+    check = blocks.slot_states_check()
+    assert run(check, depth=check.depth).status == "proven"

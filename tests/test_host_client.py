@@ -415,6 +415,12 @@ def test_play_sequence_sends_the_table_then_the_frames(projector):
     with Client("127.0.0.1", projector.port, timeout=1.0, rate=50e6, mtu=1500) as client:
         with pytest.raises(ClientError, match="outside the sequence"):
             client.play_sequence(images, [{"slot": 2}])
+        # as many frames as the memory holds of the DMD (128 MiB of 8-plane frames), at most
+        # the 256 slots an entry names
+        held = client.sequence_frames()
+        assert held == min(256, 128 * 2**20 // (SHAPE[0] * SHAPE[1]))
+        with pytest.raises(ClientError, match=f"2 to {held} frames"):
+            client.play_sequence(images[:1] * (held + 1), [{"slot": 0}])
         with pytest.raises(ClientError, match="entry 0: .*lsb_even"):
             client.play_sequence(images, [{"slot": 0, "lsb": 3}])
         with pytest.raises(ClientError, match="entry 1: .*depth"):

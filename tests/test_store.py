@@ -25,9 +25,9 @@ FIELD_ROWS = 1 << (SHORT_DMD.rows - 1).bit_length()
 class Bench:
     """A StoreChain with the MCB model on both ports and sequencer-side helpers (``dmd``)."""
 
-    def __init__(self, dmd=DMD, *, slots=4, timing=None, read_width=128):
+    def __init__(self, dmd=DMD, *, slots=4, timing=None, read_width=128, **store):
         self.dmd, self.slots, self.read_width = dmd, slots, read_width
-        self.dut = StoreChain(dmd, slots=slots, read_width=read_width)
+        self.dut = StoreChain(dmd, slots=slots, read_width=read_width, **store)
         self.model = McbModel(64 * 1024, timing=timing, widths=widths(self.dut.mcb_write, self.dut.mcb_read))
         self.processes = [
             amaranth_process(self.model.ports[0], self.dut.mcb_write, domain="sync", frequency=SYNC_HZ),
@@ -987,6 +987,147 @@ def test_sequence_entries_pick_planes(test_name):
         assert bench.counters(ctx)["bad_releases"] == 0
 
     bench.run([producer, consumer], test_name, deadline=8e-4)
+
+
+#: A store whose sequence spans slots beyond its live ones (as the projector's 170 XGA slots
+#: beyond its 16 live ones), small enough to simulate: 12 slots, 4 live.
+SEQUENCE_SLOTS, LIVE = 12, 4
+
+
+def test_sequence_beyond_the_live_slots(test_name):
+    """A sequence of 12 frames on a store of 12 slots of which 4 are live (kept in registers):
+    frames of every bit depth sent in a random order load every slot; the sequence plays in
+    order, each frame read back exactly (every stored plane and the occupancy map, numpy's) from
+    its slot, then by an entry table that names slots on both sides of the live ones in any
+    order. A delta frame for a slot beyond the live ones is refused (no base), as are rows of a
+    frame complete (duplicate) and beyond the sequence (stale), each counted."""
+    bench = Bench(SHORT_DMD, slots=SEQUENCE_SLOTS, live=LIVE)
+    dut = bench.dut
+    n = SEQUENCE_SLOTS
+    rng = random.Random(12)
+    images = {f: store_stim.random_image(SHORT_DMD, 1500 + f) for f in range(n)}
+    depths = {f: 1 + (f * 3) % 8 for f in range(n)}
+    entries = [11, 4, 0, 9, 9, 5, 3, 7]
+
+    async def producer(ctx):
+        ctx.set(dut.sequence_length, n)
+        for _ in range(3):
+            await ctx.tick()
+        # a delta frame of slot 7 (beyond the live ones), before its whole frame: refused
+        await bench.feed(ctx, images[7], 7, rows=range(3), base=0, carried=3)
+        order = list(range(n))
+        rng.shuffle(order)
+        for f in order:
+            ctx.set(dut.bit_depth, depths[f])
+            await ctx.tick()
+            await bench.feed(ctx, images[f], f)
+        await bench.feed(ctx, images[9], 9, rows=range(5))       # complete already: duplicate
+        await bench.feed(ctx, images[1], n, rows=range(2))       # beyond the sequence: stale
+
+    async def consumer(ctx):
+        held = None
+        for f in range(n):
+            slot, frame, depth = await bench.ask(ctx)
+            assert (slot, frame, depth) == (f, f, depths[f]), f"sequence frame {f}"
+            await bench.check_frame(ctx, slot, images[f], depth, what=f"sequence frame {f}")
+            if held is not None:
+                await bench.release(ctx, held)
+            held = slot
+        counters = bench.counters(ctx)
+        assert counters["frames_complete"] == n
+        assert (counters["rows_no_base"], counters["rows_duplicate"], counters["rows_stale"]) == (3, 5, 2), counters
+        # the same frames by entries, played once
+        await bench.write_entries(ctx, [{"slot": slot} for slot in entries])
+        ctx.set(dut.sequence_start, 1)
+        await ctx.tick("dmd")
+        ctx.set(dut.sequence_start, 0)
+        for index, slot in enumerate(entries):
+            payload = await bench.answer(ctx)
+            assert (int(payload.slot), int(payload.frame_id), int(payload.bit_depth)) == (slot, slot, depths[slot]), \
+                f"entry {index}"
+            assert int(payload.showing.last) == (index == len(entries) - 1)
+            if slot >= LIVE:
+                await bench.check_frame(ctx, slot, images[slot], depths[slot], what=f"entry {index}")
+            if held != slot:
+                await bench.release(ctx, held)
+            held = slot
+        assert await bench.answer(ctx, wait=400) is None, "an answer after the last entry of a sequence played once"
+        assert bench.counters(ctx)["bad_releases"] == 0
+
+    bench.run([producer, consumer], test_name, deadline=3e-3)
+
+
+def test_sequence_slots_walked_on_mode_change_and_loss(test_name):
+    """The slots beyond the live ones are walked, one a cycle, when the mode changes or the memory
+    is lost. A sequence of 12 frames plays up to frame 10 (a slot beyond the live ones), held;
+    the sequence is cut to 11 frames: every other slot is freed (its frame sent again is taken),
+    the held one is kept (its rows refused as shown) until released, then taken again. The
+    sequence plays again, frame 10 exact. Then the memory loses its calibration while frame 10
+    is held: all 11 frames are counted lost, the held one is handed back without complaint, and
+    the frames sent again after the recovery play in order, exact."""
+    bench = Bench(SHORT_DMD, slots=SEQUENCE_SLOTS, live=LIVE)
+    dut = bench.dut
+    n = SEQUENCE_SLOTS
+    images = {f: store_stim.random_image(SHORT_DMD, 1600 + f) for f in range(n)}
+    phase = {}
+
+    async def send(ctx, frames):
+        for f in frames:
+            await bench.feed(ctx, images[f], f)
+        await bench.settle(ctx)
+
+    async def producer(ctx):
+        ctx.set(dut.bit_depth, 1)
+        ctx.set(dut.sequence_length, n)
+        for _ in range(3):
+            await ctx.tick()
+        await send(ctx, range(n))
+        await wait_until(ctx, lambda: "held" in phase)
+        ctx.set(dut.sequence_length, n - 1)
+        await send(ctx, [10])                                     # held: refused as shown
+        await send(ctx, range(10))                                # freed by the walk: taken
+        phase["resent"] = True
+        await wait_until(ctx, lambda: "released" in phase)
+        await send(ctx, [10])
+        await wait_until(ctx, lambda: "recovered" in phase)
+        await send(ctx, range(n - 1))
+
+    async def play_to(ctx, last, check=()):
+        """Ask for frames 0..last in order (each released when the next is given): the slot
+        of ``last``, held."""
+        held = None
+        for f in range(last + 1):
+            slot, frame, _ = await bench.ask(ctx)
+            assert (slot, frame) == (f, f)
+            if f in check:
+                await bench.check_frame(ctx, slot, images[f], 1, what=f"sequence frame {f}")
+            if held is not None:
+                await bench.release(ctx, held)
+            held = slot
+        return held
+
+    async def consumer(ctx):
+        held = await play_to(ctx, 10)
+        phase["held"] = True
+        await wait_until(ctx, lambda: "resent" in phase, domain="dmd")
+        counters = bench.counters(ctx)
+        assert counters["rows_shown"] == SHORT_DMD.rows, counters
+        assert counters["frames_complete"] == n + 10, counters
+        await bench.release(ctx, held)
+        phase["released"] = True
+        for _ in range(2 * SHORT_DMD.rows):
+            await ctx.tick("dmd")
+        held = await play_to(ctx, 10, check=(0, 10))
+        assert bench.counters(ctx)["frames_complete"] == n + 11
+        bench.model.lose_calibration(bench.model.now + 60e-9, 2e-6)
+        await ctx.tick("dmd").until(dut.lost)
+        await bench.recovered(ctx, frames_lost=n - 1)
+        await bench.release(ctx, held)
+        phase["recovered"] = True
+        await play_to(ctx, 10, check=(5, 9))
+        assert bench.counters(ctx)["bad_releases"] == 0
+
+    bench.run([producer, consumer], test_name, deadline=4e-3)
 
 
 @pytest.mark.parametrize("dmd,width", [("dlp7000", 128), ("dlp7000", 64), ("dlp9500", 128), ("dlp650lnir", 128),

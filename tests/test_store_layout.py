@@ -18,10 +18,13 @@ def test_xga_plane_is_0x3000_words():
     assert amap.address(1, 2, 3, 4) == 0xC0000 + 2 * 0x18000 + 3 * 0x80 + 4 * 8
 
 
-@pytest.mark.parametrize("dmd", ["dlp7000", "dlp9500", "dlp650lnir", "test"])
-def test_slots_and_planes_tile_the_memory(dmd):
+@pytest.mark.parametrize("dmd, slots", [("dlp7000", 170), ("dlp9500", 60), ("dlp650lnir", 131), ("test", 256)])
+def test_slots_and_planes_tile_the_memory(dmd, slots):
+    """The projector's slots (every whole frame in 128 MiB, 256 at most: 1024 x 768, 2048 x 1080
+    and 1280 x 800 bytes a frame) tile the memory: no gap, no overlap, nothing beyond it."""
+    from gateware.top.system import slots_for
     geometry = DMDS[dmd]
-    slots = 16
+    assert slots_for(geometry) == slots
     amap = AddressMap(geometry, slots)
     assert amap.end <= MEMORY_BYTES
     spans = sorted((amap.address(s, p), amap.address(s, p) + amap.plane_bytes)

@@ -119,6 +119,7 @@ class Parser(wiring.Component):
 
         def applies(name):
             return control.apply[names.index(name)]
+        frames = records.sequence_frames(dmd.rows, dmd.columns)    # a longer sequence: a bad value
         with m.If(header.magic != records.MAGIC):
             m.d.comb += cause.eq(1 + causes.index("magic"))
         with m.Elif(header.version != records.VERSION):
@@ -137,7 +138,8 @@ class Parser(wiring.Component):
             m.d.comb += cause.eq(1 + causes.index("rows"))
         with m.Elif((header.type == RecordType.DELTA) & Cat(records.delta_faults(delta).values()).any()):
             m.d.comb += cause.eq(1 + causes.index("value"))
-        with m.Elif((header.type == RecordType.CONTROL) & Cat(records.config_faults(control, applies).values()).any()):
+        with m.Elif((header.type == RecordType.CONTROL)
+                    & Cat(records.config_faults(control, applies, frames).values()).any()):
             m.d.comb += cause.eq(1 + causes.index("value"))
         with m.Elif((header.type == RecordType.ENTRY)
                     & Cat(records.entry_faults(entry, self.settings.sequence_length).values()).any()):

@@ -20,10 +20,12 @@ Every row starts on a 16-byte boundary when ``words_per_row`` is even (every DMD
 128-bit memory port reads whole rows.
 """
 
-__all__ = ["AddressMap", "MEMORY_BYTES", "PLANES", "WORD_BYTES"]
+from spec.facts import MEMORY, frames_held
+
+__all__ = ["AddressMap", "MEMORY_BYTES", "PLANES", "WORD_BYTES", "slots_held"]
 
 #: The Atlys DDR2 (MT47H64M16): 64 Mi x 16 bit = 128 MiB.
-MEMORY_BYTES = 128 * 2**20
+MEMORY_BYTES = int(MEMORY["bytes"].value)
 PLANES = 8
 #: Bytes in a plane word (64 columns); the memory ports move one, two or half of one at a time.
 WORD_BYTES = 8
@@ -53,3 +55,8 @@ class AddressMap:
         """``(first, end)`` byte addresses of a slot."""
         first = self.address(slot, 0)
         return first, first + self.slot_bytes
+
+
+def slots_held(dmd, *, limit, memory_bytes=MEMORY_BYTES):
+    """Frame slots of ``dmd`` the memory holds whole (``limit`` at most): DLP7000 170, DLP9500 60."""
+    return min(limit, frames_held(dmd.rows, dmd.words_per_row * 64, memory_bytes=memory_bytes))

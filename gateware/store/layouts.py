@@ -29,14 +29,19 @@ sequencer, so reading it from another clock domain is safe for every slot the se
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-__all__ = ["COUNTER_BITS", "SLOT_BITS", "BLOCK_BITS", "SHOW_BITS", "PlaneRequest", "Showing", "FrameInfo",
+__all__ = ["COUNTER_BITS", "SLOT_BITS", "LIVE_SLOTS", "BLOCK_BITS", "SHOW_BITS", "PlaneRequest", "Showing", "FrameInfo",
            "OccupancySignature"]
 
-#: Frame slots are numbered in this many bits (16 slots; sequence mode spans slots).
 #: Width of every event counter: that of the status reply's fields, so that none wraps inside
 #: its field (at 65,536 a 16-bit count of frames shown wrapped after minutes).
 COUNTER_BITS = 32
-SLOT_BITS = 4
+#: Frame slots are numbered in this many bits: a stored sequence spans every slot the memory
+#: holds (170 XGA frames in 128 MiB), that of the entry record's slot field.
+SLOT_BITS = 8
+#: The slots streaming uses, and delta frames and their bases: the store searches their states
+#: every cycle, so they are kept in registers (the sequence slots beyond them are looked up by
+#: number, their states in memory).
+LIVE_SLOTS = 16
 #: DMD blocks are numbered in this many bits (16 blocks at most).
 BLOCK_BITS = 4
 

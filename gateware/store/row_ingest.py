@@ -12,8 +12,9 @@ block's planes in the occupancy map. The row that completes the frame (every row
 rows it says it carries) is marked for the writer and reported to the table.
 """
 
-from amaranth import Array, Cat, Const, Module, Mux, Signal
+from amaranth import Cat, Const, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
+from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
 
@@ -106,7 +107,11 @@ class RowIngest(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         dmd, count = self._dmd, self.counters
-        missing = Array(Signal(range(dmd.rows + 1), name=f"missing{s}") for s in range(self._slots))
+        # rows each slot still waits for: several slots of a sequence may receive at once (only
+        # the current slot's count is read or written, so a memory: LUT RAM, not a register each)
+        m.submodules.missing = missing_rows = Memory(shape=range(dmd.rows + 1), depth=self._slots, init=[])
+        missing_w, missing_r = missing_rows.write_port(), missing_rows.read_port(domain="comb")
+        missing = missing_r.data
         head = self.words.payload
         flags = self.rows.payload
         place = self.placement
@@ -116,7 +121,7 @@ class RowIngest(wiring.Component):
         delta = Signal()                        # the frame being set up is a delta ...
         base = Signal(SLOT_BITS)                # ... of the frame in this slot,
         base_depth = Signal(4)                  # at its bit depth
-        needed = Signal.like(missing[0])        # rows that complete it
+        needed = Signal(range(dmd.rows + 1))    # rows that complete it
         clear_index = Signal(ceil_log2(dmd.rows))
         depth_in = Signal(4)
         m.d.comb += depth_in.eq(self.bit_depth)
@@ -160,7 +165,9 @@ class RowIngest(wiring.Component):
             self.store.payload.row.eq(head.row),
             self.store.payload.word.eq(head.word),
             self.store.payload.last.eq(is_last),
-            self.store.payload.completes.eq(missing[cur_slot] == 1),
+            self.store.payload.completes.eq(missing == 1),
+            missing_r.addr.eq(cur_slot),
+            missing_w.addr.eq(cur_slot),
         ]
 
         with m.FSM(name="ingest") as ingest:
@@ -199,7 +206,8 @@ class RowIngest(wiring.Component):
                 m.d.sync += clear_index.eq(clear_index + 1)
                 with m.If(clear_index == dmd.rows - 1):
                     m.d.comb += self.opened.valid.eq(1)
-                    m.d.sync += [missing[cur_slot].eq(needed), cur_depth.eq(Mux(delta, base_depth, depth_in))]
+                    m.d.comb += [missing_w.en.eq(1), missing_w.data.eq(needed)]
+                    m.d.sync += cur_depth.eq(Mux(delta, base_depth, depth_in))
                     m.next = "LOOKUP"
 
             with m.State("LOOKUP"):
@@ -237,8 +245,8 @@ class RowIngest(wiring.Component):
                             self.map_writes.payload.occupancy_mask.eq(flags.planes & stored_mask),
                             self.map_writes.payload.occupancy.eq(~0),
                         ]
-                        m.d.sync += missing[cur_slot].eq(missing[cur_slot] - 1)
-                        with m.If(missing[cur_slot] == 1):
+                        m.d.comb += [missing_w.en.eq(1), missing_w.data.eq(missing - 1)]
+                        with m.If(missing == 1):
                             m.d.comb += self.completed.valid.eq(1)
                             m.d.sync += count.frames_complete.eq(count.frames_complete + 1)
                         m.next = "ROW_START"

@@ -65,7 +65,8 @@ class RowLookupSignature(wiring.Signature):
     stored : In(1)
         (``"stored"``) One cycle later: that row arrived in that slot.
     source : In(SLOT_BITS)
-        (``"source"``) One cycle later: the slot whose words that row shows.
+        (``"source"``) One cycle later: the slot whose words that row shows (of a delta frame;
+        a whole frame's rows show the slot itself).
     delta : In(1)
         (``"source"``) One cycle later: the slot holds a delta frame (some rows show its base's
         words).
@@ -93,6 +94,9 @@ class SlotMaps(wiring.Component):
     dmd : :class:`spec.facts.DmdType`
     slots : int
         Frame slots.
+    live : int
+        The slots whose rows may show another slot's words (delta frames: the live slots of
+        :class:`~gateware.store.slot_table.SlotTable`); default: every slot.
 
     Members
     -------
@@ -108,8 +112,9 @@ class SlotMaps(wiring.Component):
         Occupancy map read port (``dmd``).
     """
 
-    def __init__(self, dmd, *, slots=4):
+    def __init__(self, dmd, *, slots=4, live=None):
         self._dmd, self._slots = dmd, slots
+        self._live = slots if live is None else min(live, slots)
         super().__init__({
             "writes": In(stream.Signature(map_write_layout(dmd), always_ready=True)),
             "bitmap": In(RowLookupSignature(dmd, "stored")),
@@ -123,12 +128,17 @@ class SlotMaps(wiring.Component):
         row_bits = ceil_log2(self._dmd.rows)
         write = self.writes.payload
 
-        written = Cat(write.row, write.slot)
-        for name, port, domain in (("stored", self.bitmap, "sync"), ("source", self.sources, "dmd")):
-            m.submodules[name] = memory = Memory(shape=len(getattr(port, name)), depth=self._slots << row_bits, init=[])
+        # the stored bits of every slot; the sources of the live slots only: a slot beyond them
+        # holds a whole frame (never a delta, :mod:`gateware.store.slot_table`), whose rows the
+        # plane reader reads from the slot itself without asking for their source
+        for name, port, domain, slots in (("stored", self.bitmap, "sync", self._slots),
+                                          ("source", self.sources, "dmd", self._live)):
+            bits = ceil_log2(slots)
+            m.submodules[name] = memory = Memory(shape=len(getattr(port, name)), depth=slots << row_bits, init=[])
             w, r = memory.write_port(), memory.read_port(domain=domain)
-            m.d.comb += [w.addr.eq(written), w.data.eq(write[name]), w.en.eq(self.writes.valid),
-                         r.addr.eq(Cat(port.row, port.slot)), r.en.eq(port.en), getattr(port, name).eq(r.data)]
+            m.d.comb += [w.addr.eq(Cat(write.row, write.slot[:bits])), w.data.eq(write[name]),
+                         w.en.eq(self.writes.valid & (write.slot < slots)),
+                         r.addr.eq(Cat(port.row, port.slot[:bits])), r.en.eq(port.en), getattr(port, name).eq(r.data)]
         m.submodules.kinds = kinds = Memory(shape=1, depth=self._slots, init=[])
         kinds_w, kinds_r = kinds.write_port(), kinds.read_port(domain="dmd")
         m.d.comb += [

@@ -39,7 +39,8 @@ from amaranth.lib.wiring import In, Out
 from spec.records import ENTRIES
 
 from .entries import ENTRY_BITS, Entry
-from .layouts import COUNTER_BITS, SLOT_BITS, FrameInfo
+from .layouts import COUNTER_BITS, LIVE_SLOTS, SLOT_BITS, FrameInfo
+from .slot_states import SlotStates
 
 __all__ = ["SlotTable", "SlotState", "Placement", "PlacementSignature", "opening_layout", "TableCounters"]
 
@@ -126,12 +127,21 @@ class TableCounters(data.Struct):
 class SlotTable(wiring.Component):
     """States of the frame slots, placement of rows, and housekeeping (``sync``).
 
+    The first ``live`` slots are kept in registers and searched every cycle: streaming uses only
+    those, and so do delta frames and their bases. A stored sequence spans every slot; the
+    states of those beyond the live ones are in memory (:class:`~gateware.store.slot_states.SlotStates`),
+    looked up by number, they hold whole frames only (a delta frame there is refused as having
+    no base: ``NO_BASE``), and a change of mode or a lost memory walks them, one slot a cycle,
+    while rows and asks wait.
+
     Parameters
     ----------
     slots : int
         Frame slots.
     frame_bits : int
         Width of the frame id.
+    live : int
+        Slots kept in registers (at most ``slots``).
 
     Members
     -------
@@ -143,8 +153,9 @@ class SlotTable(wiring.Component):
         Every row of the frame in this slot has arrived: it is being written.
     written : In(stream.Signature(SLOT_BITS))
         From the writer: the completing row of this slot is in memory.
-    sequence_length : In(5)
-        0: streaming; N: sequence of N frames in slots 0..N-1 (at most ``slots``).
+    sequence_length : In(16)
+        0: streaming; N: sequence of N frames in slots 0..N-1 (``slots`` at most: a longer one
+        is cut to ``slots``).
     entries, loop, sequence_start : In(range(ENTRIES + 1)), In(1), In(1)
         A sequence's entries played (0: its slots in order); in a loop or once; a pulse that
         plays them from the first again.
@@ -163,14 +174,15 @@ class SlotTable(wiring.Component):
     counters : Out(TableCounters)
     """
 
-    def __init__(self, *, slots=4, frame_bits=16):
-        self._slots, self._frame_bits = slots, frame_bits
+    def __init__(self, *, slots=4, frame_bits=16, live=LIVE_SLOTS):
+        assert slots <= 2**SLOT_BITS
+        self._slots, self._frame_bits, self._live = slots, frame_bits, min(live, slots)
         super().__init__({
             "placement": In(PlacementSignature(frame_bits)),
             "opened": In(stream.Signature(opening_layout(frame_bits), always_ready=True)),
             "completed": In(stream.Signature(SLOT_BITS, always_ready=True)),
             "written": In(stream.Signature(SLOT_BITS)),
-            "sequence_length": In(5),
+            "sequence_length": In(16),
             "entries": In(range(ENTRIES + 1)),
             "loop": In(1),
             "sequence_start": In(1),
@@ -186,111 +198,141 @@ class SlotTable(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        n_slots = self._slots
+        n_slots, live = self._slots, self._live
         count = self.counters
-        t = _Registers(n_slots, self._frame_bits)
-        state, frame_id, depth, in_sequence, stale = t.state, t.frame_id, t.depth, t.in_sequence, t.stale
+        t = _Registers(live, self._frame_bits)
+        slots = _Slots(m, t, n_slots, live)
+        state, frame_id, in_sequence, stale = t.state, t.frame_id, t.in_sequence, t.stale
 
         # -- mode
-        seq_len = Signal(5)          # the mode in force
-        wanted_len = Signal(5)
-        m.d.comb += wanted_len.eq(self.sequence_length)
-        with m.If(self.sequence_length > n_slots):
-            m.d.comb += wanted_len.eq(n_slots)
+        seq_len = Signal(range(n_slots + 1))          # the mode in force
+        wanted_len = Signal(range(n_slots + 1))
+        m.d.comb += wanted_len.eq(Mux(self.sequence_length > n_slots, n_slots, self.sequence_length))
         mode_pending = Signal()
         sequence = Signal()
         m.d.comb += [mode_pending.eq(wanted_len != seq_len), sequence.eq(seq_len != 0)]
+        # the sequence slots' walk (a change of mode, a lost memory): their states are in memory
+        walking, walk_loss = Signal(), Signal()
+        walk_slot = Signal(SLOT_BITS)
+        high_ready = Signal(range(n_slots + 1))     # sequence slots beyond the live ones complete
 
-        self._place(m, t, seq_len, mode_pending, sequence)
+        self._place(m, slots, seq_len, mode_pending | walking, sequence)
 
         # -- the ingest's events
         opening = self.opened.payload
         with m.If(self.opened.valid):
-            m.d.sync += [
-                state[opening.slot].eq(SlotState.RECEIVING),
-                frame_id[opening.slot].eq(opening.frame),
-                depth[opening.slot].eq(opening.depth),
-                in_sequence[opening.slot].eq(sequence),
-                t.delta[opening.slot].eq(opening.delta),
-                t.base[opening.slot].eq(opening.base),
-            ]
+            slots.ingest(opening.slot, SlotState.RECEIVING, in_sequence=sequence, depth=opening.depth)
+            with m.If(opening.slot < live):
+                m.d.sync += [
+                    frame_id[opening.slot].eq(opening.frame),
+                    t.delta[opening.slot].eq(opening.delta),
+                    t.base[opening.slot].eq(opening.base),
+                ]
             with m.If(~sequence):
                 m.d.sync += [t.recv_active.eq(1), t.recv_slot.eq(opening.slot), t.recv_frame.eq(opening.frame),
                              t.last_valid.eq(1), t.last_frame.eq(opening.frame)]
         with m.If(self.completed.valid):
-            m.d.sync += state[self.completed.payload].eq(SlotState.WRITING)
+            slots.ingest(self.completed.payload, SlotState.WRITING)
             with m.If(~sequence):
                 m.d.sync += t.recv_active.eq(0)
 
         # -- the answer to an ask
-        answer = self._answer(m, t, seq_len, sequence)
+        answer = self._answer(m, slots, seq_len, sequence, high_ready)
         play, finished, advance = answer.play, answer.finished, answer.advance
         answer_slot, can_answer, skip = answer.slot, answer.can_answer, answer.skip
 
         # -- a base no delta uses any more is freed (housekeeping below never changes a KEPT slot
         # but to FREE)
-        used = [Signal(name=f"used{s}") for s in range(n_slots)]
-        for s in range(n_slots):
+        used = [Signal(name=f"used{s}") for s in range(live)]
+        for s in range(live):
             m.d.comb += used[s].eq(Cat((state[d] != SlotState.FREE) & t.delta[d] & (t.base[d] == s) & ~stale[d]
-                                       for d in range(n_slots) if d != s).any())
+                                       for d in range(live) if d != s).any())
             with m.If((state[s] == SlotState.KEPT) & ~used[s]):
                 m.d.sync += state[s].eq(SlotState.FREE)
         used = Array(used)
 
-        def retire(s):
-            """Slot ``s`` is neither shown nor showable: kept while a delta uses it, else free."""
-            return state[s].eq(Mux(used[s], SlotState.KEPT, SlotState.FREE))
+        def retired(s):
+            """What slot ``s`` becomes once neither shown nor showable: kept while a delta uses it
+            (a live slot), else free."""
+            return Mux((s < live) & used[s], SlotState.KEPT, SlotState.FREE)
 
         # -- housekeeping: one event per cycle. An answer offered and not taken (the answer FIFO
         # full) stays offered, unchanged: nothing else happens until it is taken.
         offered = Signal()
         m.d.sync += offered.eq(self.answers.valid & ~self.answers.ready)
         released = self.releases.payload
+        done = self.written.payload
+        # the slot housekeeping looks at (the event below that takes it)
+        hk = slots.housekeeping(Mux(walking, walk_slot,
+                                    Mux(self.written.valid & ~offered, done,
+                                        Mux(self.releases.valid, released, answer_slot))))
         with m.If(~self.lose):
             m.d.sync += self.forgotten.eq(0)
-        with m.If(self.lose & ~self.forgotten & self.placement.between_rows & ~offered):
-            m.d.sync += [self.forgotten.eq(1), t.recv_active.eq(0), t.last_valid.eq(0),
+        with m.If(walking):
+            # one sequence slot a cycle: a loss forgets it (stale if shown), a change of mode frees
+            # it unless shown and takes it out of the sequence
+            with m.If(walk_loss):
+                with m.If(hk.state != SlotState.FREE):
+                    m.d.sync += count.frames_lost.eq(count.frames_lost + 1)
+                with m.If(hk.state == SlotState.SHOWN):
+                    slots.keep(stale=1)
+                with m.Else():
+                    slots.keep(state=SlotState.FREE)
+            with m.Else():
+                slots.keep(state=Mux(hk.state == SlotState.SHOWN, hk.state, SlotState.FREE), in_sequence=0)
+            m.d.sync += walk_slot.eq(walk_slot + 1)
+            with m.If(walk_slot == n_slots - 1):
+                m.d.sync += walking.eq(0)
+                with m.If(walk_loss):
+                    m.d.sync += self.forgotten.eq(self.lose)
+        with m.Elif(self.lose & ~self.forgotten & self.placement.between_rows & ~offered):
+            m.d.sync += [t.recv_active.eq(0), t.last_valid.eq(0), high_ready.eq(0),
                          count.calibration_losses.eq(count.calibration_losses + 1),
                          count.frames_lost.eq(count.frames_lost
-                                              + sum(state[s] != SlotState.FREE for s in range(n_slots)))]
-            for s in range(n_slots):
+                                              + sum(state[s] != SlotState.FREE for s in range(live)))]
+            self._walk(m, walking, walk_loss, walk_slot, loss=True)
+            for s in range(live):
                 with m.If(state[s] == SlotState.SHOWN):
                     m.d.sync += stale[s].eq(1)
                 with m.Else():
                     m.d.sync += state[s].eq(SlotState.FREE)
         with m.Elif(mode_pending & self.placement.between_rows & ~offered):
             m.d.sync += [seq_len.eq(wanted_len), play.eq(0), finished.eq(0), t.recv_active.eq(0),
-                         t.last_valid.eq(0)]
-            for s in range(n_slots):
+                         t.last_valid.eq(0), high_ready.eq(0)]
+            self._walk(m, walking, walk_loss, walk_slot, loss=False)
+            for s in range(live):
                 with m.If(state[s] != SlotState.SHOWN):
-                    m.d.sync += retire(s)
+                    m.d.sync += state[s].eq(retired(s))
                 m.d.sync += in_sequence[s].eq(0)
         with m.Elif(self.written.valid & ~offered):
             m.d.comb += self.written.ready.eq(1)
-            done = self.written.payload
-            with m.If(state[done] == SlotState.WRITING):
-                m.d.sync += state[done].eq(SlotState.READY)
-                # streaming: the newest complete frame replaces one never shown
-                for s in range(n_slots):
-                    with m.If((state[s] == SlotState.READY) & ~in_sequence[s] & ~in_sequence[done]
-                              & (done != s)):
-                        m.d.sync += [retire(s), count.frames_replaced.eq(count.frames_replaced + 1)]
+            with m.If(hk.state == SlotState.WRITING):
+                slots.keep(state=SlotState.READY)
+                with m.If(done >= live):
+                    m.d.sync += high_ready.eq(high_ready + 1)
+                with m.Else():
+                    # streaming: the newest complete frame replaces one never shown
+                    for s in range(live):
+                        with m.If((state[s] == SlotState.READY) & ~in_sequence[s] & ~in_sequence[done]
+                                  & (done != s)):
+                            m.d.sync += [state[s].eq(retired(s)),
+                                         count.frames_replaced.eq(count.frames_replaced + 1)]
         with m.Elif(self.releases.valid):
             m.d.comb += self.releases.ready.eq(1)
-            m.d.sync += stale[released].eq(0)
-            with m.If(state[released] != SlotState.SHOWN):
+            with m.If(hk.state != SlotState.SHOWN):
+                slots.keep(stale=0)
                 m.d.sync += count.bad_releases.eq(count.bad_releases + 1)
-            with m.Elif(in_sequence[released] & sequence & ~stale[released]):
-                m.d.sync += state[released].eq(SlotState.READY)
-            with m.Elif(stale[released]):
-                m.d.sync += state[released].eq(SlotState.FREE)
+            with m.Elif(hk.in_sequence & sequence & ~hk.stale):
+                slots.keep(state=SlotState.READY, stale=0)
+            with m.Elif(hk.stale):
+                slots.keep(state=SlotState.FREE, stale=0)
             with m.Else():
-                m.d.sync += retire(released)
+                slots.keep(state=retired(released), stale=0)
         with m.Elif(self.asks.valid & can_answer & ~self.lose):
             m.d.comb += self.answers.valid.eq(1)
             with m.If(self.answers.ready):
                 m.d.comb += self.asks.ready.eq(1)
-                m.d.sync += state[answer_slot].eq(SlotState.SHOWN)
+                slots.keep(state=SlotState.SHOWN)
                 with m.If(sequence):
                     advance()
         with m.Elif(skip & ~offered & ~self.lose):
@@ -301,45 +343,62 @@ class SlotTable(wiring.Component):
             m.d.sync += [play.eq(0), finished.eq(0)]
         return m
 
-    def _answer(self, m, t, seq_len, sequence):
+    def _walk(self, m, walking, walk_loss, walk_slot, *, loss):
+        """Start the walk over the sequence slots (if there are any beyond the live ones);
+        without them a loss is forgotten at once."""
+        if self._slots > self._live:
+            m.d.sync += [walking.eq(1), walk_loss.eq(loss), walk_slot.eq(self._live)]
+        elif loss:
+            m.d.sync += self.forgotten.eq(1)
+
+    def _answer(self, m, slots, seq_len, sequence, high_ready):
         """Drive ``answers``: which frame an ask is given (streaming: the newest ready; a
         sequence: its slots in order, or its table's entries with their settings), and the
         play position's registers. Returns them with ``advance()`` (the play position after a
         frame given out or skipped)."""
-        n_slots = self._slots
-        state, frame_id, depth, in_sequence = t.state, t.frame_id, t.depth, t.in_sequence
-        ready_found, ready_slot = _first_of(m, n_slots, lambda s: (state[s] == SlotState.READY) & ~in_sequence[s])
+        live = self._live
+        t = slots.t
+        state, in_sequence = t.state, t.in_sequence
+        ready_found, ready_slot = _first_of(m, live, lambda s: (state[s] == SlotState.READY) & ~in_sequence[s])
         play = Signal(ENTRY_BITS)      # the slot, or the entry, given out next
         finished = Signal()            # played once: the last entry given out
+        # every slot of the sequence holds its frame (those beyond the live ones counted as they
+        # complete: they never go back but through a walk, which restarts the count)
         loaded = Signal()
-        m.d.comb += loaded.eq(1)
-        for s in range(n_slots):
+        m.d.comb += loaded.eq(high_ready + live >= seq_len)
+        for s in range(live):
             with m.If((s < seq_len) & ~((state[s] == SlotState.READY) | (state[s] == SlotState.SHOWN))):
                 m.d.comb += loaded.eq(0)
         entry = self.entry
         by_entry = sequence & (self.entries != 0)
         last_entry = play + 1 >= self.entries
-        shown_depth, low_plane, missing = _entry_planes(m, entry, depth[entry.slot])
+        answer_slot = Signal(SLOT_BITS)
+        with m.If(by_entry):
+            m.d.comb += answer_slot.eq(entry.slot)
+        with m.Elif(sequence):
+            m.d.comb += answer_slot.eq(play)
+        with m.Else():
+            m.d.comb += answer_slot.eq(ready_slot)
+        given = slots.view("answer", answer_slot)
+        shown_depth, low_plane, missing = _entry_planes(m, entry, given.depth)
         # (a frame's depth is known once every slot of the sequence holds its frame)
         skip = by_entry & ~finished & ((entry.slot >= seq_len) | (loaded & missing))
         m.d.comb += self.entry_index.eq(play)
-        answer_slot = Signal(SLOT_BITS)
         can_answer = Signal()
         with m.If(by_entry):
             # (an entry may show the frame shown now: the sequencer holds a slot once)
-            m.d.comb += [answer_slot.eq(entry.slot),
-                         can_answer.eq(loaded & ~finished & ~skip & ((state[entry.slot] == SlotState.READY)
-                                                                | (state[entry.slot] == SlotState.SHOWN)))]
+            m.d.comb += can_answer.eq(loaded & ~finished & ~skip & ((given.state == SlotState.READY)
+                                                                | (given.state == SlotState.SHOWN)))
         with m.Elif(sequence):
-            m.d.comb += [answer_slot.eq(play), can_answer.eq(loaded & (state[play] == SlotState.READY))]
+            m.d.comb += can_answer.eq(loaded & (given.state == SlotState.READY))
         with m.Else():
-            m.d.comb += [answer_slot.eq(ready_slot), can_answer.eq(ready_found)]
+            m.d.comb += can_answer.eq(ready_found)
         answer = self.answers.payload
         m.d.comb += [
             answer.slot.eq(answer_slot),
-            answer.frame_id.eq(frame_id[answer_slot]),
-            answer.bit_depth.eq(depth[answer_slot]),
-            answer.low_plane.eq(8 - depth[answer_slot]),
+            answer.frame_id.eq(given.frame_id),
+            answer.bit_depth.eq(given.depth),
+            answer.low_plane.eq(8 - given.depth),
             answer.sequence.eq(sequence),
         ]
         with m.If(by_entry):
@@ -359,18 +418,20 @@ class SlotTable(wiring.Component):
         return SimpleNamespace(play=play, finished=finished, advance=advance, slot=answer_slot,
                                can_answer=can_answer, skip=skip)
 
-    def _place(self, m, t, seq_len, mode_pending, sequence):
-        """Drive ``placement``: where a row of ``placement.frame`` goes, from the registers ``t``."""
+    def _place(self, m, slots, seq_len, hold, sequence):
+        """Drive ``placement``: where a row of ``placement.frame`` goes, from the registers ``t``
+        (and, for a sequence, the sequence slots' states)."""
         place = self.placement
-        n_slots, frame_bits = self._slots, self._frame_bits
+        live, frame_bits = self._live, self._frame_bits
+        t = slots.t
         state = t.state
-        free_found, free_slot = _first_of(m, n_slots, lambda s: state[s] == SlotState.FREE)
-        writing_found, _ = _first_of(m, n_slots, lambda s: state[s] == SlotState.WRITING)
-        shown_match, _ = _first_of(m, n_slots,
+        free_found, free_slot = _first_of(m, live, lambda s: state[s] == SlotState.FREE)
+        writing_found, _ = _first_of(m, live, lambda s: state[s] == SlotState.WRITING)
+        shown_match, _ = _first_of(m, live,
                                    lambda s: (state[s] == SlotState.SHOWN) & (t.frame_id[s] == place.frame))
         base_found, base_slot = _first_of(
-            m, n_slots, lambda s: ((state[s] == SlotState.WRITING) | (state[s] == SlotState.READY)
-                                   | (state[s] == SlotState.SHOWN) | (state[s] == SlotState.KEPT))
+            m, live, lambda s: ((state[s] == SlotState.WRITING) | (state[s] == SlotState.READY)
+                                | (state[s] == SlotState.SHOWN) | (state[s] == SlotState.KEPT))
             & ~t.delta[s] & ~t.stale[s] & (t.frame_id[s] == place.base))
         no_base = place.delta & ~base_found
         m.d.comb += [place.base_slot.eq(base_slot), place.base_depth.eq(t.depth[base_slot])]
@@ -383,20 +444,22 @@ class SlotTable(wiring.Component):
             if slot is not None:
                 m.d.comb += place.slot.eq(slot)
 
-        m.d.comb += place.depth.eq(t.depth[place.slot])
         seq_slot = place.frame[:SLOT_BITS]
-        with m.If(mode_pending | self.lose):
+        seq = slots.view("place", seq_slot)
+        # (a sequence's row joins its frame's slot: the one looked up)
+        m.d.comb += place.depth.eq(Mux(sequence, seq.depth, t.depth[place.slot]))
+        with m.If(hold | self.lose):
             verdict(Placement.HOLD)
         with m.Elif(sequence):
             with m.If(place.frame >= seq_len):
                 verdict(Placement.STALE)
-            with m.Elif((state[seq_slot] == SlotState.FREE) & no_base):
+            with m.Elif((seq.state == SlotState.FREE) & (no_base | place.delta & (seq_slot >= live))):
                 verdict(Placement.NO_BASE)
-            with m.Elif(state[seq_slot] == SlotState.FREE):
+            with m.Elif(seq.state == SlotState.FREE):
                 verdict(Placement.TAKE, seq_slot)
-            with m.Elif(state[seq_slot] == SlotState.RECEIVING):
+            with m.Elif(seq.state == SlotState.RECEIVING):
                 verdict(Placement.JOIN, seq_slot)
-            with m.Elif(state[seq_slot] == SlotState.SHOWN):
+            with m.Elif(seq.state == SlotState.SHOWN):
                 verdict(Placement.SHOWN)
             with m.Else():
                 verdict(Placement.DUPLICATE)
@@ -417,6 +480,76 @@ class SlotTable(wiring.Component):
             verdict(Placement.SHOWN)
         with m.Else():
             verdict(Placement.STALE)
+
+
+class _Slots:
+    """Every slot's fields, looked up by slot number: the live slots' registers ``t``, and the
+    sequence slots' states in memory (:class:`~gateware.store.slot_states.SlotStates`) when there
+    are slots beyond the live ones. Each view is one of the memory's read ports."""
+
+    def __init__(self, m, t, slots, live):
+        self.m, self.t, self.live = m, t, live
+        self.memory = None
+        if slots > live:
+            m.submodules.sequence_slots = self.memory = SlotStates(slots, views=("place", "answer"))
+        self._hk_slot = None
+
+    def view(self, name, slot):
+        """The fields of slot ``slot`` (a value), this cycle."""
+        t, live = self.t, self.live
+        fields = SimpleNamespace(state=t.state[slot], depth=t.depth[slot], in_sequence=t.in_sequence[slot],
+                                 stale=t.stale[slot], frame_id=t.frame_id[slot])
+        if self.memory is None:
+            return fields
+        port = getattr(self.memory, name)
+        self.m.d.comb += port.slot.eq(slot)
+        low = slot < live
+        return SimpleNamespace(state=Mux(low, fields.state, port.state), depth=Mux(low, fields.depth, port.depth),
+                               in_sequence=Mux(low, fields.in_sequence, port.in_sequence),
+                               stale=Mux(low, fields.stale, port.stale),
+                               frame_id=Mux(low, fields.frame_id, slot))
+
+    def housekeeping(self, slot):
+        """The view of the slot housekeeping changes (with :meth:`keep`)."""
+        self._hk_slot = slot
+        self._hk = self.view("housekeeping", slot)
+        return self._hk
+
+    def keep(self, *, state=None, in_sequence=None, stale=None):
+        """Housekeeping changes its slot's fields (those given) on this clock edge."""
+        m, t, slot, hk = self.m, self.t, self._hk_slot, self._hk
+        with m.If(slot < self.live):
+            for regs, value in ((t.state, state), (t.in_sequence, in_sequence), (t.stale, stale)):
+                if value is not None:
+                    m.d.sync += regs[slot].eq(value)
+        if self.memory is not None:
+            with m.Else():
+                w = self.memory.housekeeping_write
+                m.d.comb += [w.en.eq(1), w.phase.state.eq(hk.state if state is None else state),
+                             w.phase.in_sequence.eq(hk.in_sequence if in_sequence is None else in_sequence),
+                             w.stale.eq(hk.stale if stale is None else stale)]
+
+    def ingest(self, slot, state, *, in_sequence=None, depth=None):
+        """The ingest changes slot ``slot``: it becomes ``state`` (and ``in_sequence``, and its
+        bit depth ``depth``) on this clock edge."""
+        m, t = self.m, self.t
+        with m.If(slot < self.live):
+            m.d.sync += t.state[slot].eq(state)
+            if in_sequence is not None:
+                m.d.sync += t.in_sequence[slot].eq(in_sequence)
+            if depth is not None:
+                m.d.sync += t.depth[slot].eq(depth)
+        if self.memory is not None:
+            with m.Else():
+                w = self.memory.ingest_write
+                m.d.comb += [w.en.eq(1), w.slot.eq(slot), w.phase.state.eq(state)]
+                if in_sequence is not None:
+                    m.d.comb += w.phase.in_sequence.eq(in_sequence)
+                else:
+                    # (completing a slot keeps it in the sequence it was opened in)
+                    m.d.comb += w.phase.in_sequence.eq(1)
+                if depth is not None:
+                    m.d.comb += [w.depth.eq(depth), w.depth_en.eq(1)]
 
 
 class _Registers:

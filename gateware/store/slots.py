@@ -23,7 +23,10 @@ slots: one receiving, one ready, one shown.
 
 Sequence mode (``sequence_length`` = N > 0): frame id f < N goes to slot f; once all N are
 complete they are given to the sequencer in order 0, 1, .., N-1, 0, .. and a released slot stays
-in the sequence. Changing ``sequence_length`` frees every slot that is not shown.
+in the sequence. Changing ``sequence_length`` frees every slot that is not shown. A sequence
+spans every slot the memory holds: streaming and delta frames use the first
+:data:`~gateware.store.layouts.LIVE_SLOTS`, whose states are searched every cycle; the slots
+beyond them hold a sequence's whole frames (a delta frame there is refused as having no base).
 
 Delta frames
 ------------
@@ -47,7 +50,7 @@ from amaranth.lib.wiring import Out
 
 from ..compose import forward, members
 from .entries import EntryTable
-from .layouts import BLOCK_BITS, COUNTER_BITS, SLOT_BITS
+from .layouts import BLOCK_BITS, COUNTER_BITS, LIVE_SLOTS, SLOT_BITS
 from .row_ingest import RowIngest
 from .slot_crossing import SlotCrossing
 from .slot_maps import SlotMaps
@@ -87,7 +90,11 @@ class FrameSlots(wiring.Component):
     ----------
     dmd : :class:`spec.facts.DmdType`
     slots : int
-        Frame slots (3 to 16).
+        Frame slots (3 to ``2**SLOT_BITS``): the first :data:`~gateware.store.layouts.LIVE_SLOTS`
+        for streaming and delta frames, all of them for a stored sequence.
+    live : int
+        Slots kept in registers (default :data:`~gateware.store.layouts.LIVE_SLOTS`; fewer in
+        tests, to reach the others with small memories).
     frame_bits : int
         Width of the serialiser's frame tag: the frame id of the record (up to 16 bits).
 
@@ -123,14 +130,14 @@ class FrameSlots(wiring.Component):
     #: The parts that count events, each some of the counters.
     _COUNTING = ("ingest", "table")
 
-    def __init__(self, dmd, *, slots=4, frame_bits=16):
+    def __init__(self, dmd, *, slots=4, frame_bits=16, live=LIVE_SLOTS):
         assert 3 <= slots <= 2**SLOT_BITS and dmd.blocks <= 2**BLOCK_BITS and frame_bits <= 16
         assert dmd.rows >= 2**BLOCK_BITS
         self._parts = {
             "ingest": RowIngest(dmd, slots=slots, frame_bits=frame_bits),
-            "table": SlotTable(slots=slots, frame_bits=frame_bits),
+            "table": SlotTable(slots=slots, frame_bits=frame_bits, live=live),
             "crossing": SlotCrossing(),
-            "maps": SlotMaps(dmd, slots=slots),
+            "maps": SlotMaps(dmd, slots=slots, live=live),
             "entries": EntryTable(),
         }
         ports = {}

@@ -16,6 +16,7 @@ from amaranth.lib.cdc import FFSynchronizer
 from amaranth.lib.wiring import Out
 
 from ..compose import forward, members
+from .layouts import LIVE_SLOTS
 from .reader import Reader
 from .recovery import Recovery
 from .slots import FrameSlots
@@ -32,7 +33,7 @@ class Store(wiring.Component):
     ----------
     dmd : :class:`spec.facts.DmdType`
     slots : int
-        Frame slots (3..16).
+        Frame slots (3 to ``2**SLOT_BITS``, :class:`~gateware.store.slots.FrameSlots`).
     frame_bits : int
         Width of the serialiser's frame tag (the frame id).
     fifo_depth : int
@@ -43,6 +44,8 @@ class Store(wiring.Component):
         Plane words per transfer on ``planes`` (default: those of a port word); 1 with a
         128-bit reader gives each port word as two transfers, for a sequencer that takes one
         word at a time.
+    live : int
+        The slots streaming and delta frames use (:class:`~gateware.store.slots.FrameSlots`).
 
     Members
     -------
@@ -68,11 +71,12 @@ class Store(wiring.Component):
     #: The reader's ports the store gives as its own.
     _READER_PORTS = ("requests", "bad_requests")
 
-    def __init__(self, dmd, *, slots=4, frame_bits=16, fifo_depth=256, read_width=128, plane_words=None):
+    def __init__(self, dmd, *, slots=4, frame_bits=16, fifo_depth=256, read_width=128, plane_words=None,
+                 live=LIVE_SLOTS):
         port_words = read_width // 64
         self._plane_words = port_words if plane_words is None else plane_words
         assert port_words % self._plane_words == 0
-        self._slots = FrameSlots(dmd, slots=slots, frame_bits=frame_bits)
+        self._slots = FrameSlots(dmd, slots=slots, frame_bits=frame_bits, live=live)
         self._writer = Writer(dmd, slots=slots)
         self._reader = Reader(dmd, slots=slots, fifo_depth=fifo_depth, width=read_width)
         super().__init__({

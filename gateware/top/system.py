@@ -31,15 +31,21 @@ from gateware.queue import AsyncQueue
 from gateware.registers import LSB_BITS, TriggerMode
 from gateware.store import mcb
 from gateware.store.broker import FrameBroker
-from gateware.store.layouts import FrameInfo
+from gateware.store.layouts import SLOT_BITS, FrameInfo
 from gateware.store.store import Store
+from spec.records import sequence_frames
 
-__all__ = ["Projector", "ShownFrame", "SLOTS"]
+__all__ = ["Projector", "ShownFrame", "slots_for"]
 
-#: Frame slots the projector keeps in DDR2: every slot the frame tags and the sequencer's slot
-#: numbers can name (``SLOT_BITS``), 12 MiB of XGA 8-bit frames, 35 MiB of DLP9500 ones, in the
-#: Atlys's 128 MiB. A stored sequence holds up to this many frames (128 bit-planes).
-SLOTS = 16
+
+def slots_for(dmd):
+    """Frame slots the projector keeps in DDR2: every whole frame the Atlys's 128 MiB hold, up to
+    what the slot numbers name (``SLOT_BITS``): 170 XGA frames (1,360 bit-planes), 60 DLP9500
+    ones. A stored sequence holds up to this many frames; streaming and delta frames use the
+    first :data:`~gateware.store.layouts.LIVE_SLOTS`."""
+    assert sequence_frames(dmd.rows, dmd.columns) <= 2**SLOT_BITS
+    return sequence_frames(dmd.rows, dmd.columns)
+
 
 FRAME_BITS = 16
 
@@ -71,7 +77,7 @@ class Projector(wiring.Component):
     sync_hz : float
         ``sync`` frequency (status replies report it; the PHY management derives MDC from it).
     slots : int
-        Frame slots in DDR2 (default :data:`SLOTS`): a stored sequence holds up to this many
+        Frame slots in DDR2 (default :func:`slots_for`): a stored sequence holds up to this many
         frames.
     beats : int
         DCLK cycles per ``dmd`` cycle: 2 for DCLK 400 MHz (the platform's 4:1 serialisers), 1
@@ -111,7 +117,7 @@ class Projector(wiring.Component):
         self._regs = regs
         self._armed = armed
         self._sync_hz = sync_hz
-        self._slots = SLOTS if slots is None else slots
+        self._slots = slots_for(dmd) if slots is None else slots
         self._mdio_cycles = mdio_cycles or (None, None)
         self._beats = beats
         super().__init__({

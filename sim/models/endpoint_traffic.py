@@ -102,6 +102,8 @@ BAD_RECORDS = {
     "bit_depth_out_of_range": (codec.control_record(bit_depth=9, armed=1), "drop_app_value"),
     "armed_not_a_bit": (codec.control_record(armed=2), "drop_app_value"),
     "sequence_length_zero": (codec.control_record(sequence_length=0), "drop_app_value"),
+    # (the test DMD's 12 KiB frames: the 256 slots an entry names, all in the memory)
+    "sequence_beyond_the_slots": (codec.control_record(sequence_length=257), "drop_app_value"),
     "control_too_long": (codec.control_record(armed=1) + b"\0", "drop_app_length"),
     "sequencer_too_long": (sequencer_record() + b"\0", "drop_app_length"),
     "sequencer_truncated": (_record(records.RecordType.SEQUENCER, body=sequencer_record()[HEADER:-1]),

@@ -181,7 +181,9 @@ class Model:
                 return control["apply"] >> names.index(name) & 1
             if ((applies("bit_depth") and not 1 <= control["bit_depth"] <= 8)
                     or (applies("armed") and control["armed"] > 1)
-                    or (applies("sequence_length") and control["sequence_length"] == 0)
+                    or (applies("sequence_length")
+                        and not 1 <= control["sequence_length"] <= min(256, (128 << 20) // (self.dmd.rows
+                                                                                           * self.dmd.columns)))
                     or (applies("entries") and control["entries"] > 256)
                     or (applies("loop") and control["loop"] > 1)):
                 return "drop_app_value"

@@ -120,3 +120,38 @@ async def every_bit_depth_and_extreme_images(dut):
     assert all(v == 0 for k, v in counters.items() if k != "frames_complete"), counters
     assert int(dut.bad_requests.value) == 0
     store_stim.check_writes_inside(bench.model, dmd, bench.slots, range(bench.slots))
+
+
+@cocotb.test()
+async def sequence_beyond_the_live_slots(dut):
+    """A stored sequence on every slot of a store whose live slots are fewer (``params()["live"]``):
+    frames of every bit depth sent in reverse order, then given out in order, each read back
+    whole (every stored plane and the occupancy map) from its own slot, twice round."""
+    bench = Bench(dut)
+    await bench.start()
+    dmd, n = bench.dmd, bench.slots
+    images = {f: store_stim.random_image(dmd, 3000 + f) for f in range(n)}
+    depths = {f: 1 + (f * 5) % 8 for f in range(n)}
+    dut.sequence_length.value = n
+    await ClockCycles(dut.clk, 3)
+    for f in reversed(range(n)):
+        dut.bit_depth.value = depths[f]
+        await ClockCycles(dut.clk, 1)
+        await bench.pixels.send(store_stim.frame_beats(images[f], f))
+    held = None
+    for turn in range(2 * n):
+        f = turn % n
+        answer = await with_timeout(bench.ask(), 2, "ms")
+        assert (answer["slot"], answer["frame_id"], answer["bit_depth"]) == (f, f, depths[f]), answer
+        if turn < n or f >= params()["live"]:
+            for plane in store_stim.stored_planes(depths[f]):
+                store_stim.check_plane(dmd, images[f], plane, await bench.read(f, plane), what=f"frame {f}")
+            store_stim.check_occupancy(dmd, images[f], depths[f], await bench.occupancy(f), what=f"frame {f}")
+        if held is not None:
+            await bench.release(held)
+        held = f
+    counters = bench.counters()
+    assert counters["frames_complete"] == n
+    assert all(v == 0 for k, v in counters.items() if k != "frames_complete"), counters
+    assert int(dut.bad_requests.value) == 0
+    store_stim.check_writes_inside(bench.model, dmd, bench.slots, range(bench.slots))

@@ -18,9 +18,10 @@ FED = ("words", "rows")
 class StoreChain(wiring.Component):
     """Pixels in (``sync``), the store's sequencer and MCB ports out; see :class:`Store`."""
 
-    def __init__(self, dmd, *, lanes=8, slots=4, frame_bits=16, fifo_depth=256, read_width=128):
+    def __init__(self, dmd, *, lanes=8, slots=4, frame_bits=16, fifo_depth=256, read_width=128, **store):
         self._serialiser = Serialiser(dmd, lanes=lanes, frame_bits=frame_bits)
-        self._store = Store(dmd, slots=slots, frame_bits=frame_bits, fifo_depth=fifo_depth, read_width=read_width)
+        self._store = Store(dmd, slots=slots, frame_bits=frame_bits, fifo_depth=fifo_depth, read_width=read_width,
+                            **store)
         super().__init__({"pixels": In(stream.Signature(pixel_layout(dmd, lanes, frame_bits))),
                           **members(self._store, exclude=FED)})
 
