@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from gateware.store.slots import SlotCounters
-from sim.harness.amaranth_sim import simulate, stream_feed
+from sim.harness.amaranth_sim import simulate, stream_collect, stream_feed
 from sim.models import bitplane, store_stim
 from sim.models.mcb import McbModel, McbTiming, amaranth_process, widths
 from sim.models.store_stim import SHORT_DMD
@@ -1213,3 +1213,79 @@ def test_reader_commands_cover_each_run(dmd, width, seed):
     sim.run()
     assert commands == [b for request, _, sources in requests for b in bursts(request, sources)]
     assert got == list(range(len(got))) and len(got) == sum(r["row_count"] for r, _, _ in requests) * row_words
+
+
+@pytest.mark.parametrize("width", [64, 128])
+def test_reader_reads_the_high_slots(width, test_name):
+    """The plane reader with as many slots as slot numbers name (up to 40; every slot of the memory
+    is the product's case, once ``SLOT_BITS`` names them) on the MCB model: every plane of the
+    last slot and of a middle one is read at the address map's address, whole frames and a
+    delta's rows shown from both slots, and each word comes out as the memory holds it; a
+    request for a slot past the last is dropped and counted."""
+    from gateware.store.addresses import AddressMap
+    from gateware.store.layouts import SLOT_BITS
+    from gateware.store.reader import Reader
+
+    slots = min(40, 2**SLOT_BITS)
+    last, middle, delta = slots - 1, slots // 2 + 1, 1
+    dmd = TEST_DMD
+    dut = Reader(dmd, slots=slots, width=width, domain="sync")
+    amap = AddressMap(dmd, slots)
+    model = McbModel(amap.end, ports=1, widths=widths(dut.mcb))
+    model.memory[:] = np.random.default_rng(5).integers(0, 2**63, model.memory.size, dtype=np.uint64)
+    requests = [(slot, plane, 0, dmd.rows) for slot in (last, middle) for plane in range(8)]
+    requests += [(delta, 6, 3, 30), (delta, 2, 0, dmd.rows)]
+    bad = [(slots, 0, 0, dmd.rows)] if slots < 2**SLOT_BITS else []
+    got = []
+
+    def source(slot, row):
+        """The slot whose words a row of ``slot`` shows: the delta's rows show the last slot's and
+        the middle one's in stretches of 5 rows (none its own)."""
+        return (last, middle, middle, last)[row // 5 % 4] if slot == delta else slot
+
+    async def row_map(ctx):
+        # the row map's read port: a delta in slot ``delta``, whole frames elsewhere
+        src = dut.sources
+        async for _clk, _rst, en, slot, row in ctx.tick().sample(src.en, src.slot, src.row):
+            if en:
+                ctx.set(src.source, source(int(slot), int(row)))
+                ctx.set(src.delta, slot == delta)
+
+    async def sequencer(ctx):
+        while not ctx.get(dut.mcb.calib_done):
+            await ctx.tick()
+        for slot, plane, first, rows in bad + requests:
+            ctx.set(dut.requests.payload, {"slot": slot, "plane": plane, "first_row": first, "row_count": rows})
+            ctx.set(dut.requests.valid, 1)
+            await ctx.tick().until(dut.requests.ready)
+            ctx.set(dut.requests.valid, 0)
+            if slot < slots:
+                got.append(await stream_collect(ctx, dut.planes, rows * dmd.words_per_row * 64 // width, convert=int))
+        for _ in range(10):
+            await ctx.tick()
+        assert ctx.get(dut.bad_requests) == len(bad)
+
+    simulate(dut, [sequencer], name=test_name, clocks={"sync": 200e6},
+             processes=[row_map, amaranth_process(model.ports[0], dut.mcb, domain="sync", frequency=200e6)],
+             deadline=2e-3)
+
+    # the words: each row's from its source slot's plane, as the memory holds them
+    for (slot, plane, first, rows), transfers in zip(requests, got, strict=True):
+        want = [int(model.memory[amap.address(source(slot, row), plane, row, word) // 8])
+                for row in range(first, first + rows) for word in range(dmd.words_per_row)]
+        assert store_stim.plane_words(transfers, width) == want, f"slot {slot} plane {plane}"
+    # the commands: each run of rows from one slot in bursts of 64 port words from its address
+    word_bytes, commands = width // 8, []
+    for slot, plane, first, rows in requests:
+        row = first
+        while row < first + rows:
+            end = row + 1
+            while end < first + rows and source(slot, end) == source(slot, row):
+                end += 1
+            at, stop = amap.address(source(slot, row), plane, row), amap.address(source(slot, row), plane, end)
+            while at < stop:
+                words = min(64, (stop - at) // word_bytes)
+                commands.append((at, words))
+                at += words * word_bytes
+            row = end
+    assert [(at, words) for _instr, words, at in model.ports[0].command_log] == commands

@@ -29,8 +29,9 @@ waiting for words that will not come, and gets the words read before the loss fi
 
 Pipeline (every path between flip-flops within the ``dmd`` budget of :mod:`flow.timing`): a
 request is taken into registers (``IDLE``), its first row looked up and its sums formed
-(``CHECK``), then checked and gathered into runs (``GATHER``, :mod:`.runs`); a run's address is its slot and
-plane's start (a small table) plus its rows' offset, and its bursts are counted down in
+(``CHECK``), then checked and gathered into runs (``GATHER``, :mod:`.runs`); a run's address is its slot's
+start (a table of the slots) plus its plane's, summed into a register as the run's slot is
+chosen, plus its rows' offset as the run is loaded, and its bursts are counted down in
 registers; the counts of words asked for and owed step by a burst and a word in one carry chain
 each. A request's first command leaves three cycles after it is taken (``valid`` and ``ready``
 both high), and a word from the memory reaches ``planes`` three cycles after the MCB offers it.
@@ -46,7 +47,7 @@ from amaranth.utils import exact_log2
 
 from . import mcb
 from .addresses import PLANES, AddressMap
-from .layouts import SLOT_BITS, PlaneRequest
+from .layouts import PlaneRequest
 from .read_fifo import ReadFifo
 from .runs import Runs
 from .slot_maps import RowLookupSignature
@@ -117,15 +118,19 @@ class Reader(wiring.Component):
         plane_words = dmd.rows * row_words
         burst_bits = exact_log2(mcb.MAX_BURST)
 
-        # Addresses in port words. A run starts at its slot and plane's start (a table) plus its
-        # rows' offset: every start is a multiple of 2**low, so the sum is one short carry chain
-        # above the offset's low bits; a burst of 64 steps the bits above the burst's. (Each
-        # chain is at most 16 bits for every DMD through a 128-bit port, 17 for the DLP9500's
-        # burst step through a 64-bit one.)
+        # Addresses in port words. A run starts at its slot's start (a table of ``slots`` entries,
+        # read from a register: the table's LUTs, no more) plus its plane's (a table of 8) plus its
+        # rows' offset. Every start is a multiple of 2**low, so each sum is one carry chain above
+        # the low bits, in a stage of its own: the slot's and plane's starts are summed into
+        # ``start`` as the run's slot is chosen (``runs.loads``, a cycle or more before the run is
+        # given), the rows' offset is added as the run is loaded. A burst of 64 steps the bits
+        # above the burst's, in two halves (below). (With the memory full of slots, up to 256, each
+        # sum's chain is at most 16 bits for the DLP7000, the DLP9500 and the test geometries
+        # through either port, 17 for the DLP650LNIR's past 65 slots; a step's half at most 9.)
         assert self._map.base % word_bytes == 0
-        starts = [self._map.address(s, p) // word_bytes if s < self._slots else 0
-                  for s in range(1 << SLOT_BITS) for p in range(PLANES)]
         low = _trailing_zeros(math.gcd(self._map.base // word_bytes, plane_words))
+        slot_starts = [self._map.address(s, 0) // word_bytes >> low for s in range(self._slots)]
+        plane_starts = [p * plane_words >> low for p in range(PLANES)]
         address_bits = (self._map.end // word_bytes - 1).bit_length()
 
         # ---- the words: the memory's (or zeros) through a FIFO to the sequencer ----------------
@@ -181,12 +186,25 @@ class Reader(wiring.Component):
             port.cmd_byte_addr.eq(Cat(Const(0, exact_log2(word_bytes)), address)),
             port.wr_en.eq(0),
         ]
+        # A burst steps the bits above the burst's in two parts, a carry chain each: the low part
+        # at the command, the high part the cycle after with the low part's carry out. No command
+        # goes in that cycle (``issued``) and no run is loaded (``issuing`` holds after a burst
+        # that is not the run's last), so the address is whole again before it is used.
+        steps = address[burst_bits:]
+        split = len(steps) // 2
+        carry = Signal()
+        if split:
+            with m.If(carry):
+                m.d.sync += [steps[split:].eq(steps[split:] + 1), carry.eq(0)]
         with m.If(issue):
             with m.If(is_last):
                 m.d.sync += issuing.eq(0)
             with m.Else():
-                m.d.sync += [address[burst_bits:].eq(address[burst_bits:] + 1),
-                             before_last.eq(before_last - 1), is_last.eq(before_last == 1)]
+                m.d.sync += [before_last.eq(before_last - 1), is_last.eq(before_last == 1)]
+                if split:
+                    m.d.sync += Cat(steps[:split], carry).eq(steps[:split] + 1)
+                else:
+                    m.d.sync += steps.eq(steps + 1)
 
         # ---- requests into runs (:mod:`.runs`), each loaded into the above when given ----------
         m.submodules.runs = runs = Runs(dmd, slots=self._slots, row_words=row_words, max_burst=mcb.MAX_BURST)
@@ -194,16 +212,28 @@ class Reader(wiring.Component):
         wiring.connect(m, runs.sources, wiring.flipped(self.sources))
         m.d.comb += [runs.busy.eq(issuing), self.bad_requests.eq(runs.bad_requests)]
         run = runs.run
-        m.submodules.starts = starts_rom = Memory(shape=address_bits - low, depth=len(starts),
-                                                  init=[start >> low for start in starts])
-        start = starts_rom.read_port(domain="comb")
+        # the run's first port word above the low bits (``start``): its slot's start and its
+        # plane's, read and summed as its slot is chosen (its plane is the request's, the same from
+        # ``CHECK`` on; no run is of a slot past the table: a request for one is dropped, and the
+        # row map names the store's slots only)
+        m.submodules.slot_starts = slot_rom = Memory(shape=address_bits - low, depth=self._slots,
+                                                     init=slot_starts)
+        slot_start = slot_rom.read_port(domain="comb")
+        plane_start = Signal(address_bits - low)
+        with m.Switch(run.plane):
+            for p, value in enumerate(plane_starts):
+                with m.Case(p):
+                    m.d.comb += plane_start.eq(value)
+        start = Signal(address_bits - low)
+        m.d.comb += slot_start.addr.eq(runs.next_slot)
+        with m.If(runs.loads):
+            m.d.sync += start.eq(slot_start.data + plane_start)
         run_last = run.words - 1
-        m.d.comb += start.addr.eq(Cat(run.plane, run.slot))
         with m.If(runs.emit):
             m.d.sync += [
                 issuing.eq(1),
                 address[:low].eq(run.off[:low]),
-                address[low:].eq(start.data + run.off[low:]),
+                address[low:].eq(start + run.off[low:]),
                 last_bl.eq(run_last[:burst_bits]),
                 before_last.eq(run_last[burst_bits:]),
                 is_last.eq(run.single),

@@ -72,6 +72,10 @@ class Runs(wiring.Component):
         The commands still hold the run before: no run is given.
     emit : Out(1); run : Out(run_layout)
         A run is given now (held until then).
+    loads : Out(1); next_slot : Out(SLOT_BITS)
+        A run is opened: ``run.slot`` becomes ``next_slot`` (a register) at the end of this cycle,
+        a cycle or more before the run is given, so that what a table holds for the slot, read
+        into a register when ``loads``, is there beside ``run.slot``.
     idle : Out(1)
         No request under way (one is taken now if offered).
     bad_requests : Out(16)
@@ -86,6 +90,8 @@ class Runs(wiring.Component):
             "busy": In(1),
             "emit": Out(1),
             "run": Out(run_layout(dmd.rows * row_words)),
+            "loads": Out(1),
+            "next_slot": Out(SLOT_BITS),
             "idle": Out(1),
             "bad_requests": Out(16),
         })
@@ -109,7 +115,9 @@ class Runs(wiring.Component):
         last = Signal()
         run_open = Signal()
         # the row map's answers a stage later, for a delta's walk: the row's source, and whether
-        # the row before showed the same (so that the walk decides from registers alone)
+        # the row before showed the same (so that the walk decides from registers alone); while a
+        # request is checked, its own slot (the slot of its run as one: ``next_slot`` is always
+        # this register, and neither answer is used before the walk's first row is decided)
         row_source, same = Signal(SLOT_BITS), Signal()
         m.d.comb += [src.slot.eq(taken.slot), src.row.eq(look)]
         with m.If(src.en):
@@ -134,7 +142,12 @@ class Runs(wiring.Component):
             src.en.eq(~walk | advance),
             bad.inc.eq(gather & ~fits),
             self.emit.eq(~busy & (gather & fits & whole | walk & run_open & ~same | flush)),
+            # a run opens: the request's (its slot taken), or a delta's row that starts one
+            self.loads.eq(check | walk & advance & ~joins),
+            self.next_slot.eq(row_source),
         ]
+        with m.If(self.loads):
+            m.d.sync += run.slot.eq(self.next_slot)
         m.d.sync += [
             idle.eq(idle & ~self.requests.valid | gather & ~fits | gather & whole & ~busy | flush & ~busy),
             check.eq(idle & self.requests.valid),
@@ -144,14 +157,14 @@ class Runs(wiring.Component):
         ]
         with m.If(idle):
             # (every cycle: nothing uses them before a request is taken)
-            m.d.sync += [taken.eq(request), look.eq(request.first_row)]
+            m.d.sync += [taken.eq(request), look.eq(request.first_row), row_source.eq(request.slot)]
         with m.If(check):
             first, count = taken.first_row, taken.row_count
             m.d.sync += [
                 some.eq((taken.slot < self._slots) & (count != 0)), within.eq(first + count <= dmd.rows),
                 row_off.eq(_times(first, row_words)), left.eq(count), last.eq(count == 1),
-                # the request as one run (a whole frame's)
-                run.slot.eq(taken.slot), run.off.eq(_times(first, row_words)),
+                # the request as one run (a whole frame's; its slot: ``loads``)
+                run.off.eq(_times(first, row_words)),
                 run.words.eq(_times(count, row_words)), run.single.eq(count <= max_burst // row_words),
                 run_open.eq(0),
             ]
@@ -161,6 +174,6 @@ class Runs(wiring.Component):
                 m.d.sync += [run.words.eq(run.words + row_words),
                              run.single.eq(run.words <= max_burst - row_words)]
             with m.Else():
-                m.d.sync += [run.slot.eq(row_source), run.off.eq(row_off), run.words.eq(row_words),
+                m.d.sync += [run.off.eq(row_off), run.words.eq(row_words),
                              run.single.eq(row_words <= max_burst)]
         return m
