@@ -1,7 +1,7 @@
 """The bit-plane store (slots, writer, reader) with the serialiser in front and the MCB model
 behind, in the Amaranth simulator, against numpy: the layout and traffic on the test geometry,
 the slot policy (which slot, which frame, which counter; nothing there depends on the size of a
-frame) on its short variant."""
+frame) on its short variant; the frame broker's occupancy maps against a model store."""
 
 import random
 
@@ -1289,3 +1289,119 @@ def test_reader_reads_the_high_slots(width, test_name):
                 at += words * word_bytes
             row = end
     assert [(at, words) for _instr, words, at in model.ports[0].command_log] == commands
+
+
+def _broker_slots():
+    """Enough slots for numbers above 15 once slot numbers are wide enough (``SLOT_BITS``); with
+    4-bit slot numbers, every one of the 16."""
+    from gateware.store.layouts import SLOT_BITS
+    return min(40, 2**SLOT_BITS)
+
+
+@pytest.mark.parametrize("slots", [3, _broker_slots()])
+def test_broker_occupancy_against_a_model_store(slots, seed, test_name):
+    """The frame broker between a model store (frames on random slots, random planes in every
+    block, its occupancy port answering one cycle after the lookup) and a sequencer that looks a
+    slot up every cycle: a slot's map reads as the store answered it for the slot's latest frame,
+    from the first cycle that frame is on offer. After ``store_lost`` (while a frame is on offer,
+    mid-scan, as the scan's last planes come back, and at random) every slot reads empty until a
+    frame on it is offered again, and that frame reads its planes."""
+    from gateware.store.broker import FrameBroker
+    from spec.facts import DMDS
+
+    dmd = DMDS["dlp7000"]
+    blocks, empty = dmd.blocks, [0] * dmd.blocks
+    rng = random.Random(seed)
+    dut = FrameBroker(dmd, slots=slots)
+    # every slot, the highest first, then at random; planes never zero, so that a map forgotten
+    # or not yet written never passes for the frame's
+    order = [slots - 1, *range(slots), *(rng.randrange(slots) for _ in range(40))]
+    frames = [(slot, 1000 + i, [rng.randrange(1, 256) for _ in range(blocks)]) for i, slot in enumerate(order)]
+    store_maps = {}                   # the store's occupancy: slot -> each block's planes
+    planes_of = {}                    # frame id -> each block's planes, as the store answered
+    losses = {"on offer": None, "mid-scan": None, "scan's end": None, "random": None}
+    random_loss = rng.randrange(100, 800)
+    seen = {"empty after loss": 0, "planes after loss": 0}
+    taken = []
+
+    async def occupancy_port(ctx):
+        # the store's registered read: what was asked at the clock edge, answered the next cycle
+        # (a block past the last answers junk, which the broker must not keep)
+        async for _, _, slot, block in ctx.tick().sample(dut.store_occupancy.slot, dut.store_occupancy.block):
+            maps = store_maps.get(slot)
+            ctx.set(dut.store_occupancy.planes, maps[block] if maps and block < blocks else rng.randrange(256))
+
+    async def store(ctx):
+        for slot, frame_id, planes in frames:
+            ctx.set(dut.ask.ready, 1)
+            await ctx.tick().until(dut.ask.valid)
+            ctx.set(dut.ask.ready, 0)
+            for _ in range(rng.choice([0, 0, 1, 5])):
+                await ctx.tick()
+            # the slot's map is complete before the frame is given out
+            store_maps[slot], planes_of[frame_id] = planes, planes
+            ctx.set(dut.offered.payload, {"slot": slot, "frame_id": frame_id, "bit_depth": 8})
+            ctx.set(dut.offered.valid, 1)
+            await ctx.tick().until(dut.offered.ready)
+            ctx.set(dut.offered.valid, 0)
+
+    async def sequencer(ctx):
+        rows = {}                     # what each slot's map reads for a lookup made this cycle
+        on_offer = None               # the frame on offer, from the first cycle it is
+        asked = None                  # last cycle's lookup: (slot, what it reads, after a loss)
+        lost = loss_left = 0
+        after_loss = last_asked = False
+        cycle = 0
+        while len(taken) < len(frames):
+            if asked is not None:
+                slot, want, since_loss = asked
+                got = [int(ctx.get(dut.occupancy[b])) for b in range(blocks)]
+                assert got == want, f"cycle {cycle}: slot {slot} reads {got}, not {want}"
+                if since_loss:
+                    seen["planes after loss" if want != empty else "empty after loss"] += 1
+            if lost:
+                # lookups from the cycle after a loss read every map empty, the frame on offer's too
+                rows, after_loss = {}, True
+            valid, payload = ctx.get(dut.frames.valid), ctx.get(dut.frames.payload)
+            if valid and on_offer is None:
+                on_offer = int(payload.frame_id)
+                rows[int(payload.slot)] = planes_of[on_offer]
+
+            # the loss: over when its cycles are, else one of the three begins
+            lost, begins = loss_left > 0, None
+            if lost:
+                loss_left -= 1
+            else:
+                if losses["on offer"] is None and valid and len(taken) > slots // 2:
+                    begins = "on offer"
+                elif (losses["mid-scan"] is None and losses["on offer"] is not None
+                      and ctx.get(dut.store_occupancy.block) == blocks // 2):
+                    begins = "mid-scan"
+                elif losses["scan's end"] is None and losses["mid-scan"] is not None and last_asked:
+                    # the cycle the last block's planes come back
+                    begins = "scan's end"
+                elif losses["random"] is None and cycle >= random_loss:
+                    begins = "random"
+                if begins:
+                    losses[begins], lost, loss_left = cycle, True, rng.randrange(3)
+            ctx.set(dut.store_lost, lost)
+            last_asked = ctx.get(dut.store_occupancy.block) == blocks - 1
+
+            # the frame on offer is looked up at once, else a slot at random; a lookup the cycle a
+            # loss begins may still read the map
+            slot = int(payload.slot) if valid else rng.randrange(slots)
+            ctx.set(dut.occ_slot, slot)
+            asked = None if begins else (slot, rows.get(slot, empty), after_loss)
+            ready = rng.random() < 0.5
+            ctx.set(dut.frames.ready, ready)
+            await ctx.tick()
+            cycle += 1
+            if valid and ready:
+                assert int(payload.frame_id) == frames[len(taken)][1]
+                taken.append(on_offer)
+                on_offer = None
+
+    simulate(dut, [store, sequencer], name=test_name, processes=[occupancy_port], deadline=100e-6)
+    assert taken == [frame_id for _, frame_id, _ in frames]
+    assert None not in losses.values(), losses
+    assert seen["empty after loss"] > slots and seen["planes after loss"] > 10, seen
