@@ -390,7 +390,8 @@ class Client:
         or skip when it plays (planes its frame is not sent with: each frame goes at the depth
         :meth:`send_image` chooses), is refused before anything is sent. Returns the
         :class:`Sent` of each image."""
-        held = self.sequence_frames()
+        # (the images have the DMD's geometry, as each send checks: nothing to ask the projector)
+        held = records.sequence_frames(*np.shape(images[0])) if len(images) else 0
         if not 2 <= len(images) <= held:
             raise ClientError(f"a stored sequence holds 2 to {held} frames of this DMD, not {len(images)}")
         if not 1 <= len(entries) <= records.ENTRIES:
