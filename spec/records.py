@@ -59,7 +59,7 @@ class Action(_enum.IntFlag):
 
 
 #: Entries a sequence's table holds (entry records' ``index`` below it).
-ENTRIES = 256
+ENTRIES = 2048
 
 
 #: Common header of every record. A record is a whole UDP payload: its length is the datagram's.

@@ -1057,6 +1057,37 @@ def test_sequence_beyond_the_live_slots(test_name):
     bench.run([producer, consumer], test_name, deadline=3e-3)
 
 
+def test_entry_table_beyond_a_dlpc350s_buffer(test_name):
+    """300 entries (more than the 256 an 8-bit index names, and than a DLPC350's 48 planes), each
+    a slot of a 12-frame sequence on both sides of the live ones, some skipped: played once, the
+    answers are the entries' slots in the table's order, each its entry's depth, the last marked."""
+    bench = Bench(SHORT_DMD, slots=SEQUENCE_SLOTS, live=LIVE)
+    dut = bench.dut
+    n = SEQUENCE_SLOTS
+    images = {f: store_stim.random_image(SHORT_DMD, 1700 + f) for f in range(n)}
+    # (slot, depth, skip): every 7th entry leaves out all 6 planes of its 6-bit frame: skipped
+    table = [((k * 7) % n, 1 + k % 6, 6 if k % 7 == 3 else 0) for k in range(300)]
+    shown = [(slot, depth) for slot, depth, skip in table if skip == 0]
+
+    async def producer(ctx):
+        await bench.write_entries(ctx, [{"slot": slot, "depth": depth, "skip": skip} for slot, depth, skip in table])
+        await bench.feed_sequence(ctx, images, range(n), depth=6)
+
+    async def consumer(ctx):
+        held = None
+        for index, (slot, depth) in enumerate(shown):
+            payload = await bench.answer(ctx)
+            assert (int(payload.slot), int(payload.bit_depth)) == (slot, depth), f"entry {index}"
+            assert int(payload.showing.last) == (index == len(shown) - 1)
+            if held is not None and held != slot:
+                await bench.release(ctx, held)
+            held = slot
+        assert await bench.answer(ctx, wait=400) is None, "an answer after the last entry of a sequence played once"
+        assert bench.counters(ctx)["entries_skipped"] == len(table) - len(shown)
+
+    bench.run([producer, consumer], test_name, deadline=3e-3)
+
+
 def test_sequence_slots_walked_on_mode_change_and_loss(test_name):
     """The slots beyond the live ones are walked, one a cycle, when the mode changes or the memory
     is lost. A sequence of 12 frames plays up to frame 10 (a slot beyond the live ones), held;

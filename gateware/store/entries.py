@@ -8,7 +8,9 @@ trigger (wait for one, or follow the frame before), camera trigger
 them below the ``skip`` most significant, as a ``depth``-bit image (the slot table works out
 which stored planes those are when the entry plays, :mod:`gateware.store.slot_table`).
 The table is written one entry record at a time (:data:`spec.records.ENTRY`) and read by the
-slot table at its play position, in the same cycle; what an entry's planes need of its frame is
+slot table at its play position, a cycle ahead (block RAM: 2,048 entries, each any of the slots of
+a sequence, so that a sequence of binary patterns plays every plane of the 170 XGA frames the DDR2
+holds); what an entry's planes need of its frame is
 summed when it is written, so that the slot table only compares when it plays.
 """
 
@@ -51,10 +53,10 @@ class EntryTable(wiring.Component):
     entry_writes : In(stream.Signature(layout(ENTRY)))
         Checked entry records (:class:`~gateware.protocol.parser.Parser`): each writes its entry.
     index : In(ENTRY_BITS)
-        The entry to read.
+        The entry to read ...
     entry : Out(Entry)
-        Entry ``index``, this cycle (a table written never shows a half-written entry: a write
-        takes one cycle).
+        ... the next cycle (block RAM; an entry written on the cycle it is read reads as written,
+        and a table written never shows a half-written entry: a write takes one cycle).
     """
 
     entry_writes: In(stream.Signature(layout(ENTRY)))
@@ -65,7 +67,7 @@ class EntryTable(wiring.Component):
         m = Module()
         m.submodules.table = table = memory.Memory(shape=Entry, depth=ENTRIES, init=[])
         write = table.write_port()
-        read = table.read_port(domain="comb")
+        read = table.read_port(transparent_for=(write,))
         record = self.entry_writes.payload
         m.d.comb += [
             self.entry_writes.ready.eq(1),

@@ -160,7 +160,8 @@ class SlotTable(wiring.Component):
         A sequence's entries played (0: its slots in order); in a loop or once; a pulse that
         plays them from the first again.
     entry_index : Out(ENTRY_BITS); entry : In(Entry)
-        The entry table's read port: the entry at the play position, the same cycle.
+        The entry table's read port (block RAM, one cycle): the play position from the next cycle
+        on, and the entry at the play position.
     asks : In(stream.Signature(0))
         Each transfer asks for one frame; an ask waits until a frame can be given.
     releases : In(stream.Signature(SLOT_BITS))
@@ -297,7 +298,8 @@ class SlotTable(wiring.Component):
                 with m.Else():
                     m.d.sync += state[s].eq(SlotState.FREE)
         with m.Elif(mode_pending & self.placement.between_rows & ~offered):
-            m.d.sync += [seq_len.eq(wanted_len), play.eq(0), finished.eq(0), t.recv_active.eq(0),
+            m.d.comb += play.next.eq(0)
+            m.d.sync += [seq_len.eq(wanted_len), finished.eq(0), t.recv_active.eq(0),
                          t.last_valid.eq(0), high_ready.eq(0)]
             self._walk(m, walking, walk_loss, walk_slot, loss=False)
             for s in range(live):
@@ -340,7 +342,8 @@ class SlotTable(wiring.Component):
             m.d.sync += count.entries_skipped.eq(count.entries_skipped + 1)
         # last: from the first entry again (over an answer given out this cycle)
         with m.If(self.sequence_start):
-            m.d.sync += [play.eq(0), finished.eq(0)]
+            m.d.comb += play.next.eq(0)
+            m.d.sync += finished.eq(0)
         return m
 
     def _walk(self, m, walking, walk_loss, walk_slot, *, loss):
@@ -360,7 +363,11 @@ class SlotTable(wiring.Component):
         t = slots.t
         state, in_sequence = t.state, t.in_sequence
         ready_found, ready_slot = _first_of(m, live, lambda s: (state[s] == SlotState.READY) & ~in_sequence[s])
-        play = Signal(ENTRY_BITS)      # the slot, or the entry, given out next
+        # the slot, or the entry, given out next; the entry table is read a cycle ahead, at the
+        # position from the next cycle on (``play.next``)
+        play = SimpleNamespace(now=Signal(ENTRY_BITS, name="play"), next=Signal(ENTRY_BITS, name="play_next"))
+        m.d.comb += play.next.eq(play.now)
+        m.d.sync += play.now.eq(play.next)
         finished = Signal()            # played once: the last entry given out
         # every slot of the sequence holds its frame (those beyond the live ones counted as they
         # complete: they never go back but through a walk, which restarts the count)
@@ -371,19 +378,19 @@ class SlotTable(wiring.Component):
                 m.d.comb += loaded.eq(0)
         entry = self.entry
         by_entry = sequence & (self.entries != 0)
-        last_entry = play + 1 >= self.entries
+        last_entry = play.now + 1 >= self.entries
         answer_slot = Signal(SLOT_BITS)
         with m.If(by_entry):
             m.d.comb += answer_slot.eq(entry.slot)
         with m.Elif(sequence):
-            m.d.comb += answer_slot.eq(play)
+            m.d.comb += answer_slot.eq(play.now)
         with m.Else():
             m.d.comb += answer_slot.eq(ready_slot)
         given = slots.view("answer", answer_slot)
         shown_depth, low_plane, missing = _entry_planes(m, entry, given.depth)
         # (a frame's depth is known once every slot of the sequence holds its frame)
         skip = by_entry & ~finished & ((entry.slot >= seq_len) | (loaded & missing))
-        m.d.comb += self.entry_index.eq(play)
+        m.d.comb += self.entry_index.eq(play.next)
         can_answer = Signal()
         with m.If(by_entry):
             # (an entry may show the frame shown now: the sequencer holds a slot once)
@@ -410,11 +417,11 @@ class SlotTable(wiring.Component):
         def advance():
             """The play position after the entry (or slot) given out or skipped."""
             with m.If(by_entry):
-                m.d.sync += play.eq(Mux(last_entry, 0, play + 1))
+                m.d.comb += play.next.eq(Mux(last_entry, 0, play.now + 1))
                 with m.If(last_entry & ~self.loop):
                     m.d.sync += finished.eq(1)
             with m.Else():
-                m.d.sync += play.eq(Mux(play + 1 >= seq_len, 0, play + 1))
+                m.d.comb += play.next.eq(Mux(play.now + 1 >= seq_len, 0, play.now + 1))
         return SimpleNamespace(play=play, finished=finished, advance=advance, slot=answer_slot,
                                can_answer=can_answer, skip=skip)
 

@@ -110,9 +110,9 @@ BAD_RECORDS = {
                             "drop_app_length"),
     **{f"sequencer_{name}": (sequencer_record(**changes), "drop_app_value")
        for name, changes in BAD_REGISTERS.items()},
-    "entries_beyond_table": (codec.control_record(entries=257), "drop_app_value"),
+    "entries_beyond_table": (codec.control_record(entries=2049), "drop_app_value"),
     "loop_not_a_bit": (codec.control_record(loop=2), "drop_app_value"),
-    "entry_index_beyond_table": (entry_record(index=256), "drop_app_value"),
+    "entry_index_beyond_table": (entry_record(index=2048), "drop_app_value"),
     "entry_slot_outside_sequence": (entry_record(slot=255), "drop_app_value"),
     "entry_lsb_odd": (entry_record(lsb=3), "drop_app_value"),
     "entry_dark_odd": (entry_record(dark=1), "drop_app_value"),
@@ -174,7 +174,7 @@ def randomized_mix(count=260, seed=11):
             seq += 1
         elif roll < 0.78:
             # entries, mostly good: the slot against the sequence in force, odd times, flags, skips
-            entry = entry_record(seq, index=rng.choice([0, 7, 255, 256]), slot=rng.choice([0, 0, 1, 2]),
+            entry = entry_record(seq, index=rng.choice([0, 7, 2047, 2048]), slot=rng.choice([0, 0, 1, 2]),
                                  lsb=2 * rng.randrange(5) + (rng.random() < 0.2), dark=2 * rng.randrange(4),
                                  follow=rng.choice([0, 1, 0, 1, 2]), skip=rng.choice([0, 0, 3, 7, 8]))
             raw, bad = frames.udp(A, entry), False

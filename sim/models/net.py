@@ -184,13 +184,13 @@ class Model:
                     or (applies("sequence_length")
                         and not 1 <= control["sequence_length"] <= min(256, (128 << 20) // (self.dmd.rows
                                                                                            * self.dmd.columns)))
-                    or (applies("entries") and control["entries"] > 256)
+                    or (applies("entries") and control["entries"] > 2048)
                     or (applies("loop") and control["loop"] > 1)):
                 return "drop_app_value"
         if kind == RecordType.ENTRY:
             # (the protocol page's rules, written out here, not the parser's shared function)
             entry = wire.unpack(records.ENTRY, data[header_size:])
-            if (entry["index"] > 255 or entry["slot"] >= self.config["sequence_length"] or entry["lsb"] % 2
+            if (entry["index"] > 2047 or entry["slot"] >= self.config["sequence_length"] or entry["lsb"] % 2
                     or entry["dark"] % 2 or entry["follow"] > 1 or entry["camera_off"] > 1
                     or entry["depth"] > 8 or entry["skip"] > 7):
                 return "drop_app_value"
