@@ -1062,7 +1062,6 @@ def test_entry_table_beyond_a_dlpc350s_buffer(test_name):
     a slot of a 12-frame sequence on both sides of the live ones, some skipped: played once, the
     answers are the entries' slots in the table's order, each its entry's depth, the last marked."""
     bench = Bench(SHORT_DMD, slots=SEQUENCE_SLOTS, live=LIVE)
-    dut = bench.dut
     n = SEQUENCE_SLOTS
     images = {f: store_stim.random_image(SHORT_DMD, 1700 + f) for f in range(n)}
     # (slot, depth, skip): every 7th entry leaves out all 6 planes of its 6-bit frame: skipped
