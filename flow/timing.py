@@ -36,7 +36,8 @@ _LUTS = {f"LUT{n}" for n in range(1, 7)} | {"LUT6_2", "INV"}
 _LUTRAM_READS = {
     **{kind: {f"DO{p}": f"ADDR{p}" for p in "ABCD"} for kind in ("RAM32M", "RAM64M")},
     **{kind: {"SPO": "A", "DPO": "DPRA"} for kind in ("RAM32X1D", "RAM64X1D", "RAM128X1D")},
-    **{kind: {"O": "A"} for kind in ("RAM32X1S", "RAM64X1S", "RAM128X1S")},
+    # (a RAM256X1S is four 64-deep LUTs and the slice's MUXF7/MUXF8: one LUT level, as a LUT7/8)
+    **{kind: {"O": "A"} for kind in ("RAM32X1S", "RAM64X1S", "RAM128X1S", "RAM256X1S")},
 }
 #: LUT-RAM read addresses that are not its write address too: a path through one goes on through
 #: the read (and is counted where it ends) and does not end at the LUT-RAM, whose write clock may

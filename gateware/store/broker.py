@@ -92,6 +92,9 @@ class FrameBroker(wiring.Component):
                 m.d.sync += clearing.eq(0)
         zeroing = self.store_lost | clearing
 
+        # the store's map is looked up from registers alone, in every state (only SCAN uses the
+        # answers): no decode of the state in front of the store's block RAM address
+        m.d.comb += [self.store_occupancy.slot.eq(info.slot), self.store_occupancy.block.eq(block)]
         row_done = Signal()
         with m.FSM():
             with m.State("ASK"):
@@ -105,7 +108,6 @@ class FrameBroker(wiring.Component):
                     m.next = "SCAN"
             with m.State("SCAN"):
                 # Block b is asked for on one cycle and its planes come back on the next.
-                m.d.comb += [self.store_occupancy.slot.eq(info.slot), self.store_occupancy.block.eq(block)]
                 m.d.sync += [block.eq(block + 1), staged.eq(row)]
                 with m.If(zeroing):
                     # starts over after the sweep: the row is never written where the sweep

@@ -5,8 +5,9 @@ words the row shows (``source``): the slot itself for a whole frame and for a ro
 carries, the delta's base for a row it does not. ``stored`` is read back in ``sync`` (one cycle
 later) to refuse a row that arrived before, ``source`` in ``dmd`` by the plane reader, with the
 slot's kind (whole or delta). Each half is a memory of its own with one write and one read port,
-so that each maps to block RAM: a read is then a flip-flop to flip-flop path with no logic (as
-one memory with two read ports it took distributed RAM and several LUT levels of multiplexers).
+so that each maps to block RAM: a ``source`` read is then a flip-flop to flip-flop path with no
+logic (as one memory with two read ports it took distributed RAM and several LUT levels of
+multiplexers); ``stored`` keeps 64 rows a word and picks the row's bit after the read.
 Occupancy map: per slot and DMD block, 8 bits, plane ``k`` has a bit set somewhere in the block
 (a delta starts from its base's, a superset of what its rows from the base hold: a block it says
 has bits is loaded, never wrongly cleared). Every map is written in ``sync`` through one stream
@@ -14,7 +15,7 @@ of writes; the ``dmd`` read ports are safe because a slot reaches the sequencer 
 complete, and a base is never written while a delta uses it (see :mod:`gateware.store.layouts`).
 """
 
-from amaranth import Cat, Module
+from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
@@ -128,17 +129,33 @@ class SlotMaps(wiring.Component):
         row_bits = ceil_log2(self._dmd.rows)
         write = self.writes.payload
 
-        # the stored bits of every slot; the sources of the live slots only: a slot beyond them
-        # holds a whole frame (never a delta, :mod:`gateware.store.slot_table`), whose rows the
-        # plane reader reads from the slot itself without asking for their source
-        for name, port, domain, slots in (("stored", self.bitmap, "sync", self._slots),
-                                          ("source", self.sources, "dmd", self._live)):
-            bits = ceil_log2(slots)
-            m.submodules[name] = memory = Memory(shape=len(getattr(port, name)), depth=slots << row_bits, init=[])
-            w, r = memory.write_port(), memory.read_port(domain=domain)
-            m.d.comb += [w.addr.eq(Cat(write.row, write.slot[:bits])), w.data.eq(write[name]),
-                         w.en.eq(self.writes.valid & (write.slot < slots)),
-                         r.addr.eq(Cat(port.row, port.slot[:bits])), r.en.eq(port.en), getattr(port, name).eq(r.data)]
+        # The stored bits of every slot, 64 rows a word (each row's bit written alone): a memory of
+        # a few thousand words, not one per row of every slot (170 XGA slots are 174,080 rows,
+        # and the tools choke on as many initial values). The row's bit is picked from its word
+        # after the read, in ``sync``.
+        slot_bits = ceil_log2(self._slots)
+        word_bits = min(6, row_bits)
+        m.submodules.stored = stored = Memory(shape=1 << word_bits, depth=self._slots << (row_bits - word_bits),
+                                              init=[])
+        w, r = stored.write_port(granularity=1), stored.read_port(domain="sync")
+        picked = Signal(word_bits)
+        m.d.comb += [w.addr.eq(Cat(write.row[word_bits:], write.slot[:slot_bits])),
+                     w.data.eq(Cat(write.stored for _ in range(1 << word_bits))),
+                     w.en.eq(Mux(self.writes.valid & (write.slot < self._slots), 1 << write.row[:word_bits], 0)),
+                     r.addr.eq(Cat(self.bitmap.row[word_bits:], self.bitmap.slot[:slot_bits])),
+                     r.en.eq(self.bitmap.en), self.bitmap.stored.eq(r.data.bit_select(picked, 1))]
+        with m.If(self.bitmap.en):
+            m.d.sync += picked.eq(self.bitmap.row[:word_bits])
+        # the sources of the live slots only: a slot beyond them holds a whole frame (never a
+        # delta, :mod:`gateware.store.slot_table`), whose rows the plane reader reads from the
+        # slot itself without asking for their source
+        live_bits = ceil_log2(self._live)
+        m.submodules.source = source = Memory(shape=SLOT_BITS, depth=self._live << row_bits, init=[])
+        w, r = source.write_port(), source.read_port(domain="dmd")
+        m.d.comb += [w.addr.eq(Cat(write.row, write.slot[:live_bits])), w.data.eq(write.source),
+                     w.en.eq(self.writes.valid & (write.slot < self._live)),
+                     r.addr.eq(Cat(self.sources.row, self.sources.slot[:live_bits])), r.en.eq(self.sources.en),
+                     self.sources.source.eq(r.data)]
         m.submodules.kinds = kinds = Memory(shape=1, depth=self._slots, init=[])
         kinds_w, kinds_r = kinds.write_port(), kinds.read_port(domain="dmd")
         m.d.comb += [
