@@ -180,11 +180,10 @@ MEMORY = {
 }
 
 
-def frames_held(rows, columns, *, memory_bytes=None):
+def frames_held(rows, columns):
     """Whole 8-plane frames of ``rows`` x ``columns`` (a multiple of 64) the memory holds: the
     DLP7000's 170, the DLP9500's 60 in 128 MiB."""
-    memory_bytes = MEMORY["bytes"].value if memory_bytes is None else memory_bytes
-    return int(memory_bytes) // (8 * rows * columns // 8)
+    return int(MEMORY["bytes"].value) // (rows * columns)     # 8 planes of a bit a pixel
 
 
 #: The Marvell 88E1111 PHY, as the management block (:mod:`gateware.mac.mdio`) needs it.

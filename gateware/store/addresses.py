@@ -20,9 +20,9 @@ Every row starts on a 16-byte boundary when ``words_per_row`` is even (every DMD
 128-bit memory port reads whole rows.
 """
 
-from spec.facts import MEMORY, frames_held
+from spec.facts import MEMORY
 
-__all__ = ["AddressMap", "MEMORY_BYTES", "PLANES", "WORD_BYTES", "slots_held"]
+__all__ = ["AddressMap", "MEMORY_BYTES", "PLANES", "WORD_BYTES"]
 
 #: The Atlys DDR2 (MT47H64M16): 64 Mi x 16 bit = 128 MiB.
 MEMORY_BYTES = int(MEMORY["bytes"].value)
@@ -55,8 +55,3 @@ class AddressMap:
         """``(first, end)`` byte addresses of a slot."""
         first = self.address(slot, 0)
         return first, first + self.slot_bytes
-
-
-def slots_held(dmd, *, limit, memory_bytes=MEMORY_BYTES):
-    """Frame slots of ``dmd`` the memory holds whole (``limit`` at most): DLP7000 170, DLP9500 60."""
-    return min(limit, frames_held(dmd.rows, dmd.words_per_row * 64, memory_bytes=memory_bytes))

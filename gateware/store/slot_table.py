@@ -280,7 +280,7 @@ class SlotTable(wiring.Component):
                 with m.Else():
                     slots.keep(state=SlotState.FREE)
             with m.Else():
-                slots.keep(state=Mux(hk.state == SlotState.SHOWN, hk.state, SlotState.FREE), in_sequence=0)
+                slots.keep(state=Mux(hk.state == SlotState.SHOWN, SlotState.SHOWN, SlotState.FREE), in_sequence=0)
             m.d.sync += walk_slot.eq(walk_slot + 1)
             with m.If(walk_slot == n_slots - 1):
                 m.d.sync += walking.eq(0)
