@@ -5,9 +5,9 @@
 ``blocks/<block>.v`` for every block in :data:`flow.blocks.BLOCKS`; ``sync_master/`` the same
 for the sync master's own build (a tiled display's main control board,
 :mod:`gateware.top.sync_master`); ``dlp9500/`` the same for the DLP9500 projector on its board
-(the SVEC, :mod:`gateware.platform.svec`). The DLP9500 board's top is linted too, with the vendor
-primitives and the generated cores it instantiates declared as black boxes
-(:func:`lint_top`).
+(the SVEC, :mod:`gateware.platform.svec`). Each board top is linted too, the vendor primitives
+and the generated cores it instantiates declared as black boxes in ``lint/`` (:func:`lint_top`),
+so that the ISE trees hold only what ISE reads.
 """
 
 import re
@@ -171,14 +171,15 @@ def main(outdir="build/spartan6"):
             if path.is_file():
                 print(f"  {path.name}")
     print(f"block Verilog in {outdir}/blocks/: {', '.join(sorted(blocks))}")
-    results = lint(blocks)
+    results = {f"blocks/{name}.v": result for name, result in lint(blocks).items()}
     # the board tops, vendor primitives and generated cores as black boxes (declared in lint/)
     for name, where, boxes in ((top, outdir, blackboxes("atlys")), (master, outdir / "sync_master", []),
                                (dlp9500, outdir / "dlp9500", blackboxes("svec"))):
-        results[name] = lint_top(where / f"{name}.v", name, boxes, workdir=outdir / "lint")
+        path = where / f"{name}.v"
+        results[str(path.relative_to(outdir))] = lint_top(path, name, boxes, workdir=outdir / "lint")
     failed = False
     for name, (ok, messages) in results.items():
-        print(f"verilator --lint-only {name}.v: {'clean' if ok else 'ERRORS'}")
+        print(f"verilator --lint-only {name}: {'clean' if ok else 'ERRORS'}")
         if not ok:
             failed = True
             print(messages)

@@ -57,10 +57,10 @@ class PlatformTop(Elaboratable):
         self._dclk_hz = dclk_hz
 
     def elaborate(self, platform):
-        m = Module()
         dmd = self._dmd
         # a board whose adapter cannot carry this DMD is refused before anything is built
         Dlpc410Pins.check(platform, dmd.buses)
+        m = Module()
 
         # ---- Clocks: the board oscillator through the PLL; RX_CLK from the PHY ------------------
         clk = platform.request(platform.default_clk, dir="-")
