@@ -35,6 +35,8 @@ from fractions import Fraction
 from amaranth import ClockDomain, ClockSignal, Elaboratable, Instance, Module, Signal
 from amaranth.lib.cdc import ResetSynchronizer
 
+from spec.facts import SPARTAN6
+
 __all__ = ["Spartan6Clocks", "PLANS", "DCLK_HZ", "pll_multipliers"]
 
 #: The default DCLK.
@@ -55,16 +57,15 @@ PLANS = {
 }
 #: The oscillator of the Atlys (the default input).
 INPUT_HZ = 100e6
-#: Spartan-6 PLL_BASE phase detector: its lowest input (DS162, F_PFDMIN).
-PFD_MIN_HZ = 19e6
 
 
 def pll_multipliers(input_hz, vco_mhz):
     """``(DIVCLK_DIVIDE, CLKFBOUT_MULT)`` that make ``vco_mhz`` from ``input_hz``: the smallest
-    divider, the phase detector kept at or above :data:`PFD_MIN_HZ`."""
+    divider, the phase detector kept at or above the PLL's lowest (``spec.facts.SPARTAN6``)."""
     ratio = Fraction(int(vco_mhz * 1e6), int(input_hz))
     divide, mult = ratio.denominator, ratio.numerator
-    assert mult <= 64 and input_hz / divide >= PFD_MIN_HZ, f"no PLL makes {vco_mhz} MHz from {input_hz / 1e6} MHz"
+    pfd_min = SPARTAN6["pll_pfd_min"].value
+    assert mult <= 64 and input_hz / divide >= pfd_min, f"no PLL makes {vco_mhz} MHz from {input_hz / 1e6} MHz"
     return divide, mult
 
 
