@@ -24,7 +24,8 @@ from .pins import SfpGmiiPins
 
 __all__ = ["SvecPlatform", "SvecProjectorPlatform", "SVEC_DDR3", "P2_PINS"]
 
-#: FMC slot pins (``svec_v0_afpga.ucf``, "FMC slot 1" and "FMC slot 2") in the order of
+#: FMC slot pins (``svec_v0_afpga.ucf``, "FMC slot 1" and "FMC slot 2": connectors ``fmc`` 0 and 1
+#: here, ``fmc0`` and ``fmc1`` in the current constraint files) in the order of
 #: :data:`~.dlpc410_adapter.FMC_PAIRS` (LA00..LA33, CLK0_M2C, CLK1_M2C): the P pins, the N pins.
 _FMC_PINS = [
     ("C16 H21 J22 E25 D24 M19 B25 G22 F23 M20 L21 G20 F21 G18 F17 H16 F19 "
