@@ -37,7 +37,8 @@ sim: $(STAMP)
 	$(PY) -m flow sim --dclk $(DCLK) $(if $(DMD),--dmd $(DMD)) $(if $(FAULTS),--faults $(FAULTS)) $(if $(VIRTUAL),--virtual $(VIRTUAL)) \
 		$(if $(WINDOW),--window)
 
-# The Spartan-6 ISE tree (Verilog, UCF, ISE scripts) and each block's Verilog, in build/spartan6.
+# The Spartan-6 ISE trees (Verilog, UCF, ISE scripts) and each block's Verilog, in build/spartan6:
+# the Atlys's, the sync master's (sync_master/) and the DLP9500's on the SVEC (dlp9500/), linted.
 verilog: $(STAMP)
 	$(PY) -m flow verilog
 

@@ -19,12 +19,14 @@ refHDL      TI's applications-FPGA reference HDL as quoted in public repositorie
 forum       TI E2E forum answers (quoting the datasheet); Mathews et al., IEEE QCE 2022 (measured)
 DLPU133     DLPC964 applications FPGA user guide (loading into settling mirrors)
 four-DMD    the tiled four-DLP9500 projector paper (2026), eq. 6-7 (450.6 Hz 8-bit, runs at 400 Hz)
+DS162       Xilinx Spartan-6 FPGA data sheet: DC and switching characteristics (PLL)
 """
 
 import enum
 from dataclasses import dataclass
 
-__all__ = ["Fact", "TIMING", "SettleReading", "SETTLE_READINGS", "PHY", "DmdType", "DMDS", "RowMode", "BlockMode",
+__all__ = ["Fact", "TIMING", "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "DmdType", "DMDS", "RowMode",
+           "BlockMode",
            "TEST_DMD", "TEST_DMD4",
            "TEST_DMD_400", "TEST_DMD4_400"]
 
@@ -184,6 +186,13 @@ def frames_held(rows, columns):
     """Whole 8-plane frames of ``rows`` x ``columns`` (a multiple of 64) the memory holds: the
     DLP7000's 170, the DLP9500's 60 in 128 MiB."""
     return int(MEMORY["bytes"].value) // (rows * columns)     # 8 planes of a bit a pixel
+
+
+#: The Spartan-6 PLL, as the clock plans (:mod:`gateware.platform.clocks`) need it.
+SPARTAN6 = {
+    "pll_pfd_min": Fact(19e6, "Hz", "DS162 PLL specification (F_PFDMIN)", "medium",
+                        "the phase detector's lowest input: the oscillator after the PLL's input divider"),
+}
 
 
 #: The Marvell 88E1111 PHY, as the management block (:mod:`gateware.mac.mdio`) needs it.

@@ -28,6 +28,9 @@ def test_ise_tree_has_verilog_ucf_and_scripts():
     v = (out / f"{top}.v").read_text()
     for primitive in ("PLL_BASE", "BUFG", "ODDR2", "OBUFTDS"):
         assert primitive in v, primitive
+    # the top lints, the primitives and the memory controller declared as black boxes
+    ok, messages = verilog.lint_top(out / f"{top}.v", top, verilog.blackboxes("atlys"), workdir=out.parent / "lint")
+    assert ok, messages
 
 
 def test_sync_master_tree_drives_every_board_from_a_pad_flip_flop():

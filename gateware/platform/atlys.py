@@ -4,6 +4,8 @@ projector's board: amaranth-boards' platform plus the DLPC410 adapter and trigge
 from amaranth_boards.atlys import AtlysPlatform
 
 from .dlpc410_adapter import dlpc410_resources, trigger_resources
+from .mcb_instance import ATLYS_DDR2
+from .pins import GmiiPins
 
 __all__ = ["AtlysProjectorPlatform"]
 
@@ -18,3 +20,9 @@ class AtlysProjectorPlatform(AtlysPlatform):
 
     resources = AtlysPlatform.resources + dlpc410_resources() + trigger_resources()
     dlpc410_complete = any(c.name == "dlpc410_ext" for c in AtlysPlatform.connectors)
+    #: the VHDCI adapter's buses (a two-bus DMD: DLP7000)
+    dlpc410_buses = 2
+    #: the memory the store uses and its controller
+    memory = ATLYS_DDR2
+    #: the Ethernet PHY: the 88E1111 on GMII
+    ethernet = GmiiPins

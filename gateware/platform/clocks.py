@@ -1,4 +1,5 @@
-"""Clocks of the projector on a Spartan-6: PLLs from the board oscillator.
+"""Clocks of the projector on a Spartan-6: PLLs from the board oscillator (100 MHz on the Atlys,
+125 MHz on the SVEC).
 
 =========  ==========  ===========================================
 domain     frequency   use
@@ -11,10 +12,11 @@ dmd        200 MHz     plane reader, sequencer, the DLPC410 link's parallel side
 The DLPC410 link, by DCLK:
 
 * **400 MHz** (the default; the DLPC410's newer PROM takes nothing else): a second PLL, VCO 800
-  MHz, gives ``dmd`` and two 800 MHz I/O clocks, each through a BUFPLL (``DIVIDE=4``) that makes
-  the serdes strobe: one for the data lanes (DIN, DVALID), one half a bit later (its PLL output
-  at 180 degrees, 625 ps: 90 degrees of DCLK) for the DCLK lanes (:mod:`.serdes`). ``dmd`` comes
-  from the same PLL, so the 4:1 serialisers' parallel and serial clocks are phase-aligned.
+  MHz (from 125 MHz through a divide by 5 before the phase detector), gives ``dmd`` and two
+  800 MHz I/O clocks, each through a BUFPLL (``DIVIDE=4``) that makes the serdes strobe: one
+  for the data lanes (DIN, DVALID), one half a bit later (its PLL output at 180 degrees, 625 ps:
+  90 degrees of DCLK) for the DCLK lanes (:mod:`.serdes`). ``dmd`` comes from the same PLL, so
+  the 4:1 serialisers' parallel and serial clocks are phase-aligned.
 * **200 MHz**: one PLL (VCO 1 GHz) gives every domain, and ``dclk``, 90 degrees after ``dmd``,
   for DCLK forwarded through an ODDR2 so that each DCLK edge falls in the middle of a bit.
 
@@ -28,27 +30,43 @@ buffer (ISE may want a BUFIO2 or BUFG before the second), and both BUFPLLs must 
 the DLPC410 adapter's pins.
 """
 
+from fractions import Fraction
+
 from amaranth import ClockDomain, ClockSignal, Elaboratable, Instance, Module, Signal
 from amaranth.lib.cdc import ResetSynchronizer
 
-__all__ = ["Spartan6Clocks", "PLANS", "DCLK_HZ"]
+from spec.facts import SPARTAN6
+
+__all__ = ["Spartan6Clocks", "PLANS", "DCLK_HZ", "pll_multipliers"]
 
 #: The default DCLK.
 DCLK_HZ = 400e6
 
-#: PLLs by DCLK: each ``{"mult", "outputs": {name: divide}, "phases": {name: degrees}}`` from a
-#: 100 MHz input (VCO inside Spartan-6 -3's 400-1080 MHz). Outputs named ``io_*`` feed BUFPLLs,
-#: the others BUFGs that drive the domain of that name.
+#: PLLs by DCLK: each ``{"vco": MHz, "outputs": {name: divide}, "phases": {name: degrees}}``
+#: (VCO inside Spartan-6 -3's 400-1080 MHz); :func:`pll_multipliers` derives the PLL's input
+#: divider and feedback multiplier from the board's oscillator. Outputs named ``io_*`` feed
+#: BUFPLLs, the others BUFGs that drive the domain of that name.
 PLANS = {
     200e6: [
-        {"mult": 10, "outputs": {"sync": 8, "dmd": 5, "dclk": 5, "gmii_tx": 8}, "phases": {"dclk": 90.0}},
+        {"vco": 1000, "outputs": {"sync": 8, "dmd": 5, "dclk": 5, "gmii_tx": 8}, "phases": {"dclk": 90.0}},
     ],
     400e6: [
-        {"mult": 10, "outputs": {"sync": 8, "gmii_tx": 8}, "phases": {}},
-        {"mult": 8, "outputs": {"io_data": 1, "io_dclk": 1, "dmd": 4}, "phases": {"io_dclk": 180.0}},
+        {"vco": 1000, "outputs": {"sync": 8, "gmii_tx": 8}, "phases": {}},
+        {"vco": 800, "outputs": {"io_data": 1, "io_dclk": 1, "dmd": 4}, "phases": {"io_dclk": 180.0}},
     ],
 }
-INPUT_MHZ = 100.0
+#: The oscillator of the Atlys (the default input).
+INPUT_HZ = 100e6
+
+
+def pll_multipliers(input_hz, vco_mhz):
+    """``(DIVCLK_DIVIDE, CLKFBOUT_MULT)`` that make ``vco_mhz`` from ``input_hz``: the smallest
+    divider, the phase detector kept at or above the PLL's lowest (``spec.facts.SPARTAN6``)."""
+    ratio = Fraction(int(vco_mhz * 1e6), int(input_hz))
+    divide, mult = ratio.denominator, ratio.numerator
+    pfd_min = SPARTAN6["pll_pfd_min"].value
+    assert mult <= 64 and input_hz / divide >= pfd_min, f"no PLL makes {vco_mhz} MHz from {input_hz / 1e6} MHz"
+    return divide, mult
 
 
 class Spartan6Clocks(Elaboratable):
@@ -57,11 +75,13 @@ class Spartan6Clocks(Elaboratable):
     Parameters
     ----------
     clk_in : Signal
-        The board oscillator (100 MHz on the Atlys).
+        The board oscillator.
     rst_in : Signal
         Board reset button (active high).
     dclk_hz : float
         DCLK: 400 MHz or 200 MHz.
+    input_hz : float
+        The oscillator's frequency (100 MHz on the Atlys, 125 MHz on the SVEC).
 
     Attributes
     ----------
@@ -71,10 +91,11 @@ class Spartan6Clocks(Elaboratable):
         At 400 MHz: ``{"data": (ioclk, strobe), "dclk": (ioclk, strobe)}`` of the BUFPLLs.
     """
 
-    def __init__(self, clk_in, rst_in, dclk_hz=DCLK_HZ):
+    def __init__(self, clk_in, rst_in, dclk_hz=DCLK_HZ, input_hz=INPUT_HZ):
         self.clk_in = clk_in
         self.rst_in = rst_in
         self.dclk_hz = dclk_hz
+        self.input_hz = input_hz
         self.locked = Signal()
         self.io = {name: (Signal(name=f"ioclk_{name}"), Signal(name=f"strobe_{name}"))
                    for name in ("data", "dclk")} if dclk_hz == 400e6 else {}
@@ -87,8 +108,8 @@ class Spartan6Clocks(Elaboratable):
 
     @staticmethod
     def frequencies(dclk_hz=DCLK_HZ):
-        """``{domain: Hz}`` of the plan."""
-        return {name: INPUT_MHZ * plan["mult"] / div * 1e6 for plan in PLANS[dclk_hz]
+        """``{domain: Hz}`` of the plan (whatever the oscillator: the VCOs are the plan's)."""
+        return {name: plan["vco"] / div * 1e6 for plan in PLANS[dclk_hz]
                 for name, div in plan["outputs"].items() if not name.startswith("io_")}
 
     def elaborate(self, platform):
@@ -99,9 +120,10 @@ class Spartan6Clocks(Elaboratable):
         raw = {}
         for index, plan in enumerate(plans):
             feedback, lock = Signal(name=f"pll{index}_feedback"), Signal(name=f"pll{index}_locked")
+            divide, mult = pll_multipliers(self.input_hz, plan["vco"])
             params = dict(
                 p_BANDWIDTH="OPTIMIZED", p_CLK_FEEDBACK="CLKFBOUT", p_COMPENSATION="INTERNAL",
-                p_CLKIN_PERIOD=1000 / INPUT_MHZ, p_DIVCLK_DIVIDE=1, p_CLKFBOUT_MULT=plan["mult"],
+                p_CLKIN_PERIOD=1e9 / self.input_hz, p_DIVCLK_DIVIDE=divide, p_CLKFBOUT_MULT=mult,
                 p_CLKFBOUT_PHASE=0.0, i_CLKIN=clk_in, i_RST=self.rst_in, i_CLKFBIN=feedback,
                 o_CLKFBOUT=feedback, o_LOCKED=lock,
             )

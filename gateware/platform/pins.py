@@ -12,18 +12,20 @@ from amaranth.lib.cdc import FFSynchronizer, ResetSynchronizer
 from gateware.dlpc410.interface import Signature as Dlpc410Signature
 from gateware.mac.gmii import RxPins, TxPins
 
+from .blackbox import blackbox_verilog
 from .serdes import DCLK_BITS, Oserdes4, lane_bits
 
-__all__ = ["GmiiPins", "Dlpc410Pins", "TriggerPins"]
+__all__ = ["GmiiPins", "SfpGmiiPins", "SFP_MODULE", "Dlpc410Pins", "TriggerPins"]
+
+#: The wrapper around the vendor's 1000BASE-X PCS/PMA on the SFP's GTP (not part of this tree).
+SFP_MODULE = "sfp_gmii"
 
 
-class GmiiPins(Elaboratable):
-    """The 88E1111's GMII and management pins.
+class EthernetPins(Elaboratable):
+    """What the core's MAC sees of the Ethernet PHY, whichever it is: GMII and management.
 
-    Drives ``ClockSignal("gmii_rx")`` from RX_CLK (the top owns the ``gmii_rx`` domain),
-    registers the receive pins in the IOBs on RX_CLK and the transmit pins on ``gmii_tx``, and
-    forwards ``gmii_tx``'s clock to GTX_CLK through an ODDR2 so that it leaves the FPGA with the
-    same delay as the data.
+    The board's PHY block drives ``ClockSignal("gmii_rx")`` (the top owns the ``gmii_rx``
+    domain) and holds it in reset until ``locked``.
 
     Parameters
     ----------
@@ -47,6 +49,15 @@ class GmiiPins(Elaboratable):
         self.mdio_o = Signal()
         self.mdio_oe = Signal()
         self.mdio_i = Signal()
+
+
+class GmiiPins(EthernetPins):
+    """The 88E1111's GMII and management pins (the Atlys).
+
+    Drives ``ClockSignal("gmii_rx")`` from RX_CLK, registers the receive pins in the IOBs on
+    RX_CLK and the transmit pins on ``gmii_tx``, and forwards ``gmii_tx``'s clock to GTX_CLK
+    through an ODDR2 so that it leaves the FPGA with the same delay as the data.
+    """
 
     def elaborate(self, platform):
         m = Module()
@@ -81,6 +92,54 @@ class GmiiPins(Elaboratable):
         return m
 
 
+class SfpGmiiPins(EthernetPins):
+    """Gigabit Ethernet through an SFP cage (the SVEC): a GMII PHY inside the FPGA.
+
+    The PHY is :data:`SFP_MODULE`, a wrapper (not part of this tree, not written yet) around the
+    vendor's 1000BASE-X PCS/PMA core on the SFP's GTP, that keeps the 88E1111's GMII contract:
+    its receive clock and data out (``rx_clk``, ``rxd``, ``rx_dv``, ``rx_er``), transmit data in
+    on the clock given to it (``tx_clk``, ``txd``, ``tx_en``, ``tx_er``: ``gmii_tx``, which the
+    wrapper carries into the GTP's clock), and a reset. It is instantiated here as a black box.
+    The receive outputs are registered once on ``gmii_rx``, as the 88E1111's are in the IOBs.
+
+    There is no MDIO PHY: MDIO reads all ones (the core's PHY poller reads the 88E1111's
+    register 17, which a 1000BASE-X PCS does not have).
+    """
+
+    #: The wrapper's ports: (name, direction, width).
+    PORTS = [
+        ("refclk_p", "i", 1), ("refclk_n", "i", 1), ("txp", "o", 1), ("txn", "o", 1), ("rxp", "i", 1),
+        ("rxn", "i", 1), ("reset", "i", 1),
+        ("rx_clk", "o", 1), ("rxd", "o", 8), ("rx_dv", "o", 1), ("rx_er", "o", 1),
+        ("tx_clk", "i", 1), ("txd", "i", 8), ("tx_en", "i", 1), ("tx_er", "i", 1),
+    ]
+
+    def elaborate(self, platform):
+        m = Module()
+        sfp = platform.request("sfp", 0, dir="-")
+        refclk = platform.request("sfp_refclk", 0, dir="-")
+        rx_clk = Signal()
+        rx = Signal(RxPins)
+        ports = dict(
+            refclk_p=refclk.p, refclk_n=refclk.n, txp=sfp.tx.p, txn=sfp.tx.n, rxp=sfp.rx.p, rxn=sfp.rx.n,
+            reset=~self.phy_reset_n, rx_clk=rx_clk, rxd=rx.d, rx_dv=rx.dv, rx_er=rx.er,
+            tx_clk=ClockSignal("gmii_tx"), txd=self.tx.d, tx_en=self.tx.en, tx_er=self.tx.er,
+        )
+        m.submodules.pcs = Instance(SFP_MODULE, **{f"{kind}_{name}": ports[name] for name, kind, _ in self.PORTS})
+        m.submodules.rx_bufg = Instance("BUFG", i_I=rx_clk, o_O=ClockSignal("gmii_rx"))
+        platform.add_clock_constraint(rx_clk, 125e6)
+        m.submodules.rx_rst = ResetSynchronizer(~self._locked, domain="gmii_rx")
+        m.d.gmii_rx += self.rx.eq(rx)
+        m.submodules.tx_disable = tx_disable = io.Buffer("o", sfp.tx_disable)
+        m.d.comb += [tx_disable.o.eq(0), self.mdio_i.eq(1)]
+        return m
+
+    @classmethod
+    def blackbox_verilog(cls):
+        """A Verilog declaration of :data:`SFP_MODULE`'s ports (what the lint reads)."""
+        return blackbox_verilog(SFP_MODULE, {f"{kind}_{name}": Signal(width) for name, kind, width in cls.PORTS})
+
+
 class Dlpc410Pins(Elaboratable):
     """The DLPC410 interface on the adapter board's pins.
 
@@ -91,9 +150,13 @@ class Dlpc410Pins(Elaboratable):
     edges sit in the middle of each bit. Inputs are registered in the IOBs and synchronised into
     ``dmd``.
 
-    On a board without the adapter's second port (``platform.dlpc410_complete`` false) only
-    bus A, DCLK and DVALID exist: the core's other outputs go nowhere and ECP2_FINISHED reads
-    low, so the sequencer never leaves its initialisation wait.
+    The adapter's pins are the board's resources ``dlpc410`` and ``dlpc410_ext``
+    (:mod:`.dlpc410_adapter`), each bus's DIN, DCLK and DVALID in whichever holds them. On a
+    board without the adapter's second port (``platform.dlpc410_complete`` false) only what
+    ``dlpc410`` holds is driven (on the Atlys: bus A, the DCLKs and DVALIDs): the core's other
+    outputs go nowhere and ECP2_FINISHED reads low, so the sequencer never leaves its
+    initialisation wait. A DMD with more buses than the board's adapter carries
+    (``platform.dlpc410_buses``) is refused.
 
     Parameters
     ----------
@@ -110,8 +173,15 @@ class Dlpc410Pins(Elaboratable):
 
     def __init__(self, buses=2, beats=1, io=None):
         assert beats == 1 or io, "two beats a cycle need the serialisers' I/O clocks"
-        self._beats, self._io = beats, io or {}
+        self._buses, self._beats, self._io = buses, beats, io or {}
         self.bus = Dlpc410Signature(buses, beats).flip().create()
+
+    @staticmethod
+    def check(platform, buses):
+        """Refuse a DMD of more ``buses`` than the board's adapter carries."""
+        carried = getattr(platform, "dlpc410_buses", 2)
+        if buses > carried:
+            raise ValueError(f"the board's DLPC410 adapter carries {carried} buses, the DMD needs {buses}")
 
     def _lanes(self, m, name, port, edges):
         """A pin bus (``port``, one pin per bit) sending ``edges`` (per edge, one bit per pin)."""
@@ -138,18 +208,32 @@ class Dlpc410Pins(Elaboratable):
     def elaborate(self, platform):
         m = Module()
         bus = self.bus
-        fast = platform.request("dlpc410", 0, dir="-")
-        self._lanes(m, "din_a", fast.din_a, bus.din_a)
-        for clk in ("dclk_a", "dclk_b"):
-            self._dclk(m, clk, getattr(fast, clk))
-        for valid in ("dvalid_a", "dvalid_b"):
-            self._lanes(m, valid, getattr(fast, valid), [bus.dvalid[e] for e in range(2 * self._beats)])
+        self.check(platform, self._buses)
+        complete = getattr(platform, "dlpc410_complete", False)
+        groups = [platform.request(name, 0, dir="-") for name in ("dlpc410", "dlpc410_ext")[:1 + complete]]
 
-        if not getattr(platform, "dlpc410_complete", False):
+        # each group's DIN lanes, then its DCLKs, then its DVALIDs
+        letters = "abcd"[:self._buses]
+        driven = set()
+        for group in groups:
+            for kind in ("din", "dclk", "dvalid"):
+                for name in (f"{kind}_{letter}" for letter in letters):
+                    port = getattr(group, name, None)
+                    if port is None:
+                        continue
+                    if kind == "din":
+                        self._lanes(m, name, port, getattr(bus, name))
+                    elif kind == "dclk":
+                        self._dclk(m, name, port)
+                    else:
+                        self._lanes(m, name, port, [bus.dvalid[e] for e in range(2 * self._beats)])
+                    driven.add(name)
+        if not complete:
             return m
+        missing = {f"{kind}_{letter}" for kind in ("din", "dclk", "dvalid") for letter in letters} - driven
+        assert not missing, f"the adapter has no pins for {sorted(missing)}"
 
-        ext = platform.request("dlpc410_ext", 0, dir="-")
-        self._lanes(m, "din_b", ext.din_b, bus.din_b)
+        ext = groups[1]
         for name in ("rowmd", "rowad", "blkmd", "blkad", "rst2blkz", "comp_data", "ns_flip",
                      "wdt_enblz", "pwr_float", "arstz"):
             m.submodules[name] = buf = io.FFBuffer("o", getattr(ext, name), o_domain="dmd")

@@ -9,7 +9,7 @@ from amaranth.lib import io, wiring
 
 from gateware.platform.clocks import DCLK_HZ, Spartan6Clocks
 from gateware.platform.mcb_instance import McbInstance
-from gateware.platform.pins import Dlpc410Pins, GmiiPins, TriggerPins
+from gateware.platform.pins import Dlpc410Pins, TriggerPins
 from gateware.registers import Registers
 from spec import schedule
 from spec.facts import DMDS
@@ -39,12 +39,15 @@ def core(dmd, dclk_hz=DCLK_HZ):
 
 
 class PlatformTop(Elaboratable):
-    """The whole projector for :data:`gateware.platform.Board`.
+    """The whole projector for a board of :data:`gateware.platform.BOARDS`: its oscillator and
+    reset (``default_clk``, ``default_rst``), its Ethernet PHY (``ethernet``), its DLPC410
+    adapter and its memory (``memory``), as the platform class names them.
 
     Parameters
     ----------
     dmd : str
-        DMD name in :data:`spec.facts.DMDS`.
+        DMD name in :data:`spec.facts.DMDS`; the board's adapter must carry its buses (the
+        Atlys two, the SVEC four).
     dclk_hz : float
         DCLK: 400 MHz (the default: two beats a ``dmd`` cycle through OSERDES2s) or 200 MHz.
     """
@@ -54,19 +57,22 @@ class PlatformTop(Elaboratable):
         self._dclk_hz = dclk_hz
 
     def elaborate(self, platform):
-        m = Module()
         dmd = self._dmd
+        # a board whose adapter cannot carry this DMD is refused before anything is built
+        Dlpc410Pins.check(platform, dmd.buses)
+        m = Module()
 
         # ---- Clocks: the board oscillator through the PLL; RX_CLK from the PHY ------------------
-        clk100 = platform.request("clk100", dir="-")
-        rst = platform.request("rst", dir="-")
-        m.submodules.clk_buf = clk_buf = io.Buffer("i", clk100)
+        clk = platform.request(platform.default_clk, dir="-")
+        rst = platform.request(platform.default_rst, dir="-")
+        m.submodules.clk_buf = clk_buf = io.Buffer("i", clk)
         m.submodules.rst_buf = rst_buf = io.Buffer("i", rst)
         m.domains += [*Spartan6Clocks.domains(self._dclk_hz), ClockDomain("gmii_rx")]
-        m.submodules.clocks = clocks = Spartan6Clocks(clk_buf.i, rst_buf.i, self._dclk_hz)
+        m.submodules.clocks = clocks = Spartan6Clocks(clk_buf.i, rst_buf.i, self._dclk_hz,
+                                                      platform.default_clk_frequency)
 
         # ---- Pins ---------------------------------------------------------------------------
-        m.submodules.gmii = gmii = GmiiPins(clocks.locked)
+        m.submodules.gmii = gmii = platform.ethernet(clocks.locked)
         beats = schedule.beats_at(self._dclk_hz)
         m.submodules.dlpc410 = dlpc = Dlpc410Pins(dmd.buses, beats, clocks.io)
         m.submodules.trigger = trigger = TriggerPins()
@@ -86,8 +92,8 @@ class PlatformTop(Elaboratable):
             trigger.camera.eq(projector.camera_out),
             trigger.ready.eq(projector.ready_out),
         ]
-        # ---- DDR2 through the memory controller ----------------------------------------------
-        m.submodules.mcb = mcb = McbInstance(port0_domain="sync", port1_domain="dmd")
+        # ---- DDR2 or DDR3 through the memory controller ---------------------------------------
+        m.submodules.mcb = mcb = McbInstance(memory=platform.memory, port0_domain="sync", port1_domain="dmd")
         wiring.connect(m, projector.mcb_write, mcb.port0)
         wiring.connect(m, projector.mcb_read, mcb.port1)
         m.d.comb += [mcb.sys_clk.eq(clk_buf.i), mcb.sys_rst.eq(rst_buf.i)]
