@@ -83,6 +83,11 @@ def _sync_master():
     return SyncMaster(BOARDS)
 
 
+def _clock_trim():
+    from gateware.sync.clock_trim import ClockTrim
+    return ClockTrim()
+
+
 #: Each block under one name: its class's, in snake case (``res.<name>.*``, ``blocks/<name>.v``).
 BLOCKS = {
     "receive_path": _receive_path,
@@ -100,6 +105,7 @@ BLOCKS = {
     "core_dlp9500": lambda: core("dlp9500"),
     "register_crossing": _register_crossing,
     "sync_master": _sync_master,
+    "clock_trim": _clock_trim,
 }
 
 

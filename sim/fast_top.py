@@ -82,14 +82,15 @@ def read_rate(timing, dmd_hz):
 
 def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cycles, flush,
                  ecp2_cycles=ECP2_CYCLES, restart_at=0, restart_cycles=0, restart_ecp2_cycles=0,
-                 extra=None, layout=None, always=None, domain="dmd"):
+                 extra=None, layout=None, always=None, domain="dmd", plusarg=PLUSARGS["pins"]):
     """The DLPC410's side of the pins ``dlpc`` (an interface of
     :class:`gateware.dlpc410.interface.Signature`, seen from its driver): the responder drives the
     controller's outputs (its cycle counts: ints, or signals set at run time; ``restart_*``: a
     restart mid-run, none when ``restart_cycles`` is 0), the recorder writes
     the pins and ``extra`` (``{field: signal}`` of ``layout``'s other fields; default layout
-    :func:`pin_layout`) to the file of plusarg ``PLUSARGS["pins"]``, on every cycle with DVALID
-    or ``always`` high and every cycle something changed. The interface's ``beats`` (DCLK cycles
+    :func:`pin_layout`) to the file of plusarg ``plusarg`` (one per board where several share a
+    simulation), on every cycle with DVALID or ``always`` high and every cycle something
+    changed. The interface's ``beats`` (DCLK cycles
     per cycle) set the row cycle's length in cycles and the trace's widths."""
     beats = dlpc.signature.beats
     rst_active, init_active, ecp2 = Signal(), Signal(), Signal()
@@ -114,7 +115,7 @@ def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cyc
     for name, signal in (extra or {}).items():
         m.d.comb += getattr(pins, name).eq(signal)
     m.submodules.pin_trace = Instance(
-        "trace_recorder", p_WIDTH=len(pins.as_value()), p_PLUSARG=PLUSARGS["pins"],
+        "trace_recorder", p_WIDTH=len(pins.as_value()), p_PLUSARG=plusarg,
         i_clk=ClockSignal(domain), i_rst=ResetSignal(domain), i_value=pins.as_value(),
         i_always_record=dlpc.dvalid.any() if always is None else dlpc.dvalid.any() | always, i_flush=flush)
 

@@ -45,7 +45,8 @@ from spec.registers import TIME_BITS
 from spec.schedule import DECISION_TO_PINS
 
 __all__ = ["SequencerRig", "EventPlayer", "run_rig", "run_script", "rig_verilog", "analyse", "event_table",
-           "rig_layout", "event_layout", "Timing", "SOURCES", "PLUSARGS", "INPUTS", "MAX_EVENTS", "TOPLEVEL"]
+           "rig_layout", "event_layout", "Timing", "file_table", "write_hex", "responder_timing", "SOURCES",
+           "PLUSARGS", "INPUTS", "MAX_EVENTS", "TOPLEVEL"]
 
 TOPLEVEL = "sequencer_rig"
 #: The Verilog models the rig instantiates.
@@ -205,8 +206,8 @@ class SequencerRig(wiring.Component):
         ]
         depths = table_depths(dmd, self._store_words)
         for name in TABLES:
-            _file_table(m, name, getattr(core, name), depths[name])
-        _file_table(m, "events", player.table, MAX_EVENTS)
+            file_table(m, name, getattr(core, name), depths[name])
+        file_table(m, "events", player.table, MAX_EVENTS)
         dlpc410_side(m, dmd, core.pins, flush=self.flush, domain="sync", layout=rig_layout(dmd.buses, self._beats),
                      always=core.release.valid,
                      extra={"trigger_in": core.trigger_in, "sync_out": core.sync_out,
@@ -217,12 +218,13 @@ class SequencerRig(wiring.Component):
         return m
 
 
-def _file_table(m, name, port, depth):
+def file_table(m, name, port, depth, plusarg=None):
     """A ``file_memory.v`` behind the read port ``port`` (a :class:`TableSignature` interface),
-    loaded from the file of plusarg ``PLUSARGS[name]``."""
+    loaded from the file of plusarg ``plusarg`` (default ``PLUSARGS[name]``)."""
     width = len(Value.cast(port.data))
     m.submodules[f"{name}_table"] = Instance(
-        "file_memory", p_WIDTH=width, p_DEPTH=depth, p_ADDR_BITS=len(port.addr), p_PLUSARG=PLUSARGS[name],
+        "file_memory", p_WIDTH=width, p_DEPTH=depth, p_ADDR_BITS=len(port.addr),
+        p_PLUSARG=plusarg or PLUSARGS[name],
         i_addr=port.addr, o_data=port.data)
 
 
@@ -241,7 +243,7 @@ def rig_verilog(dmd, beats=1, store_words=1):
     return cocotb_run.emit_verilog(SequencerRig(dmd, beats=beats, store_words=store_words), TOPLEVEL)
 
 
-def _write_hex(path, words, width):
+def write_hex(path, words, width):
     digits = (width + 3) // 4
     Path(path).write_text("".join(f"{int(w):0{digits}x}\n" for w in words))
 
@@ -269,9 +271,18 @@ def _stimulus(directory, dmd, frames, images, events, store_words=1):
     for name, words, width in (("planes", c.planes, 64 * store_words), ("occupancy_map", c.occupancy, 8 * dmd.blocks),
                                ("offered", c.offered, OfferedFrame.as_shape().size),
                                ("events", events, event_layout().size)):
-        _write_hex(files[name], words, width)
+        write_hex(files[name], words, width)
     files["pins"] = directory / "pins.txt"
     return files, [f"+{PLUSARGS[name]}={path}" for name, path in files.items()]
+
+
+def responder_timing(model):
+    """The responder's cycle counts (packed :class:`Timing`) of the controller ``model``."""
+    return pack(Timing, {
+        "rst_active_cycles": model.rst_active_cycles, "init_cycles": model.init_cycles,
+        "init_grace_cycles": model.init_grace_cycles, "ecp2_cycles": model.ecp2_cycles,
+        "restart_at": model.restart_at or 0, "restart_cycles": model.restart_cycles if model.restart_at else 0,
+        "restart_ecp2_cycles": model.restart_ecp2_cycles})
 
 
 def run_script(dmd, params, frames, images=None, *, script, name, model=None, seed=None, events=(),
@@ -289,11 +300,7 @@ def run_script(dmd, params, frames, images=None, *, script, name, model=None, se
     files, plusargs = _stimulus(directory, dmd, frames, images, list(events), store_words)
     report = directory / "report.json"
     report.unlink(missing_ok=True)
-    timing = {"rst_active_cycles": model.rst_active_cycles, "init_cycles": model.init_cycles,
-              "init_grace_cycles": model.init_grace_cycles, "ecp2_cycles": model.ecp2_cycles,
-              "restart_at": model.restart_at or 0, "restart_cycles": model.restart_cycles if model.restart_at else 0,
-              "restart_ecp2_cycles": model.restart_ecp2_cycles}
-    p = {"regs": pack(Registers, params.registers(dmd)), "timing": pack(Timing, timing),
+    p = {"regs": pack(Registers, params.registers(dmd)), "timing": responder_timing(model),
          "seed": seed, "script": script, "report": str(report), "max_cycles": max_cycles,
          "status": [(n, f.offset, f.width) for n, f in data.Layout.cast(Status)]}
     cocotb_run.run(rig_verilog(dmd, params.beats, store_words), toplevel=TOPLEVEL, module="sim.tb.seq_rig",

@@ -105,7 +105,8 @@ FIELDS = [
                                  "first plane loaded no sooner than this many cycles later (the "
                                  "requester's occupancy look-up plus the store's latency to the "
                                  "first words of a row)"),
-    Field("period", DURATION_BITS, doc="trigger period of TriggerMode.PERIODIC"),
+    Field("period", DURATION_BITS, doc="trigger period of TriggerMode.PERIODIC; in SYNC, the sync "
+                                       "master's period, for the board's clock loop (0: off)"),
     Field("camera_offset", DURATION_BITS, doc="camera-trigger pulse: starts this many cycles "
                                               "after a frame's first pulse"),
     Field("camera_width", 16, doc="camera-trigger pulse length"),

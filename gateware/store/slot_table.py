@@ -266,7 +266,7 @@ class SlotTable(wiring.Component):
         # the slot housekeeping looks at (the event below that takes it)
         hk = slots.housekeeping(Mux(walking, walk_slot,
                                     Mux(self.written.valid & ~offered, done,
-                                        Mux(self.releases.valid, released, answer_slot))))
+                                        Mux(self.releases.valid & ~offered, released, answer_slot))))
         with m.If(~self.lose):
             m.d.sync += self.forgotten.eq(0)
         with m.If(walking):
@@ -319,7 +319,7 @@ class SlotTable(wiring.Component):
                                   & (done != s)):
                             m.d.sync += [state[s].eq(retired(s)),
                                          count.frames_replaced.eq(count.frames_replaced + 1)]
-        with m.Elif(self.releases.valid):
+        with m.Elif(self.releases.valid & ~offered):
             m.d.comb += self.releases.ready.eq(1)
             with m.If(hk.state != SlotState.SHOWN):
                 slots.keep(stale=0)

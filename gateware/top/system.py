@@ -14,7 +14,7 @@ The top that instantiates this defines the four clock domains and connects the M
 memory controller (platform) or the MCB model (simulation).
 """
 
-from amaranth import Cat, DomainRenamer, Module, Mux, Signal
+from amaranth import Cat, DomainRenamer, Module, Mux, Signal, signed
 from amaranth.lib import data, wiring
 from amaranth.lib.cdc import FFSynchronizer, PulseSynchronizer
 from amaranth.lib.wiring import In, Out
@@ -33,6 +33,7 @@ from gateware.store import mcb
 from gateware.store.broker import FrameBroker
 from gateware.store.layouts import SLOT_BITS, FrameInfo
 from gateware.store.store import Store
+from gateware.sync.clock_trim import TRIM_BITS, ClockTrim
 from spec.records import sequence_frames
 
 __all__ = ["Projector", "ShownFrame", "slots_for"]
@@ -108,6 +109,11 @@ class Projector(wiring.Component):
         display's sync master.
     shown : Out(ShownFrame)
         The frame shown last (``dmd``); its id also reaches the status reply (``shown_frame``).
+    vcxo_trim : Out(signed(16))
+        The control word of the ``dmd`` clock's VCXO (``dmd``), for a board of a tiled display:
+        in SYNC trigger mode with a non-zero ``period`` (the sync period in ``dmd`` cycles), the
+        clock loop (:class:`gateware.sync.clock_trim.ClockTrim`) pulls the clock to the sync
+        master's rate; else 0. A board without a VCXO leaves it unconnected.
     """
 
     def __init__(self, dmd, *, mac, ip, port, regs, armed=True, sync_hz=125e6, slots=None, mdio_cycles=None,
@@ -137,6 +143,7 @@ class Projector(wiring.Component):
             "camera_out": Out(1),
             "ready_out": Out(1),
             "shown": Out(ShownFrame),
+            "vcxo_trim": Out(signed(TRIM_BITS)),
         })
 
     def elaborate(self, platform):
@@ -203,6 +210,11 @@ class Projector(wiring.Component):
             self.ready_out.eq(seq.ready),
         ]
         m.submodules.soft_trigger = soft = PulseSynchronizer(i_domain="sync", o_domain="dmd")
+        # a tiled display's board: its clock kept at the sync master's rate, the pulse on one edge
+        m.submodules.clock_trim = trim = DomainRenamer("dmd")(ClockTrim())
+        m.d.comb += [trim.sync_in.eq(self.sync_in), trim.now.eq(seq.status.now[:16]),
+                     trim.period.eq(Mux(seq.regs.trigger == TriggerMode.SYNC, seq.regs.period, 0)),
+                     self.vcxo_trim.eq(trim.trim)]
 
         # ---- The sequencer's registers and arming (sync -> dmd) -------------------------------
         m.submodules.registers = registers = RegisterCrossing(self._regs)

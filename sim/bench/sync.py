@@ -1,0 +1,203 @@
+"""Tiled display: the sync error between boards against run time, measured on the tiled rig.
+
+A sync master and four boards, each on its own crystal, in one Verilator simulation of their
+generated Verilog (:mod:`sim.tiled_rig`). The crystals are off by up to 100 ppm either way, one
+drifts (a temperature change, sped up so that a short run sees it: 1,000 ppm/s), two jitter.
+Each board starts its frame on the master's pulse, so its error does not build up from one
+frame to the next. Within a frame it is the board's sampling of the pulse plus its clock's
+error times the time since the pulse; each board's clock loop
+(:class:`gateware.sync.clock_trim.ClockTrim`, pulling the board's VCXO) removes both once
+locked: the boards keep the master's rate and take each pulse on the same edge.
+
+* The long run, loops on: 10,000 frames of 4 planes on the test DMD (1,458 cycles a frame;
+  8-plane frames would take 40 minutes to simulate). The spread of the boards' clocking pulses
+  at every pulse of every frame, in ns, per 500 frames against the run time, with each board's
+  rate measured from its pulses' times: ``build/sync_spread.csv`` and ``.png``.
+* The same clocks with the loops off, 2,000 frames: the sampling (the bus decides on even
+  cycles: up to two cycles apart) and the drift.
+* 8-plane frames, loops on (their pins through the rule-checking DLPC410 model, and one camera
+  over the whole scene from one pulse to the next, in real time: the error either side of each
+  seam) and off (the check of the extrapolation: the spread predicted from the 4-plane run's
+  figures against the one measured).
+* Extrapolated to the DLP7000's 8-bit frame (the schedule model's period) and to hours: a frame
+  restarts on each pulse, so the spread depends on the clocks' difference at that moment, not on
+  the run time: without the loops the crystals' tolerance (+-100 ppm at any temperature) bounds
+  it, with them the loop's remaining error at that period (its model, :func:`sim.models
+  .clock_trim.lock`, checked against the gateware at the small DMD's periods).
+"""
+
+import numpy as np
+
+from sim.bench.tables import label, pyplot, save_figure, write_table
+from sim.models import clock_trim
+from sim.tiled_rig import BOARD_PERIOD_FS, MASTER_PERIOD_FS, Oscillator, run_tiled
+from spec import schedule
+from spec.facts import DMDS, TEST_DMD
+
+__all__ = ["run", "OSCILLATORS", "MASTER", "FRAMES", "CHUNK"]
+
+OSCILLATORS = [Oscillator(100, jitter_ps=10, seed=1), Oscillator(-100, jitter_ps=30, seed=3),
+               Oscillator(37, seed=5), Oscillator(-61, ramp_ppm_per_s=1000, jitter_ps=20, seed=7)]
+MASTER = Oscillator(-20, seed=11)
+#: Frames of the long run, and how many make a row of the table.
+FRAMES = 10_000
+CHUNK = 500
+#: Frames of the run with the loops off.
+UNTRIMMED_FRAMES = 2_000
+#: Frames of the 8-plane run (its pins recorded and checked by the rule model, and the camera).
+EIGHT_FRAMES = 250
+#: The crystals' tolerance the extrapolation takes (any temperature).
+PPM_TOLERANCE = 100
+
+
+def _plan(depth):
+    return schedule.plan(TEST_DMD, 200e6, depth=depth, t_rst_s=20 / 200e6, t_settle_s=30 / 200e6)
+
+
+def _tiles():
+    """One scene across the boards side by side (a ramp holding every grey level on every row),
+    split in tiles."""
+    boards, (rows, columns) = len(OSCILLATORS), (TEST_DMD.rows, TEST_DMD.columns)
+    r, c = np.indices((rows, columns * boards))
+    scene = ((c * 255) // (columns * boards - 1) + 37 * r) & 255
+    return [scene[:, i * columns:(i + 1) * columns].astype(np.uint8) for i in range(boards)]
+
+
+def _run(depth, frames, name, *, trim, traces=False):
+    plan = _plan(depth)
+    period = int(plan.frame_cycles * BOARD_PERIOD_FS / MASTER_PERIOD_FS * 1.001) + 64
+    period += -period % 5               # whole board cycles a period, for the loops
+    return run_tiled(TEST_DMD, plan.params, _tiles(), oscillators=OSCILLATORS, master=MASTER, frames=frames,
+                     master_period_cycles=period, name=name, traces=traces, depth=depth, trim=trim)
+
+
+def _seam_errors(run, lsb, first):
+    """Per frame from ``first`` to the one before the last, a camera over the whole scene from one sync
+    pulse to the next, in real time: the largest error (LSB) on the columns either side of a
+    seam, and anywhere."""
+    boards = [run.board_run(i, TEST_DMD) for i in range(len(OSCILLATORS))]
+    images = _tiles()
+    seams, anywhere = [], []
+    for k in range(max(first, 1), len(run.syncs) - 1):
+        errors = [run.light(i, b, run.syncs[k], run.syncs[k + 1], lsb) - images[i] for i, b in enumerate(boards)]
+        anywhere.append(max(float(np.abs(e).max()) for e in errors))
+        seams.append(max(float(np.abs(np.stack([a[:, -1], b[:, 0]])).max())
+                         for a, b in zip(errors, errors[1:], strict=False)))
+    return max(seams), max(anywhere)
+
+
+def _rates_ppm(run, first, last):
+    """Each board's frequency error (ppm) from its pulses in frames ``first..last - 1``."""
+    out = []
+    for times, cycles, _ in run.pulses:
+        inside = (times >= run.syncs[first]) & (times < (run.syncs[last] if last < len(run.syncs) else np.inf))
+        t, c = times[inside], cycles[inside]
+        out.append((BOARD_PERIOD_FS * (c[-1] - c[0]) / (1000 * (t[-1] - t[0])) - 1) * 1e6)
+    return out
+
+
+def _since_ns(run):
+    """Per pulse of a frame, its mean time after the sync pulse (ns), over the run."""
+    first = run.frame_pulses()[0]
+    whole = [f for f in first if len(f) == len(first[0])]
+    return np.mean([(f - s) / 1000 for f, s in zip(whole, run.syncs, strict=False)], axis=0)
+
+
+def _table(run, spreads):
+    rows = []
+    for first in range(0, len(spreads), CHUNK):
+        last = min(first + CHUNK, len(run.syncs))
+        part = spreads[first:last]
+        rows.append([first, f"{(run.syncs[first] - run.syncs[0]) / 1e9:.3f}", f"{part.max():.3f}",
+                     f"{part.mean():.3f}", f"{part[:, 0].max():.3f}", f"{part[:, -1].max():.3f}",
+                     *[f"{r:.3f}" for r in _rates_ppm(run, first, last)]])
+    return rows
+
+
+def run():
+    long = _run(4, FRAMES, "sync_spread_4planes", trim=True)
+    locked = long.locked_from()
+    assert locked is not None, "the clock loops never locked"
+    spreads = long.spreads()
+    rows = _table(long, spreads)
+    write_table("sync_spread", ["first_frame", "run_time_ms", "spread_ns_max", "spread_ns_mean",
+                                "first_pulse_spread_ns_max", "last_pulse_spread_ns_max",
+                                *[f"board{i}_ppm" for i in range(len(OSCILLATORS))]], rows)
+    _plot(rows)
+    chunks = range(0, len(long.syncs), CHUNK)
+    rates = np.array([_rates_ppm(long, f, min(f + CHUNK, len(long.syncs))) for f in chunks])
+    after = spreads[locked:]
+    hours = len(after) // 2
+    figures = {
+        "sync.boards": (len(OSCILLATORS), "boards"),
+        "sync.frames": (min(s["frames"] for s in long.status), "frames a board played"),
+        "sync.refused": (long.counts["not_ready"] + long.counts["early"], "pulses the master refused"),
+        "sync.ppm_max": (float(max(abs(o.error(t)) for o in OSCILLATORS for t in (0, long.syncs[-1] / 1e12)) * 1e6),
+                         "ppm, the crystals' largest error in the run"),
+        "sync.lock_frames": (locked, "frames until every board's loop stayed locked"),
+        "sync.spread_ns_max": (float(after.max()), "ns, every pulse of every frame once locked"),
+        "sync.spread_ns_max_first_half": (float(after[:hours].max()), "ns"),
+        "sync.spread_ns_max_second_half": (float(after[hours:].max()), "ns"),
+        "sync.spread_ns_max_acquiring": (float(spreads[:locked].max()), "ns, before the lock"),
+        "sync.locked_rate_difference_ppm_max": (float((rates.max(axis=1) - rates.min(axis=1))[1:].max()),
+                                                "ppm between boards, per 500 frames once locked"),
+    }
+
+    untrimmed = _run(4, UNTRIMMED_FRAMES, "sync_spread_4planes_untrimmed", trim=False)
+    loose = untrimmed.spreads()
+    loose_rates = np.array([_rates_ppm(untrimmed, f, min(f + CHUNK, len(untrimmed.syncs)))
+                            for f in range(0, len(untrimmed.syncs), CHUNK)])
+    difference = float((loose_rates.max(axis=1) - loose_rates.min(axis=1)).max()) * 1e-6
+    sampling_ns = float(loose[:, 0].max())
+    figures.update({
+        "sync.spread_ns_max_untrimmed": (float(loose.max()), "ns, loops off"),
+        "sync.first_pulse_spread_ns_max_untrimmed": (sampling_ns, "ns (the boards' sampling of the pulse)"),
+    })
+
+    # 8 planes: with the loops (every board's pins checked, the seams) and without (the check)
+    eight = _run(8, EIGHT_FRAMES, "sync_spread_8planes", trim=True, traces=True)
+    eight_locked = eight.locked_from()
+    seam, anywhere = _seam_errors(eight, _plan(8).params.lsb, eight_locked or 1)
+    loose8 = _run(8, 100, "sync_spread_8planes_untrimmed", trim=False)
+    predicted = sampling_ns + difference * float(_since_ns(loose8)[-1])
+    figures.update({
+        "sync.spread_ns_max_8planes": (float(eight.spreads()[eight_locked:].max()), "ns, loops locked"),
+        "sync.seam_gray_error_lsb_max": (seam, "LSB, window from pulse to pulse, either side of a seam"),
+        "sync.tile_gray_error_lsb_max": (anywhere, "LSB, the same window, any pixel"),
+        "sync.spread_ns_max_8planes_untrimmed": (float(loose8.spreads().max()), "ns, 100 frames, loops off"),
+        "sync.spread_ns_max_8planes_untrimmed_predicted_model": (predicted, "ns, from the 4-plane run's figures"),
+    })
+
+    # the DLP7000's 8-bit frame, for hours: the crystals' tolerance, or the loop's residual
+    dlp7000 = schedule.plan(DMDS["dlp7000"], 400e6, depth=8)
+    frame_ns = dlp7000.frame_cycles / 200e6 * 1e9
+    residual = max(abs(e) for ppm in (PPM_TOLERANCE, -PPM_TOLERANCE)
+                   for _, e in clock_trim.lock(dlp7000.frame_cycles, ppm, pulses=400)[200:]) * 1e-6
+    figures.update({
+        "sync.spread_ns_max_last_hour_extrapolated": (float(after.max()) + 2 * residual * frame_ns,
+                                                      "ns, DLP7000 8-bit frame, loops on"),
+        "sync.spread_ns_max_last_hour_extrapolated_untrimmed": (2 * BOARD_PERIOD_FS / 1e6
+                                                                + 2 * PPM_TOLERANCE * 1e-6 * frame_ns,
+                                                                "ns, DLP7000 8-bit frame, loops off, +-100 ppm"),
+        "sync.wall_s": (long.wall_s + untrimmed.wall_s + eight.wall_s + loose8.wall_s, "s of simulation"),
+    })
+    return figures
+
+
+def _plot(rows):
+    plt = pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4))
+    t = [float(r[1]) for r in rows]
+    for column, name in ((2, "largest spread"), (4, "first pulse (sampling)"), (5, "last pulse")):
+        axes[0].plot(t, [float(r[column]) for r in rows], "o-", label=name)
+    label(axes[0], "run time (ms)", "spread of the boards' clocking pulses (ns)",
+          f"sync error per {CHUNK} frames, {len(OSCILLATORS)} boards, clock loops on")
+    for i in range(len(OSCILLATORS)):
+        axes[1].plot(t, [float(r[6 + i]) for r in rows], "o-", label=f"board {i}")
+    label(axes[1], "run time (ms)", "clock error measured from the pulses (ppm)")
+    save_figure(plt, fig, "sync_spread")
+
+
+if __name__ == "__main__":
+    for figure, (value, unit) in run().items():
+        print(f"{figure:55s} {value:12.3f} {unit}")
