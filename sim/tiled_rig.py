@@ -95,7 +95,7 @@ class Board(wiring.Component):
     dmd : DmdType
     index : int
         The board's number: its domain and plusargs (:func:`board_plusargs`).
-    beats : int
+    beats, store_words : int
         As the sequencer's.
 
     Members
@@ -118,9 +118,9 @@ class Board(wiring.Component):
         pulses it saw and its slips.
     """
 
-    def __init__(self, dmd, index, *, beats=1):
-        self._dmd, self._index, self._beats = dmd, index, beats
-        self._core = SourcedSequencer(dmd, beats=beats)
+    def __init__(self, dmd, index, *, beats=1, store_words=1):
+        self._dmd, self._index, self._beats, self._store_words = dmd, index, beats, store_words
+        self._core = SourcedSequencer(dmd, beats=beats, store_words=store_words)
         self._trim = ClockTrim()
         super().__init__({
             **members(self._core, ("regs", "sync_in", "ready", "status")),
@@ -145,7 +145,7 @@ class Board(wiring.Component):
             self.trim.eq(trim.trim), self.locked.eq(trim.locked), self.trim_pulses.eq(trim.pulses),
             self.slips.eq(trim.slips),
         ]
-        depths = table_depths(dmd)
+        depths = table_depths(dmd, self._store_words)
         for name in TABLES:
             file_table(m, name, getattr(core, name), depths[name], plusarg=names[name])
         pins = core.pins
@@ -194,8 +194,8 @@ class TiledRig(wiring.Component):
         Writes every recorder's buffered lines to its file.
     """
 
-    def __init__(self, dmd, boards=4, *, beats=1):
-        self._dmd, self._boards, self._beats = dmd, boards, beats
+    def __init__(self, dmd, boards=4, *, beats=1, store_words=1):
+        self._dmd, self._boards, self._beats, self._store_words = dmd, boards, beats, store_words
         self._master = SyncMaster(boards)
         super().__init__({
             "regs": In(Registers),
@@ -222,7 +222,7 @@ class TiledRig(wiring.Component):
         m.d.master += last.eq(master.sync_out[0])
         _pulse_times(m, "master", MASTER_PLUSARGS["pulses"], Const(1, 1), master.sync_out[0] & ~last, self.flush)
         for i in range(self._boards):
-            board = m.submodules[f"board{i}"] = Board(self._dmd, i, beats=self._beats)
+            board = m.submodules[f"board{i}"] = Board(self._dmd, i, beats=self._beats, store_words=self._store_words)
             m.d.comb += [
                 board.regs.eq(self.regs), board.timing.eq(self.timing), board.flush.eq(self.flush),
                 board.sync_in.eq(master.sync_out[i]), self.ready[i].eq(board.ready),
@@ -338,7 +338,7 @@ def _read_times(path):
 
 
 def run_tiled(dmd, params, images, *, oscillators, master=Oscillator(), frames, name, master_period_cycles,
-              depth=8, width=4, traces=True, trim=False, max_sim_s=None):
+              depth=8, width=4, traces=True, trim=False, store_words=1, max_sim_s=None):
     """Run the tiled rig: one board per image of ``images`` (8-bit images of ``dmd``'s size),
     each showing its image's ``depth`` most significant planes as a frame again at every sync
     pulse, under ``params`` (a
@@ -347,7 +347,8 @@ def run_tiled(dmd, params, images, *, oscillators, master=Oscillator(), frames, 
     cycles long) until it has sent ``frames`` pulses. ``traces``: record every board's pins (for
     :meth:`TiledRun.board_run`); without, only the pulse times. ``trim``: every board's clock
     loop on (the registers' ``period`` set to the master's period in nominal board cycles, which
-    must be whole). Returns the :class:`TiledRun`."""
+    must be whole); ``store_words``: 64-bit words a transfer from each board's store stand-in.
+    Returns the :class:`TiledRun`."""
     boards = len(images)
     assert len(oscillators) == boards
     sync_fs = master_period_cycles * MASTER_PERIOD_FS
@@ -358,8 +359,9 @@ def run_tiled(dmd, params, images, *, oscillators, master=Oscillator(), frames, 
     plusargs, trace_files, pulse_files = [], [], []
     for i, image in enumerate(images):
         names = board_plusargs(i)
-        c = contents(dmd, [(0, depth)], {0: image})
-        for table, words, bits in (("planes", c.planes, 64), ("occupancy_map", c.occupancy, 8 * dmd.blocks),
+        c = contents(dmd, [(0, depth)], {0: image}, store_words)
+        for table, words, bits in (("planes", c.planes, 64 * store_words),
+                                   ("occupancy_map", c.occupancy, 8 * dmd.blocks),
                                    ("offered", c.offered, OfferedFrame.as_shape().size)):
             path = directory / f"board{i}_{table}.hex"
             write_hex(path, words, bits)
@@ -381,9 +383,10 @@ def run_tiled(dmd, params, images, *, oscillators, master=Oscillator(), frames, 
           "max_ps": round((max_sim_s or (frames + 20) * period_ps * 2e-12) * 1e12),
           "status": [(n, f.offset, f.width) for n, f in data.Layout.cast(Status)],
           "loops": [(n, f.offset, f.width) for n, f in data.Layout.cast(LoopState)]}
-    cocotb_run.run(TiledRig(dmd, boards, beats=p.beats), toplevel=TOPLEVEL, module="sim.tb.tiled_rig",
-                   key=f"{slug(dmd.name)}-{boards}-{p.beats}", params=tb, extra_sources=SOURCES,
-                   plusargs=plusargs, run_dir=directory / "run", build_args=VERILATOR_TIMING)
+    key = f"{slug(dmd.name)}-{boards}-{p.beats}-{store_words}"
+    cocotb_run.run(TiledRig(dmd, boards, beats=p.beats, store_words=store_words), toplevel=TOPLEVEL,
+                   module="sim.tb.tiled_rig", key=key, params=tb, extra_sources=SOURCES, plusargs=plusargs,
+                   run_dir=directory / "run", build_args=VERILATOR_TIMING)
     result = json.loads(report.read_text())
     syncs = _read_times(sync_file)[0]
     return TiledRun(syncs=syncs, pulses=[_read_times(f) for f in pulse_files], status=result["status"],

@@ -18,6 +18,8 @@ PERIOD_NS = 10
 #: The time base when the pulse is seen, after the falling edge that sampled it: the
 #: synchroniser's two stages.
 SEEN_AFTER = 2
+#: Cycles the loop's steps take after a pulse, at most (the terms doubled up to 15 times).
+SETTLE = 30
 
 
 def _arrivals(rng, period):
@@ -48,14 +50,14 @@ def test_clock_trim_follows_its_model():
         for step, late in [(50, False), *_arrivals(rng, period)]:
             if step is None:        # to the other side of the expected cycle
                 step = period - 1 if model.phase == 0 else period + 1
-            await ctx.tick().repeat(step - 12)
+            await ctx.tick().repeat(step - SETTLE - 4)
             # mid-cycle: before the falling edge, or after it (then the next one samples it)
             await ctx.delay(PERIOD_NS * (0.75 if late else 0.25) * 1e-9)
             sampled = (ctx.get(now) + late) & 0xFFFF
             ctx.set(dut.sync_in, 1)
             await ctx.tick().repeat(4)
             ctx.set(dut.sync_in, 0)
-            await ctx.tick().repeat(8)
+            await ctx.tick().repeat(SETTLE)
             model.pulse((sampled + SEEN_AFTER) & 0xFFFF)
             got = {name: ctx.get(getattr(dut, name)) for name in ("phase", "trim", "locked", "pulses", "slips")}
             want = {"phase": model.phase, "trim": model.trim, "locked": int(model.locked), "pulses": model.pulses,

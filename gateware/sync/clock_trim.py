@@ -22,10 +22,12 @@ that samples it, so that every board takes the pulse on the same edge of its own
 * A pulse more than ``CAPTURE`` cycles from where it was expected (a pulse missed, the master
   restarted) is a slip: counted, and the next pulse sets the expected times again.
 
-Everything after the detector is a few registered stages a pulse, no chain over 16 bits.
+Everything after the detector is registered steps after each pulse (pulses come thousands of
+cycles apart): the terms are doubled a step a cycle, and the gains' search takes a bit of the
+period a cycle, so that no path is deeper than a few LUTs or has a chain over 16 bits.
 """
 
-from amaranth import Cat, ClockDomain, ClockSignal, Const, Module, ResetSignal, Signal, signed
+from amaranth import Cat, ClockDomain, ClockSignal, Const, Module, Mux, ResetSignal, Signal, signed
 from amaranth.lib import wiring
 from amaranth.lib.cdc import FFSynchronizer
 from amaranth.lib.wiring import In, Out
@@ -47,33 +49,6 @@ def gains(period):
     """``(kp, ki)``: the loop's shifts for a period of ``period`` cycles."""
     kp = min(max(23 - period.bit_length(), 0), 15)
     return kp, max(kp - 4, 0)
-
-
-def _saturated_shift(m, value, shift, name):
-    """``value << shift`` (``shift`` 0..15) clamped to a signed :data:`_TERM`-bit value,
-    registered."""
-    out = Signal(signed(_TERM), name=name)
-    width = len(value)
-    top, bottom = (1 << (_TERM - 1)) - 1, -(1 << (_TERM - 1))
-    with m.Switch(shift):
-        for s in range(16):
-            with m.Case(s):
-                # fits when every bit from the result's sign position up equals the sign
-                if _TERM - 1 - s >= width:
-                    fits = Const(1)
-                elif s >= _TERM - 1:
-                    fits = value == 0
-                else:
-                    kept = value[_TERM - 1 - s:]
-                    fits = (kept == 0) | (kept == (1 << len(kept)) - 1)
-                shifted = Cat(Const(0, s), value)[:_TERM]
-                with m.If(fits):
-                    m.d.sync += out.eq(shifted)
-                with m.Elif(value[-1]):
-                    m.d.sync += out.eq(bottom)
-                with m.Else():
-                    m.d.sync += out.eq(top)
-    return out
 
 
 class ClockTrim(wiring.Component):
@@ -118,35 +93,42 @@ class ClockTrim(wiring.Component):
         m.d.sync += last.eq(synced)
         edge = synced & ~last
 
-        # the gains, from the period (registered: it holds still while the loop runs)
-        on, kp, ki = Signal(), Signal(4), Signal(4)
-        length = Signal(range(DURATION_BITS + 1))
-        for bit in range(DURATION_BITS):           # the highest set bit wins
-            with m.If(self.period[bit]):
-                m.d.comb += length.eq(bit + 1)
-        m.d.sync += [on.eq(self.period != 0), kp.eq(_clamp(m, 23 - length, "kp")), ki.eq(_clamp(m, kp - 4, "ki"))]
+        # the gains, from the period: it holds still while the loop runs, so its length (its
+        # highest set bit) is found a bit a cycle, over and over, and the gains registered
+        period, on = Signal(DURATION_BITS), Signal()
+        scan, count, length = Signal(DURATION_BITS), Signal(range(DURATION_BITS + 1)), Signal(range(DURATION_BITS + 1))
+        kp, ki = Signal(4), Signal(4)
+        m.d.sync += [period.eq(self.period), on.eq(period != 0)]
+        with m.If(scan != 0):
+            m.d.sync += [scan.eq(scan >> 1), count.eq(count + 1)]
+        with m.Else():
+            m.d.sync += [length.eq(count), scan.eq(period), count.eq(0)]
+        m.d.sync += [kp.eq(_clamp(m, 23 - length, "kp")), ki.eq(_clamp(m, kp - 4, "ki"))]
 
-        expected, anchored = Signal(16), Signal()
-        stage = Signal(4)               # one-hot: the registered steps after a pulse
-        error = Signal(signed(12))      # -(2 * phase + 1), within the capture range
+        expected, anchored, anchoring = Signal(16), Signal(), Signal()
+        stage = Signal(3)               # one-hot: the registered steps after a pulse
+        error = Signal(signed(_TERM))   # -(2 * phase + 1), within the capture range
         integral = Signal(signed(_TERM))
         good = Signal(range(LOCK_PULSES + 1))
         crossings, side = Signal(2), Signal()       # the edge crossed the falling edge (saturates at 2)
         m.d.comb += self.locked.eq((good == LOCK_PULSES) & (crossings == 2))
 
-        m.d.sync += stage.eq(stage << 1)
+        m.d.sync += [stage.eq(stage << 1), anchoring.eq(0)]
         with m.If(edge & on):
             m.d.sync += self.pulses.eq(self.pulses + 1)
             with m.If(~anchored):
-                # the first pulse: expected times on even cycles, a period apart
-                m.d.sync += [expected.eq(self.now + self.period[:16] + self.now[0]), anchored.eq(1)]
+                # the first pulse: expected times on even cycles (rounded up, then a period on)
+                m.d.sync += [expected.eq(self.now + self.now[0]), anchored.eq(1), anchoring.eq(1)]
             with m.Else():
-                m.d.sync += [self.phase.eq(self.now - expected), expected.eq(expected + self.period[:16]),
+                m.d.sync += [self.phase.eq(self.now - expected), expected.eq(expected + period[:16]),
                              stage.eq(1)]
+        with m.If(anchoring):
+            m.d.sync += expected.eq(expected + period[:16])
         # 1: within the capture range? -(2 * phase + 1) is the bits of 2 * phase inverted
         with m.If(stage[0]):
-            with m.If((self.phase >= -CAPTURE) & (self.phase < CAPTURE)):
-                m.d.sync += error.eq(~Cat(Const(0, 1), self.phase[:11]))
+            top_bits = self.phase[10:]
+            with m.If((top_bits == 0) | (top_bits == (1 << len(top_bits)) - 1)):
+                m.d.sync += error.eq(~Cat(Const(0, 1), self.phase[:11], self.phase[15].replicate(_TERM - 12)))
                 with m.If((self.phase == 0) | (self.phase == -1)):
                     m.d.sync += side.eq(self.phase[0])
                     with m.If(good != LOCK_PULSES):
@@ -161,23 +143,35 @@ class ClockTrim(wiring.Component):
         # 2: the integral, saturated
         total = Signal(signed(_TERM + 1))
         m.d.comb += total.eq(integral + error)
-        top, bottom = (1 << (_TERM - 1)) - 1, -(1 << (_TERM - 1))
         with m.If(stage[1]):
-            with m.If(total > top):
-                m.d.sync += integral.eq(top)
-            with m.Elif(total < bottom):
-                m.d.sync += integral.eq(bottom)
+            with m.If(total[-1] != total[-2]):          # beyond 15 bits: the sign says which way
+                m.d.sync += integral.eq(Mux(total[-1], _BOTTOM, _TOP))
             with m.Else():
                 m.d.sync += integral.eq(total)
-        # 3: each term scaled by its gain and saturated (both settle here, read in 4)
-        proportional = _saturated_shift(m, error, kp, "proportional")
-        integrated = _saturated_shift(m, integral, ki, "integrated")
-        # 4: the control word
-        with m.If(stage[3]):
-            m.d.sync += self.trim.eq(proportional + integrated)
+        # 3..: each term doubled, saturated, a step a cycle until scaled by its gain; then summed
+        proportional, integrated = Signal(signed(_TERM)), Signal(signed(_TERM))
+        steps_p, steps_i, shifting = Signal(4), Signal(4), Signal()
+        with m.If(stage[2]):
+            m.d.sync += [proportional.eq(error), integrated.eq(integral), steps_p.eq(kp), steps_i.eq(ki),
+                         shifting.eq(1)]
+        with m.Elif(shifting):
+            for term, steps in ((proportional, steps_p), (integrated, steps_i)):
+                with m.If(steps != 0):
+                    m.d.sync += [term.eq(_doubled(term)), steps.eq(steps - 1)]
+            with m.If((steps_p == 0) & (steps_i == 0)):
+                m.d.sync += [self.trim.eq(proportional + integrated), shifting.eq(0)]
         with m.If(~on):
-            m.d.sync += [anchored.eq(0), integral.eq(0), self.trim.eq(0), good.eq(0), crossings.eq(0), stage.eq(0)]
+            m.d.sync += [anchored.eq(0), integral.eq(0), self.trim.eq(0), good.eq(0), crossings.eq(0), stage.eq(0),
+                         shifting.eq(0)]
         return m
+
+
+_TOP, _BOTTOM = (1 << (_TERM - 1)) - 1, -(1 << (_TERM - 1))
+
+
+def _doubled(value):
+    """``2 * value`` clamped to the term's range: it overflows when its top two bits differ."""
+    return Mux(value[-1] != value[-2], Mux(value[-1], _BOTTOM, _TOP), value << 1)
 
 
 def _clamp(m, value, name):
