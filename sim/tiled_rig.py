@@ -127,8 +127,8 @@ class Board(wiring.Component):
             "timing": In(Timing),
             "flush": In(1),
             **members(self._trim, ("trim", "locked")),
-            "trim_pulses": Out(16),
-            "slips": Out(16),
+            "trim_pulses": Out(32),
+            "slips": Out(32),
         })
 
     def elaborate(self, platform):
@@ -169,8 +169,8 @@ class LoopState(data.Struct):
     """A board's clock loop, as the rig reports it."""
     trim: signed(16)
     locked: 1
-    pulses: 16
-    slips: 16
+    pulses: 32
+    slips: 32
 
 
 class TiledRig(wiring.Component):

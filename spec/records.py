@@ -36,7 +36,7 @@ from .wire import size
 MAGIC = 0x444D
 #: Protocol version this tree speaks; records with any other version are dropped and counted.
 #: ``magic`` and ``version`` keep their places in every version, so that a projector can tell.
-VERSION = 7
+VERSION = 8
 #: IPv4 and UDP headers around a record: a record fills an MTU less these.
 UDP_IP_OVERHEAD = 28
 #: Largest record: a UDP payload inside a 9000-byte IP MTU (9000 - 20 IPv4 - 8 UDP).
@@ -227,6 +227,8 @@ SYSTEM_STATUS = [
     ("triggers_after_end", 32),        # triggers ignored: a sequence played once had ended
     ("sequence_entries_skipped", 32),  # sequence entries skipped: their slot is outside the sequence,
                                        # or their planes outside their frame
+    ("clock_loop_slips", 32),          # sync pulses far from where the board's clock loop expected them
+    ("clock_loop_locked", 8),          # 1 while the clock loop holds the board's clock to the sync master's
 ]
 
 #: Status reply body (after :data:`HEADER`).

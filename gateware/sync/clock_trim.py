@@ -32,6 +32,8 @@ from amaranth.lib import wiring
 from amaranth.lib.cdc import FFSynchronizer
 from amaranth.lib.wiring import In, Out
 
+from ..counter import Counter
+from ..dlpc410.layouts import COUNTER_BITS
 from ..registers import DURATION_BITS
 
 __all__ = ["ClockTrim", "CAPTURE", "TRIM_BITS", "gains"]
@@ -70,7 +72,7 @@ class ClockTrim(wiring.Component):
         The last :data:`LOCK_PULSES` pulses each came within a cycle of the falling edge, and
         meanwhile the edge crossed it twice: it dithers across it, no longer sweeping through
         the cycle as the frequency settles.
-    pulses, slips : Out(16)
+    pulses, slips : Out(COUNTER_BITS)
         Pulses seen; pulses beyond :data:`CAPTURE` cycles of their expected time.
     """
     sync_in: In(1)
@@ -79,8 +81,8 @@ class ClockTrim(wiring.Component):
     trim: Out(signed(TRIM_BITS))
     phase: Out(signed(16))
     locked: Out(1)
-    pulses: Out(16)
-    slips: Out(16)
+    pulses: Out(COUNTER_BITS)
+    slips: Out(COUNTER_BITS)
 
     def elaborate(self, platform):
         m = Module()
@@ -114,8 +116,11 @@ class ClockTrim(wiring.Component):
         m.d.comb += self.locked.eq((good == LOCK_PULSES) & (crossings == 2))
 
         m.d.sync += [stage.eq(stage << 1), anchoring.eq(0)]
+        m.submodules.pulse_count = pulse_count = Counter(COUNTER_BITS)
+        m.submodules.slip_count = slip_count = Counter(COUNTER_BITS)
+        m.d.comb += [self.pulses.eq(pulse_count.count), self.slips.eq(slip_count.count),
+                     pulse_count.inc.eq(edge & on)]
         with m.If(edge & on):
-            m.d.sync += self.pulses.eq(self.pulses + 1)
             with m.If(~anchored):
                 # the first pulse: expected times on even cycles (rounded up, then a period on)
                 m.d.sync += [expected.eq(self.now + self.now[0]), anchored.eq(1), anchoring.eq(1)]
@@ -138,8 +143,8 @@ class ClockTrim(wiring.Component):
                 with m.Else():
                     m.d.sync += [good.eq(0), crossings.eq(0)]
             with m.Else():
-                m.d.sync += [self.slips.eq(self.slips + 1), anchored.eq(0), stage.eq(0), good.eq(0),
-                             crossings.eq(0)]
+                m.d.comb += slip_count.inc.eq(1)
+                m.d.sync += [anchored.eq(0), stage.eq(0), good.eq(0), crossings.eq(0)]
         # 2: the integral, saturated
         total = Signal(signed(_TERM + 1))
         m.d.comb += total.eq(integral + error)

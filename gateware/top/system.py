@@ -255,6 +255,10 @@ class Projector(wiring.Component):
             sync = m.submodules[f"{name}_cdc"] = CountSynchronizer(len(source), i_domain="dmd", o_domain="sync")
             m.d.comb += [sync.i.eq(source), status[name].eq(sync.o)]
         m.d.comb += status.registers_superseded.eq(registers.superseded)
+        m.submodules.clock_loop_slips_cdc = slips = CountSynchronizer(len(trim.slips), i_domain="dmd",
+                                                                      o_domain="sync")
+        m.submodules.clock_loop_locked_cdc = FFSynchronizer(trim.locked, status.clock_loop_locked[0])
+        m.d.comb += [slips.i.eq(trim.slips), status.clock_loop_slips.eq(slips.o)]
         for verdict, _ in ethernet.mac_counters.shape():
             m.d.comb += status[f"mac_{verdict}"].eq(ethernet.mac_counters[verdict])
         store_counts = store.counters
