@@ -9,6 +9,7 @@ from gateware.dlpc410.layouts import Status
 from gateware.dlpc410.register_crossing import RegisterCrossing
 from gateware.registers import Registers
 from gateware.store.slots import SlotCounters
+from gateware.sync.clock_trim import ClockTrim
 from spec import records
 
 WIDTHS = dict(records.SYSTEM_STATUS)
@@ -49,3 +50,8 @@ def test_register_sets_counted_in_full():
     members = crossing.signature.members
     for name in ("applied", "superseded"):
         assert members[name].shape == WIDTHS[f"registers_{name}"], name
+
+
+def test_clock_loop_slips_counted_in_full():
+    members = ClockTrim().signature.members
+    assert Shape.cast(members["slips"].shape).width == WIDTHS["clock_loop_slips"]
