@@ -11,7 +11,9 @@ oscillator; a sync master pulses every board once a frame. This rig is that syst
   (:class:`sim.tb.plane_source.SourcedSequencer`, its generated Verilog) in SYNC mode, on an
   oscillator (``board_clock.v``) with its own frequency error, drift ramp and jitter; each with
   its own DLPC410 responder, pin recorder and a recorder of its clocking pulses' times
-  (``trace_recorder.v`` with time stamps); its ready line goes back to the master.
+  (``trace_recorder.v`` with time stamps); its ready line goes back to the master; its clock
+  loop (:class:`gateware.sync.clock_trim.ClockTrim`, generated Verilog) pulls its oscillator
+  when the registers' ``period`` is set (:func:`run_tiled` ``trim``).
 
 Every clock is a Verilog oscillator (Verilator's ``--timing``): the testbench
 (:mod:`sim.tb.tiled_rig`) only sets the registers, arms the master and waits for the pulses.

@@ -26,6 +26,8 @@ locked: the boards keep the master's rate and take each pulse on the same edge.
   .clock_trim.lock`, checked against the gateware at the small DMD's periods).
 """
 
+from dataclasses import replace
+
 import numpy as np
 
 from sim.bench.tables import label, pyplot, save_figure, write_table
@@ -200,13 +202,19 @@ def _plot(rows):
 
 #: Frames of the DLP9500 run: its loops lock in about 160 pulses at its period (the model's).
 DLP9500_FRAMES = 220
+#: The steepest drift of the DLP9500 run's crystals (ppm/s).
+DLP9500_RAMP = 10
 
 
 def dlp9500():
     """Four boards of full DLP9500 geometry (four buses, DCLK 400 MHz, the store stand-in four
     words a cycle), 8-bit frames at the short settle timing of the small DMD's runs (a frame of
     150,000 cycles: TI's timing would make it five times longer), loops on: the spread once
-    locked. About 15 minutes; not part of :func:`run`."""
+    locked. The crystals are the small runs' but the drifting one ramps at 10 ppm/s (a
+    temperature change of about a degree a second): at 1,000 ppm/s, 0.75 ppm a frame of this
+    length, its loop keeps the master's rate but the integral term lags the ramp by more than
+    the lock window, so the board takes the pulse a cycle late (a run of this bench showed it).
+    About 15 minutes; not part of :func:`run`."""
     dmd = DMDS["dlp9500"]
     plan = schedule.plan(dmd, 400e6, depth=8, t_rst_s=20 / 200e6, t_settle_s=30 / 200e6, words_per_cycle=4)
     period = int(plan.frame_cycles * BOARD_PERIOD_FS / MASTER_PERIOD_FS * 1.001) + 64
@@ -215,7 +223,9 @@ def dlp9500():
     r, c = np.indices((dmd.rows, dmd.columns * boards))
     scene = ((c * 255) // (dmd.columns * boards - 1) + r) & 255
     images = [scene[:, i * dmd.columns:(i + 1) * dmd.columns].astype(np.uint8) for i in range(boards)]
-    run = run_tiled(dmd, plan.params, images, oscillators=OSCILLATORS, master=MASTER, frames=DLP9500_FRAMES,
+    oscillators = [replace(o, ramp_ppm_per_s=max(-DLP9500_RAMP, min(o.ramp_ppm_per_s, DLP9500_RAMP)))
+                   for o in OSCILLATORS]
+    run = run_tiled(dmd, plan.params, images, oscillators=oscillators, master=MASTER, frames=DLP9500_FRAMES,
                     master_period_cycles=period, name="sync_spread_dlp9500", traces=False, trim=True, store_words=4)
     locked = run.locked_from()
     spreads = run.spreads()
