@@ -10,7 +10,10 @@ def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m flow", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("verilog", help="write the Spartan-6 ISE tree and every block's Verilog to build/spartan6")
-    sub.add_parser("resources", help="Yosys synth_xilinx -family xc6s: LUT/FF/BRAM/DSP per block and in total")
+    resources = sub.add_parser("resources", help="Yosys synth_xilinx -family xc6s: LUT/FF/BRAM/DSP per block and "
+                                                 "in total")
+    resources.add_argument("--block", action="append", default=None,
+                           help="only this block of flow.blocks, no total (repeatable)")
     timing = sub.add_parser("timing", help="logic depth between flip-flops per clock domain (Yosys, xc6s)")
     timing.add_argument("--block", default=None, help="one block of flow.blocks instead of the core")
     timing.add_argument("--over", action="append", default=[], metavar="DOMAIN",
@@ -43,7 +46,7 @@ def main(argv=None):
         return run()
     if args.command == "resources":
         from flow.resources import main as run
-        return run()
+        return run(blocks=args.block)
     if args.command == "timing":
         from flow.timing import main as run
         return run(block=args.block, over=args.over)
