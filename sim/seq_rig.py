@@ -45,7 +45,7 @@ from spec.registers import TIME_BITS
 from spec.schedule import DECISION_TO_PINS
 
 __all__ = ["SequencerRig", "EventPlayer", "run_rig", "run_script", "rig_verilog", "analyse", "event_table",
-           "rig_layout", "event_layout", "Timing", "file_table", "write_hex", "responder_timing", "SOURCES",
+           "rig_layout", "event_layout", "Timing", "file_table", "write_tables", "responder_timing", "SOURCES",
            "PLUSARGS", "INPUTS", "MAX_EVENTS", "TOPLEVEL"]
 
 TOPLEVEL = "sequencer_rig"
@@ -264,14 +264,22 @@ def event_table(pins=(), sync_pins=(), soft=(), early_pins=()):
             for (by_now, at), entry in sorted(holds.items())]
 
 
+def write_tables(directory, dmd, frames, images, store_words=1, prefix=""):
+    """Write the store stand-in's tables (:func:`sim.tb.plane_source.contents`) to
+    ``<directory>/<prefix><table>.hex``; returns ``{table: path}``."""
+    c = contents(dmd, frames, images, store_words)
+    files = {name: directory / f"{prefix}{name}.hex" for name in TABLES}
+    for name, words, width in (("planes", c.planes, 64 * store_words), ("occupancy_map", c.occupancy, 8 * dmd.blocks),
+                               ("offered", c.offered, OfferedFrame.as_shape().size)):
+        write_hex(files[name], words, width)
+    return files
+
+
 def _stimulus(directory, dmd, frames, images, events, store_words=1):
     """Write the tables and the events; the plusargs naming them and the trace."""
-    c = contents(dmd, frames, images, store_words)
-    files = {name: directory / f"{name}.hex" for name in (*TABLES, "events")}
-    for name, words, width in (("planes", c.planes, 64 * store_words), ("occupancy_map", c.occupancy, 8 * dmd.blocks),
-                               ("offered", c.offered, OfferedFrame.as_shape().size),
-                               ("events", events, event_layout().size)):
-        write_hex(files[name], words, width)
+    files = write_tables(directory, dmd, frames, images, store_words)
+    files["events"] = directory / "events.hex"
+    write_hex(files["events"], events, event_layout().size)
     files["pins"] = directory / "pins.txt"
     return files, [f"+{PLUSARGS[name]}={path}" for name, path in files.items()]
 

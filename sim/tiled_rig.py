@@ -23,6 +23,7 @@ Every clock is a Verilog oscillator (Verilator's ``--timing``): the testbench
 """
 
 import json
+import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -43,12 +44,12 @@ from sim.harness.paths import ROOT, build_dir, slug
 from sim.models import trace
 from sim.models.camera import Camera, to_lsb
 from sim.seq_rig import SOURCES as RIG_SOURCES
-from sim.seq_rig import Timing, analyse, file_table, responder_timing, rig_layout, write_hex
-from sim.tb.plane_source import TABLES, OfferedFrame, SourcedSequencer, contents, table_depths
+from sim.seq_rig import Timing, analyse, file_table, responder_timing, rig_layout, write_tables
+from sim.tb.plane_source import TABLES, SourcedSequencer, table_depths
 from sim.tb.seq_sim import CAMERA_DELAY, CAMERA_RAMP, dlpc410_for
 
 __all__ = ["TiledRig", "Board", "Oscillator", "TiledRun", "run_tiled", "board_plusargs", "TOPLEVEL", "SOURCES",
-           "MASTER_PERIOD_FS", "BOARD_PERIOD_FS", "VERILATOR_TIMING", "TRIM_PPB", "LoopState"]
+           "MASTER_PERIOD_FS", "BOARD_PERIOD_FS", "VERILATOR_TIMING", "TRIM_PPB", "LoopState", "tiles", "master_period"]
 
 TOPLEVEL = "tiled_rig"
 SOURCES = [*RIG_SOURCES, ROOT / "sim" / "hdl" / "board_clock.v"]
@@ -61,6 +62,21 @@ BOARD_PERIOD_FS = 5_000_000
 #: The pull of one step of a board's trim word (its VCXO and DAC), in ppb: +-131 ppm with a
 #: term of the loop's 15 bits.
 TRIM_PPB = 8
+
+
+def tiles(dmd, boards, row_step=1):
+    """One scene across ``boards`` DMDs side by side, split in their tiles: a ramp holding every
+    grey level across the whole width, shifted by ``row_step`` levels a row."""
+    rows, columns = np.indices((dmd.rows, dmd.columns * boards))
+    scene = ((columns * 255) // (dmd.columns * boards - 1) + row_step * rows) & 255
+    return [scene[:, i * dmd.columns:(i + 1) * dmd.columns].astype(np.uint8) for i in range(boards)]
+
+
+def master_period(frame_cycles):
+    """The master's period (its cycles) for frames of ``frame_cycles`` board cycles: the slowest
+    board's frame and a margin to load the next, whole board cycles (for the clock loops)."""
+    period = int(frame_cycles * BOARD_PERIOD_FS / MASTER_PERIOD_FS * 1.001) + 64
+    return period + -period % (BOARD_PERIOD_FS // math.gcd(BOARD_PERIOD_FS, MASTER_PERIOD_FS))
 
 
 def board_plusargs(index):
@@ -114,7 +130,7 @@ class Board(wiring.Component):
         Writes the recorders' buffered lines to their files.
     status : Out(Status)
         The sequencer's counters.
-    trim, locked, trim_pulses, slips : Out
+    trim, locked, pulses, slips : Out
         The clock's loop (:class:`~gateware.sync.clock_trim.ClockTrim`: on while the registers'
         ``period``, the sync period in nominal cycles, is not 0): its control word, lock, the
         pulses it saw and its slips.
@@ -128,9 +144,7 @@ class Board(wiring.Component):
             **members(self._core, ("regs", "sync_in", "ready", "status")),
             "timing": In(Timing),
             "flush": In(1),
-            **members(self._trim, ("trim", "locked")),
-            "trim_pulses": Out(32),
-            "slips": Out(32),
+            **members(self._trim, ("trim", "locked", "pulses", "slips")),
         })
 
     def elaborate(self, platform):
@@ -144,7 +158,7 @@ class Board(wiring.Component):
             core.regs.eq(self.regs), core.sync_in.eq(self.sync_in), self.ready.eq(core.ready),
             self.status.eq(core.status), core.release.ready.eq(1),
             trim.sync_in.eq(self.sync_in), trim.now.eq(core.status.now[:16]), trim.period.eq(self.regs.period),
-            self.trim.eq(trim.trim), self.locked.eq(trim.locked), self.trim_pulses.eq(trim.pulses),
+            self.trim.eq(trim.trim), self.locked.eq(trim.locked), self.pulses.eq(trim.pulses),
             self.slips.eq(trim.slips),
         ]
         depths = table_depths(dmd, self._store_words)
@@ -229,7 +243,7 @@ class TiledRig(wiring.Component):
                 board.regs.eq(self.regs), board.timing.eq(self.timing), board.flush.eq(self.flush),
                 board.sync_in.eq(master.sync_out[i]), self.ready[i].eq(board.ready),
                 self.status[i].eq(board.status), self.loops[i].trim.eq(board.trim),
-                self.loops[i].locked.eq(board.locked), self.loops[i].pulses.eq(board.trim_pulses),
+                self.loops[i].locked.eq(board.locked), self.loops[i].pulses.eq(board.pulses),
                 self.loops[i].slips.eq(board.slips),
             ]
         return m
@@ -314,6 +328,19 @@ class TiledRun:
         assert self.traces, "run without pin traces"
         return analyse(self.models[index], trace.read(self.traces[index]), dmd)
 
+    def rate_ppm(self, index, t0_ps=0, t1_ps=None):
+        """Board ``index``'s frequency error (ppm) measured from its pulses between ``t0_ps`` and
+        ``t1_ps`` (default: all of them)."""
+        times, cycles, _ = self.pulses[index]
+        inside = (times >= t0_ps) & (times < (np.inf if t1_ps is None else t1_ps))
+        t, c = times[inside], cycles[inside]
+        return (BOARD_PERIOD_FS * (c[-1] - c[0]) / (1000 * (t[-1] - t[0])) - 1) * 1e6
+
+    def rates_ppm(self, first, last):
+        """Every board's :meth:`rate_ppm` over frames ``first..last - 1``."""
+        end = self.syncs[last] if last < len(self.syncs) else None
+        return [self.rate_ppm(i, self.syncs[first], end) for i in range(len(self.pulses))]
+
     def cycle_at(self, index, t_ps):
         """Board ``index``'s cycle (a fraction) at time ``t_ps``: between its pulses by their
         times and cycles (its clock's rate is constant to well under a ppm over a frame)."""
@@ -361,13 +388,8 @@ def run_tiled(dmd, params, images, *, oscillators, master=Oscillator(), frames, 
     plusargs, trace_files, pulse_files = [], [], []
     for i, image in enumerate(images):
         names = board_plusargs(i)
-        c = contents(dmd, [(0, depth)], {0: image}, store_words)
-        for table, words, bits in (("planes", c.planes, 64 * store_words),
-                                   ("occupancy_map", c.occupancy, 8 * dmd.blocks),
-                                   ("offered", c.offered, OfferedFrame.as_shape().size)):
-            path = directory / f"board{i}_{table}.hex"
-            write_hex(path, words, bits)
-            plusargs.append(f"+{names[table]}={path}")
+        tables = write_tables(directory, dmd, [(0, depth)], {0: image}, store_words, prefix=f"board{i}_")
+        plusargs += [f"+{names[table]}={path}" for table, path in tables.items()]
         trace_files.append(directory / f"board{i}_pins.txt")
         pulse_files.append(directory / f"board{i}_pulses.txt")
         plusargs += [f"+{names['pins']}={trace_files[-1] if traces else '-'}",

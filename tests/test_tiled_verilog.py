@@ -14,7 +14,7 @@ import pytest
 
 from sim.models.camera import to_lsb
 from sim.tb.seq_sim import frame_lights
-from sim.tiled_rig import BOARD_PERIOD_FS, MASTER_PERIOD_FS, Oscillator, run_tiled
+from sim.tiled_rig import BOARD_PERIOD_FS, Oscillator, master_period, run_tiled, tiles
 from spec import schedule
 from spec.facts import TEST_DMD
 
@@ -24,23 +24,14 @@ OSCILLATORS = [Oscillator(100), Oscillator(-100, jitter_ps=20, seed=3), Oscillat
 MASTER = Oscillator(-20, seed=11)
 
 
-def _tiles(dmd, boards):
-    """One scene split in ``boards`` tiles side by side: a ramp across the whole width."""
-    rows, columns = np.indices((dmd.rows, dmd.columns * boards))
-    scene = ((columns * 255) // (dmd.columns * boards - 1) + rows) & 255
-    return [scene[:, i * dmd.columns:(i + 1) * dmd.columns].astype(np.uint8) for i in range(boards)]
-
-
 @pytest.mark.verilog
 def test_tiled_boards_follow_the_master():
     dmd = TEST_DMD
     plan = schedule.plan(dmd, 200e6, depth=8, t_rst_s=20 / 200e6, t_settle_s=30 / 200e6)
     p = plan.params
-    # the master's period: a frame at the slowest board's rate, and a margin to load the next
-    period = int(plan.frame_cycles * BOARD_PERIOD_FS / MASTER_PERIOD_FS * 1.001) + 64
-    images = _tiles(dmd, len(OSCILLATORS))
+    images = tiles(dmd, len(OSCILLATORS))
     run = run_tiled(dmd, p, images, oscillators=OSCILLATORS, master=MASTER, frames=FRAMES,
-                    master_period_cycles=period, name="tiled_boards_follow_the_master")
+                    master_period_cycles=master_period(plan.frame_cycles), name="tiled_boards_follow_the_master")
 
     assert run.counts == {"pulses": FRAMES, "not_ready": 0, "early": 0}
     assert len(run.syncs) == FRAMES
@@ -60,16 +51,15 @@ def test_tiled_boards_follow_the_master():
     # one camera over the whole scene, from one sync pulse to the next, in real time: each tile
     # is off by its clock's error only (a fast board's planes are short), seams included
     for k in range(1, FRAMES - 1):
-        tiles = [run.light(i, board, run.syncs[k], run.syncs[k + 1], p.lsb) for i, board in enumerate(boards)]
-        for i, (tile, image, osc) in enumerate(zip(tiles, images, OSCILLATORS, strict=True)):
+        seen = [run.light(i, board, run.syncs[k], run.syncs[k + 1], p.lsb) for i, board in enumerate(boards)]
+        for i, (tile, image, osc) in enumerate(zip(seen, images, OSCILLATORS, strict=True)):
             expect = image * (1 - osc.error(run.syncs[k] / 1e12))
             assert np.abs(tile - expect).max() < 2e-3, (k, i, np.abs(tile - expect).max())
 
     # the oscillators run at the rates asked: from the pulses' times and cycles
-    for i, (osc, (times, cycles, _values)) in enumerate(zip(OSCILLATORS, run.pulses, strict=True)):
-        period_fs = 1000 * (times[-1] - times[0]) / (cycles[-1] - cycles[0])
+    for i, (osc, (times, _cycles, _values)) in enumerate(zip(OSCILLATORS, run.pulses, strict=True)):
         middle_s = (times[0] + times[-1]) / 2e12
-        measured_ppm = (BOARD_PERIOD_FS / period_fs - 1) * 1e6
+        measured_ppm = run.rate_ppm(i)
         assert abs(measured_ppm - osc.error(middle_s) * 1e6) < 0.5, (i, measured_ppm)
 
     # the spread of every pulse of every frame, against what the clocks explain
@@ -94,20 +84,18 @@ def test_tiled_boards_lock_their_clocks_to_the_master():
     of a cycle, not the two cycles of sampling and the drift a frame as without."""
     dmd, frames = TEST_DMD, 150
     plan = schedule.plan(dmd, 200e6, depth=4, t_rst_s=20 / 200e6, t_settle_s=30 / 200e6)
-    period = int(plan.frame_cycles * BOARD_PERIOD_FS / MASTER_PERIOD_FS * 1.001) + 64
-    period += -period % 5                    # whole board cycles a period
-    images = _tiles(dmd, len(OSCILLATORS))
+    images = tiles(dmd, len(OSCILLATORS))
     run = run_tiled(dmd, plan.params, images, oscillators=OSCILLATORS, master=MASTER, frames=frames, depth=4,
-                    master_period_cycles=period, name="tiled_boards_lock_their_clocks", trim=True)
+                    master_period_cycles=master_period(plan.frame_cycles), name="tiled_boards_lock_their_clocks",
+                    trim=True)
     assert run.counts == {"pulses": frames, "not_ready": 0, "early": 0}
     for i, (status, loop) in enumerate(zip(run.status, run.loops, strict=True)):
         assert status["frames"] == frames and status["overruns"] == status["late"] == 0, (i, status)
         assert loop["locked"] and loop["slips"] == 0 and loop["pulses"] == frames, (i, loop)
     # every board now runs at the master's rate (its crystal -20 ppm): from the last 50 frames
-    for i, (times, cycles, _) in enumerate(run.pulses):
-        late = times >= run.syncs[-50]
-        period_fs = 1000 * (times[late][-1] - times[late][0]) / (cycles[late][-1] - cycles[late][0])
-        assert abs((BOARD_PERIOD_FS / period_fs - 1) * 1e6 - MASTER.ppm) < 5, (i, period_fs)
+    for i in range(len(run.pulses)):
+        measured_ppm = run.rate_ppm(i, run.syncs[-50])
+        assert abs(measured_ppm - MASTER.ppm) < 5, (i, measured_ppm)
     for i, image in enumerate(images):
         board = run.board_run(i, dmd)
         lights = frame_lights(board.model, board.frames())

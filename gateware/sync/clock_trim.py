@@ -45,12 +45,15 @@ CAPTURE = 1024
 #: Pulses in a row with the edge within a cycle of the falling edge before ``locked``.
 LOCK_PULSES = 15
 _TERM = 15          # bits of each term
+#: The gains' shifts: ``kp = KP_LENGTH - bit_length(period)``, ``ki = kp - KI_BELOW`` (each 0..15).
+KP_LENGTH, KI_BELOW = 23, 4
 
 
 def gains(period):
-    """``(kp, ki)``: the loop's shifts for a period of ``period`` cycles."""
-    kp = min(max(23 - period.bit_length(), 0), 15)
-    return kp, max(kp - 4, 0)
+    """``(kp, ki)``: the loop's shifts for a period of ``period`` cycles, as the gateware forms
+    them."""
+    kp = min(max(KP_LENGTH - period.bit_length(), 0), 15)
+    return kp, max(kp - KI_BELOW, 0)
 
 
 class ClockTrim(wiring.Component):
@@ -105,7 +108,7 @@ class ClockTrim(wiring.Component):
             m.d.sync += [scan.eq(scan >> 1), count.eq(count + 1)]
         with m.Else():
             m.d.sync += [length.eq(count), scan.eq(period), count.eq(0)]
-        m.d.sync += [kp.eq(_clamp(m, 23 - length, "kp")), ki.eq(_clamp(m, kp - 4, "ki"))]
+        m.d.sync += [kp.eq(_clamp(m, KP_LENGTH - length, "kp")), ki.eq(_clamp(m, kp - KI_BELOW, "ki"))]
 
         expected, anchored, anchoring = Signal(16), Signal(), Signal()
         stage = Signal(3)               # one-hot: the registered steps after a pulse

@@ -32,7 +32,7 @@ import numpy as np
 
 from sim.bench.tables import label, pyplot, save_figure, write_table
 from sim.models import clock_trim
-from sim.tiled_rig import BOARD_PERIOD_FS, MASTER_PERIOD_FS, Oscillator, run_tiled
+from sim.tiled_rig import BOARD_PERIOD_FS, Oscillator, master_period, run_tiled, tiles
 from spec import schedule
 from spec.facts import DMDS, TEST_DMD
 
@@ -57,20 +57,14 @@ def _plan(depth):
 
 
 def _tiles():
-    """One scene across the boards side by side (a ramp holding every grey level on every row),
-    split in tiles."""
-    boards, (rows, columns) = len(OSCILLATORS), (TEST_DMD.rows, TEST_DMD.columns)
-    r, c = np.indices((rows, columns * boards))
-    scene = ((c * 255) // (columns * boards - 1) + 37 * r) & 255
-    return [scene[:, i * columns:(i + 1) * columns].astype(np.uint8) for i in range(boards)]
+    return tiles(TEST_DMD, len(OSCILLATORS), row_step=37)
 
 
 def _run(depth, frames, name, *, trim, traces=False):
     plan = _plan(depth)
-    period = int(plan.frame_cycles * BOARD_PERIOD_FS / MASTER_PERIOD_FS * 1.001) + 64
-    period += -period % 5               # whole board cycles a period, for the loops
     return run_tiled(TEST_DMD, plan.params, _tiles(), oscillators=OSCILLATORS, master=MASTER, frames=frames,
-                     master_period_cycles=period, name=name, traces=traces, depth=depth, trim=trim)
+                     master_period_cycles=master_period(plan.frame_cycles), name=name, traces=traces, depth=depth,
+                     trim=trim)
 
 
 def _seam_errors(run, lsb, first):
@@ -88,16 +82,6 @@ def _seam_errors(run, lsb, first):
     return max(seams), max(anywhere)
 
 
-def _rates_ppm(run, first, last):
-    """Each board's frequency error (ppm) from its pulses in frames ``first..last - 1``."""
-    out = []
-    for times, cycles, _ in run.pulses:
-        inside = (times >= run.syncs[first]) & (times < (run.syncs[last] if last < len(run.syncs) else np.inf))
-        t, c = times[inside], cycles[inside]
-        out.append((BOARD_PERIOD_FS * (c[-1] - c[0]) / (1000 * (t[-1] - t[0])) - 1) * 1e6)
-    return out
-
-
 def _since_ns(run):
     """Per pulse of a frame, its mean time after the sync pulse (ns), over the run."""
     first = run.frame_pulses()[0]
@@ -105,14 +89,18 @@ def _since_ns(run):
     return np.mean([(f - s) / 1000 for f, s in zip(whole, run.syncs, strict=False)], axis=0)
 
 
-def _table(run, spreads):
+def _chunk_rates(run):
+    """Every board's rate (ppm) per :data:`CHUNK` frames: ``(chunks, boards)``."""
+    return np.array([run.rates_ppm(f, min(f + CHUNK, len(run.syncs))) for f in range(0, len(run.syncs), CHUNK)])
+
+
+def _table(run, spreads, rates):
     rows = []
-    for first in range(0, len(spreads), CHUNK):
-        last = min(first + CHUNK, len(run.syncs))
-        part = spreads[first:last]
+    for k, first in enumerate(range(0, len(spreads), CHUNK)):
+        part = spreads[first:first + CHUNK]
         rows.append([first, f"{(run.syncs[first] - run.syncs[0]) / 1e9:.3f}", f"{part.max():.3f}",
                      f"{part.mean():.3f}", f"{part[:, 0].max():.3f}", f"{part[:, -1].max():.3f}",
-                     *[f"{r:.3f}" for r in _rates_ppm(run, first, last)]])
+                     *[f"{r:.3f}" for r in rates[k]]])
     return rows
 
 
@@ -121,13 +109,12 @@ def run():
     locked = long.locked_from()
     assert locked is not None, "the clock loops never locked"
     spreads = long.spreads()
-    rows = _table(long, spreads)
+    rates = _chunk_rates(long)
+    rows = _table(long, spreads, rates)
     write_table("sync_spread", ["first_frame", "run_time_ms", "spread_ns_max", "spread_ns_mean",
                                 "first_pulse_spread_ns_max", "last_pulse_spread_ns_max",
                                 *[f"board{i}_ppm" for i in range(len(OSCILLATORS))]], rows)
     _plot(rows)
-    chunks = range(0, len(long.syncs), CHUNK)
-    rates = np.array([_rates_ppm(long, f, min(f + CHUNK, len(long.syncs))) for f in chunks])
     after = spreads[locked:]
     hours = len(after) // 2
     figures = {
@@ -147,8 +134,7 @@ def run():
 
     untrimmed = _run(4, UNTRIMMED_FRAMES, "sync_spread_4planes_untrimmed", trim=False)
     loose = untrimmed.spreads()
-    loose_rates = np.array([_rates_ppm(untrimmed, f, min(f + CHUNK, len(untrimmed.syncs)))
-                            for f in range(0, len(untrimmed.syncs), CHUNK)])
+    loose_rates = _chunk_rates(untrimmed)
     difference = float((loose_rates.max(axis=1) - loose_rates.min(axis=1)).max()) * 1e-6
     sampling_ns = float(loose[:, 0].max())
     figures.update({
@@ -217,16 +203,12 @@ def dlp9500():
     About 15 minutes; not part of :func:`run`."""
     dmd = DMDS["dlp9500"]
     plan = schedule.plan(dmd, 400e6, depth=8, t_rst_s=20 / 200e6, t_settle_s=30 / 200e6, words_per_cycle=4)
-    period = int(plan.frame_cycles * BOARD_PERIOD_FS / MASTER_PERIOD_FS * 1.001) + 64
-    period += -period % 5
-    boards = len(OSCILLATORS)
-    r, c = np.indices((dmd.rows, dmd.columns * boards))
-    scene = ((c * 255) // (dmd.columns * boards - 1) + r) & 255
-    images = [scene[:, i * dmd.columns:(i + 1) * dmd.columns].astype(np.uint8) for i in range(boards)]
+    images = tiles(dmd, len(OSCILLATORS))
     oscillators = [replace(o, ramp_ppm_per_s=max(-DLP9500_RAMP, min(o.ramp_ppm_per_s, DLP9500_RAMP)))
                    for o in OSCILLATORS]
     run = run_tiled(dmd, plan.params, images, oscillators=oscillators, master=MASTER, frames=DLP9500_FRAMES,
-                    master_period_cycles=period, name="sync_spread_dlp9500", traces=False, trim=True, store_words=4)
+                    master_period_cycles=master_period(plan.frame_cycles), name="sync_spread_dlp9500",
+                    traces=False, trim=True, store_words=4)
     locked = run.locked_from()
     spreads = run.spreads()
     return {

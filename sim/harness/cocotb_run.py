@@ -129,14 +129,15 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
     sources = [build / name for name in sorted(files, key=lambda n: not n.endswith(".vlt"))]
     # the runner takes the last source for the top's language: the control file goes first
     sources += [Path(p) for p in extra_sources if Path(p).suffix != ".cpp"]
-    cpp = [*build_args, *(str(p) for p in extra_sources if Path(p).suffix == ".cpp")]
+    # C++ sources go on Verilator's command line, beside the extra flags
+    extra_args = [*build_args, *(str(p) for p in extra_sources if Path(p).suffix == ".cpp")]
     stamp = _stamp(toplevel, files, extra_sources, waves or traced, top_signals_only, build_args)
 
     with _lock(build.parent / f"{build.name}.lock") as lock:
         if not _built(build, toplevel, stamp):
             lock.exclusive()
             if not _built(build, toplevel, stamp):
-                _build(build, toplevel, files, sources, waves or traced, top_signals_only, cpp)
+                _build(build, toplevel, files, sources, waves or traced, top_signals_only, extra_args)
                 (build / "stamp").write_text(stamp)
             lock.shared()
         directory = Path(run_dir) if run_dir is not None else \
@@ -176,7 +177,7 @@ def _built(build, toplevel, stamp):
     return (build / toplevel).exists() and stamp_file.exists() and stamp_file.read_text() == stamp
 
 
-def _build(build, toplevel, files, sources, waves, top_signals_only, cpp=()):
+def _build(build, toplevel, files, sources, waves, top_signals_only, extra_args=()):
     from cocotb_tools.runner import get_runner
 
     for name, text in files.items():
@@ -192,7 +193,7 @@ def _build(build, toplevel, files, sources, waves, top_signals_only, cpp=()):
             sources=sources,
             hdl_toplevel=toplevel,
             build_dir=build,
-            build_args=[*VERILATOR_ARGS, *cpp],
+            build_args=[*VERILATOR_ARGS, *extra_args],
             waves=waves,
             timescale=("1ns", "1ps"),
             log_file=build / "build.log",
