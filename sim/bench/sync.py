@@ -162,11 +162,11 @@ def run():
     residual = max(abs(e) for ppm in (PPM_TOLERANCE, -PPM_TOLERANCE)
                    for _, e in clock_trim.lock(dlp7000.frame_cycles, ppm, pulses=400)[200:]) * 1e-6
     figures.update({
-        "sync.spread_ns_max_last_hour_extrapolated": (float(after.max()) + 2 * residual * frame_ns,
-                                                      "ns, DLP7000 8-bit frame, loops on"),
-        "sync.spread_ns_max_last_hour_extrapolated_untrimmed": (2 * BOARD_PERIOD_FS / 1e6
-                                                                + 2 * PPM_TOLERANCE * 1e-6 * frame_ns,
-                                                                "ns, DLP7000 8-bit frame, loops off, +-100 ppm"),
+        "sync.spread_ns_max_last_hour_extrapolated_model": (
+            float(after.max()) + 2 * residual * frame_ns, "ns, DLP7000 8-bit frame, loops on"),
+        "sync.spread_ns_max_last_hour_extrapolated_untrimmed_model": (
+            2 * BOARD_PERIOD_FS / 1e6 + 2 * PPM_TOLERANCE * 1e-6 * frame_ns,
+            "ns, DLP7000 8-bit frame, loops off, +-100 ppm"),
         "sync.wall_s": (long.wall_s + untrimmed.wall_s + eight.wall_s + loose8.wall_s, "s of simulation"),
     })
     return figures
