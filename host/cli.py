@@ -60,7 +60,7 @@ def _t_rst(args):
 def _plan(args):
     dmd = DMDS[args.dmd]
     common = dict(depth=args.depth, exposure_s=args.exposure, words_per_cycle=args.read_rate,
-                  t_rst_cycles=_t_rst(args), reading=args.settle_reading)
+                  t_rst_cycles=_t_rst(args), reading=args.settle_reading, anchor=args.anchor)
     if args.best:
         found = plan_search.find(dmd, args.dclk, **common)
         print(f"plan finder: every reset mode, plane order and hide threshold under the {args.settle_reading} "
@@ -132,6 +132,9 @@ def main(argv=None):
                                 "plan (spec.plan_search; about two minutes on the DLP7000) instead of "
                                 "--reset-mode and --order")
     configure.add_argument("--order", default="MSB_FIRST", choices=["MSB_FIRST", "LSB_FIRST"])
+    configure.add_argument("--anchor", type=int, default=0, choices=range(8),
+                           help="the position in the plane order a frame starts at (modulo its depth), "
+                                "where the trigger or a tiled display's sync pulse lands (default 0)")
     configure.add_argument("--exposure", type=float, default=0.0,
                            help="least significant plane at least this long, seconds (0: shortest)")
     configure.add_argument("--trigger", default="external", choices=[m.name.lower() for m in TriggerMode],

@@ -115,6 +115,10 @@ FIELDS = [
     Field("trigger_hold", 1, doc="1: a trigger that comes while a frame plays or loads is held and "
                                  "obeyed on the first cycle every group is ready (one at a time; a "
                                  "second one meanwhile is an overrun); 0: it is an overrun"),
+    Field("anchor", 3, doc="the display position a frame starts at: its planes are shown in the "
+                           "plane order from position anchor (modulo the frame's depth), wrapping "
+                           "round to the order's first; the trigger (in SYNC, the sync pulse) "
+                           "lands on that plane. 0: the order as it is"),
 ]
 
 _BY_NAME = {f.name: f for f in FIELDS}

@@ -159,6 +159,7 @@ class Params:
     reset_mode: ResetMode = ResetMode.GLOBAL
     order: PlaneOrder = PlaneOrder.MSB_FIRST
     order_table: tuple = (7, 6, 5, 4, 3, 2, 1, 0)
+    anchor: int = 0
     chain: bool = False
     strict_rst: bool = True
     trigger: TriggerMode = TriggerMode.EXTERNAL
@@ -180,7 +181,7 @@ class Params:
         """The values of :class:`~gateware.registers.Registers`, as a dict."""
         regs = {k: getattr(self, k) for k in (
             "lsb", "t_rst", "t_settle", "hide", "dark_gap", "stagger", "period", "reload_lead",
-            "camera_offset", "camera_width")}
+            "camera_offset", "camera_width", "anchor")}
         regs.update(reset_mode=self.reset_mode, order=self.order, order_table=list(self.order_table),
                     chain=int(self.chain), strict_rst=int(self.strict_rst), trigger=self.trigger,
                     trigger_hold=int(self.trigger_hold),
@@ -236,15 +237,18 @@ class Result:
         return [c for c in self.commands if c[1] != "noop"]
 
 
-def exponents(order, table, depth):
-    """Weight exponents (0 = least significant) in display order for a frame of ``depth``."""
+def exponents(order, table, depth, anchor=0):
+    """Weight exponents (0 = least significant) in display order for a frame of ``depth``: the
+    order's, started at its position ``anchor`` (modulo ``depth``) and wrapped round."""
     if order == PlaneOrder.MSB_FIRST:
-        return list(range(depth - 1, -1, -1))
-    if order == PlaneOrder.LSB_FIRST:
-        return list(range(depth))
-    exps = [int(e) for e in table[:depth]]
-    assert sorted(exps) == list(range(depth)), "order table must be a permutation"
-    return exps
+        exps = list(range(depth - 1, -1, -1))
+    elif order == PlaneOrder.LSB_FIRST:
+        exps = list(range(depth))
+    else:
+        exps = [int(e) for e in table[:depth]]
+        assert sorted(exps) == list(range(depth)), "order table must be a permutation"
+    start = anchor % depth
+    return exps[start:] + exps[:start]
 
 
 def groups(dmd, mode):
@@ -352,7 +356,7 @@ class _Model:
     # -- the planner -------------------------------------------------------------------------
 
     def exps_of(self, fi):
-        return exponents(self.p.order, self.p.order_table, self.res.shown[fi].depth)
+        return exponents(self.p.order, self.p.order_table, self.res.shown[fi].depth, self.p.anchor)
 
     def enqueue(self, g, fi, j):
         """Queue the load of frame ``fi``'s display position ``j`` (None: clears) for group g."""
@@ -702,7 +706,7 @@ def _lattice_ok(M, s, G, sep):
 def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetMode.GLOBAL,
          exposure_s=0.0, strict_rst=True, chain=False, words_per_cycle=1.0, source=Source.STORE,
          t_rst_s=None, t_settle_s=None, frame=None, order_table=(7, 6, 5, 4, 3, 2, 1, 0),
-         reload_lead=RELOAD_LEAD, trigger_hold=False, t_rst_cycles=None, reading="ti"):
+         reload_lead=RELOAD_LEAD, trigger_hold=False, t_rst_cycles=None, reading="ti", anchor=0):
     """A parameter set that shows every plane exactly on time, and the rate it reaches.
 
     ``exposure_s`` asks for a least significant plane at least that long (0: the shortest legal
@@ -774,8 +778,8 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
             reload = t_rst + t_settle + load_g + slack
             dark_gap = even(max(reload, t_flip)) if G == 1 else lsb * math.ceil(reload / lsb)
             p = Params(lsb=lsb, t_rst=t_rst, t_settle=t_settle, hide=hide, dark_gap=dark_gap,
-                       reset_mode=reset_mode, order=order, order_table=order_table, chain=chain,
-                       strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period,
+                       reset_mode=reset_mode, order=order, order_table=order_table, anchor=anchor,
+                       chain=chain, strict_rst=strict_rst, source=source, stagger=stagger, row_period=row_period,
                        reload_lead=reload_lead, beats=beats, trigger_hold=trigger_hold, t_flip=t_flip)
             fr = frame or Frame(0, depth)
             if on_time(dmd, p, fr):
@@ -811,7 +815,7 @@ def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
     G = len(groups(dmd, p.reset_mode))
     frozen = p.t_rst + p.t_settle
     margin = 2 * row_cycles(dmd, p.beats) * G   # other groups' pulses taking row cycles
-    exps = exponents(p.order, p.order_table, fr.depth)
+    exps = exponents(p.order, p.order_table, fr.depth, p.anchor)
     best = None
     step = max(2, even(lsb_min // 64))
     for lsb in range(lsb_min, lsb_min + lsb_min // 4, step):

@@ -113,6 +113,31 @@ def test_every_level_exact(mode, strict, order, test_name):
 
 
 @pytest.mark.verilog
+@pytest.mark.parametrize("mode,order,anchor,first", [
+    (ResetMode.GLOBAL, PlaneOrder.LSB_FIRST, 7, (7, 1)),   # the MSB plane first (the paper's anchor)
+    (ResetMode.DUAL, PlaneOrder.MSB_FIRST, 3, (4, 2)),
+    (ResetMode.QUAD, PlaneOrder.TABLE, 7, (6, 5)),        # table (3, 5, 0, 4, 1, 2, 7, 6)
+])
+def test_anchor_starts_the_frame_at_its_plane(mode, order, anchor, first, test_name):
+    """The anchor register: each frame starts at its position of the plane order, modulo its
+    depth (an 8-plane frame, then a 6-plane one), and wraps round. Commands equal the model's,
+    every grey level exact; the first state each block's mirrors take in a frame is the plane
+    of weight ``2**first[k]`` (written out here from the order, not from the model)."""
+    p = fast_plan(reset_mode=mode, order=order, order_table=(3, 5, 0, 4, 1, 2, 7, 6), anchor=anchor).params
+    assert p.anchor == anchor
+    frames = [(0, 8), (1, 6)]
+    offered, pins = paced(p, frames, None)
+    run, _ = check(p, frames, None, pins, test_name, offered=offered)
+    assert len(run.lights) == len(frames)
+    rpb = DMD.rows_per_block
+    for (start, _), (slot, depth), e in zip(run.frames(), frames, first, strict=True):
+        plane = (ramp_image(DMD, slot) >> (8 - depth + e)) & 1
+        for b, history in enumerate(run.model.history):
+            state = next(state for cycle, state in history if cycle >= start)
+            assert np.array_equal(state, plane[b * rpb:(b + 1) * rpb]), f"block {b}"
+
+
+@pytest.mark.verilog
 @pytest.mark.parametrize("dmd,mode,order,store_words", [
     (TEST_DMD_400, ResetMode.GLOBAL, PlaneOrder.MSB_FIRST, 2),    # a row every row cycle
     (TEST_DMD_400, ResetMode.DUAL, PlaneOrder.LSB_FIRST, 1),      # the store paces the rows

@@ -163,19 +163,19 @@ def _first_failure(check, build, depth):
 
 def test_sequencer_settle_rule():
     """Checked to the suite's depth; and not vacuous: claimed one cycle longer after a pulse than
-    the sequencer waits, it fails (at step 30, within that depth: a load right at
+    the sequencer waits, it fails (at step 31, within that depth: a load right at
     ``t_rst + t_settle`` after a pulse)."""
     check = _sequencer_check("no load within the settle time after a pulse and after RST_ACTIVE fell")
     assert run(check, depth=check.quick).status == "checked"
     result = _first_failure(check, lambda: sequencer.settle_top(extra=1), check.quick)
-    assert result.failed == ["a load sooner than t_rst + t_settle after a pulse"] and result.step == 30
+    assert result.failed == ["a load sooner than t_rst + t_settle after a pulse"] and result.step == 31
 
 
 @pytest.mark.parametrize("dmd", [sequencer.DMD, sequencer.DMD_1080P_CLEAR], ids=["one-row-clear", "1080p-clear"])
 def test_sequencer_clear_rule(dmd):
     """Proven; and not vacuous: claimed one no-op row cycle longer than the DMD takes, it fails (a
-    second clear right after a clear, at step 18; on the 1080p clear a row load right after the
-    two no-op rows, at step 22)."""
+    second clear right after a clear, at step 19; on the 1080p clear a row load right after the
+    two no-op rows, at step 23)."""
     name = "no clear overlapping a row load" + (", 1080p clear" if dmd.clear_row_cycles > 1 else "")
     check = _sequencer_check(name)
     assert run(check).status == "proven"
@@ -183,17 +183,17 @@ def test_sequencer_clear_rule(dmd):
         run(dataclasses.replace(check, block="Sequencer-clear-one-more", induction=None,
                                 build=lambda: sequencer.clear_top(dmd, extra=1)), depth=24)
     assert failure.value.result.failed == ["a row load, clear or pulse of the block within a clear's no-op rows"]
-    assert failure.value.result.step == (22 if dmd.clear_row_cycles > 1 else 18)
+    assert failure.value.result.step == (23 if dmd.clear_row_cycles > 1 else 19)
 
 
 def test_sequencer_phased_settle_rule():
-    """The real claim holds at every step before 34 (past the suite's depth of the check): claimed
-    one cycle longer after a pulse than the sequencer waits, it fails at step 34 (a load of a
+    """The real claim holds at every step before 35 (past the suite's depth of the check): claimed
+    one cycle longer after a pulse than the sequencer waits, it fails at step 35 (a load of a
     pulsed group right at ``t_rst + t_settle`` after its pulse)."""
     check = _sequencer_check("no load of a pulsed group within its settle time, phased modes")
-    result = _first_failure(check, lambda: sequencer.phased_settle_top(extra=1), 35)
+    result = _first_failure(check, lambda: sequencer.phased_settle_top(extra=1), 36)
     assert result.failed == ["a load sooner than t_rst + t_settle after a pulse"]
-    assert result.step == 34 and result.step > check.quick, result.step
+    assert result.step == 35 and result.step > check.quick, result.step
 
 
 def test_slot_states_last_write_wins_is_proven():

@@ -15,7 +15,7 @@ from sim.models.net import Model
 from sim.models.slots import SlotPolicy
 from spec import records
 from spec.facts import DMDS, TEST_DMD
-from spec.registers import TriggerMode
+from spec.registers import PlaneOrder, TriggerMode
 
 #: The store's refusals, summed into the status reply's ``store_rows_refused``.
 REFUSALS = ("rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot", "rows_no_base")
@@ -348,6 +348,10 @@ def test_cli_configure_says_the_rate_and_sends_the_plan(projector, capsys):
     assert model.counters["records_sequencer"] == 1 and model.counters["drop_app_value"] == 0
     assert model.registers == [records.register_wire(plan.params.registers(TEST_DMD))]
     assert model.config["bit_depth"] == 6 and model.config["armed"] == 1
+    # the anchor register: the frame starts at that position of the order (a tiled display's pulse)
+    assert cli.main(base + ["configure", "--dmd", "test", "--dclk", "200e6", "--depth", "6", "--order",
+                            "LSB_FIRST", "--anchor", "5"]) == 0
+    assert model.registers[-1]["anchor"] == 5 and model.registers[-1]["order"] == PlaneOrder.LSB_FIRST
 
 
 def test_sequencer_record_refuses_what_the_projector_would_drop():

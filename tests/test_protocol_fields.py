@@ -137,7 +137,7 @@ def test_control_record_selects_fields():
 @pytest.mark.parametrize("mutate, message", [
     (lambda r: r[:4], "shorter than a record header"),
     (lambda r: b"XX" + r[2:], "magic"),
-    (lambda r: r[:2] + bytes([9]) + r[3:], "version"),
+    (lambda r: r[:2] + bytes([records.VERSION + 1]) + r[3:], "version"),
     (lambda r: r + b"\0", "is 5 bytes, got 6"),
     (lambda r: r[:3] + bytes([77]) + r[4:], "unknown record type"),
 ])

@@ -3,8 +3,9 @@ is queued.
 
 The cycle after a pulse is applied, the group's new state (its frame, display position, dark)
 is registered as a job; a first plane queued (the frame taken next, position 0) replaces it in
-that cycle. The stored plane the job reads (the plane's exponent above the frame's lowest stored
-plane) is worked out on the stage after, and the job leaves.
+that cycle. Its position in the plane order (counted from the anchor register) is worked out on
+the stage after, and the stored plane it reads (the plane's exponent above the frame's lowest
+stored plane) on the next; then the job leaves.
 """
 
 from amaranth import Cat, Module, Signal
@@ -14,7 +15,7 @@ from amaranth.lib.wiring import In, Out
 from ..registers import Registers
 from .group_frames import FRAME
 from .layouts import event, group_bits, load_job
-from .timebase import exponent, stored_plane
+from .timebase import exponent, order_position, stored_plane
 
 __all__ = ["LoadJobs"]
 
@@ -29,7 +30,7 @@ class LoadJobs(wiring.Component):
     Members
     -------
     regs : In(:class:`~gateware.registers.Registers`)
-        ``order``, ``order_table``.
+        ``order``, ``order_table``, ``anchor``.
     pulse : In(blocks); pulse_any : In(1)
         Bit g: group g's pulse is applied now (one bit at most); some bit of ``pulse``.
     pos : In(ArrayLayout(3, blocks)); dark : In(blocks); frame : In(ArrayLayout(FRAME, blocks))
@@ -37,9 +38,9 @@ class LoadJobs(wiring.Component):
     queue_first : In(event(group)); next : In(FRAME)
         Queue the group's first plane of ``next``, the frame taken next.
     jobs : Out(event(load_job))
-        Load jobs, two cycles after their pulse or their queueing.
+        Load jobs, three cycles after their pulse or their queueing.
     due : Out(1)
-        A job is on its way (it leaves in a cycle or two).
+        A job is on its way (it leaves within three cycles).
     """
 
     def __init__(self, dmd):
@@ -76,9 +77,13 @@ class LoadJobs(wiring.Component):
             m.d.sync += [job.group.eq(self.queue_first.payload), job.slot.eq(self.next.slot),
                          job.depth.eq(self.next.depth), low_plane.eq(self.next.low_plane), job.pos.eq(0),
                          job.clear.eq(0)]
-        e = exponent(m, self.regs, job.pos, job.depth, "job_exp")
+        # the job's position in the plane order (the anchor's rotation), then its stored plane
+        staged, staged_low, at, ordered = Signal(load_job(dmd)), Signal(3), Signal(3), Signal()
+        m.d.sync += [ordered.eq(formed), staged.eq(job), staged_low.eq(low_plane),
+                     at.eq(order_position(m, self.regs, job.pos, job.depth, "job_at"))]
+        e = exponent(m, self.regs, at, staged.depth, "job_exp")
         out, valid = Signal(load_job(dmd)), Signal()
-        m.d.sync += [valid.eq(formed), out.eq(job), out.plane.eq(stored_plane(low_plane, e))]
+        m.d.sync += [valid.eq(ordered), out.eq(staged), out.plane.eq(stored_plane(staged_low, e))]
         m.d.comb += [self.jobs.valid.eq(valid), self.jobs.payload.eq(out),
-                     self.due.eq(pulsed | formed | valid)]
+                     self.due.eq(pulsed | formed | ordered | valid)]
         return m

@@ -22,12 +22,12 @@ from amaranth.lib.wiring import In, Out
 from ..limbs import greater, limb_order
 from ..registers import DURATION_BITS, Registers
 from .group_frames import FRAME
-from .timebase import exponent
+from .timebase import exponent, order_position
 
 __all__ = ["PlaneInfo", "STAGES"]
 
 #: Cycles from a group's state to its answers.
-STAGES = 6
+STAGES = 7
 
 
 class PlaneInfo(wiring.Component):
@@ -40,7 +40,7 @@ class PlaneInfo(wiring.Component):
     Members
     -------
     regs : In(:class:`~gateware.registers.Registers`)
-        ``order``, ``order_table``, ``lsb``, ``hide``, ``dark_gap``.
+        ``order``, ``order_table``, ``anchor``, ``lsb``, ``hide``, ``dark_gap``.
     pos : In(ArrayLayout(3, blocks)); dark : In(blocks); frame : In(ArrayLayout(FRAME, blocks))
         Each group's display position, whether its next pulse is a dark one, and its frame.
     changed : In(blocks)
@@ -84,7 +84,7 @@ class PlaneInfo(wiring.Component):
         m.d.sync += turn.eq(Mux(turn == G - 1, 0, turn + 1))
         # each stage's group and whether its state is still the group's: a change applied on a
         # cycle (seen registered, the cycle after) makes every stage of that group stale that
-        # read its state then or before (stages 0-4; the answers are kept from stage 4, STAGES
+        # read its state then or before (stages 0-5; the answers are kept from stage 5, STAGES
         # cycles after the state was read, unless the group changes on that cycle too)
         tags = [Signal(range(G), name=f"tag{k}") for k in range(STAGES - 1)]
         valid = [Signal(name=f"valid{k}") for k in range(STAGES - 1)]
@@ -104,36 +104,46 @@ class PlaneInfo(wiring.Component):
                      depth.eq(Array(f.depth for f in self.frame)[turn]),
                      show.eq(Array(f.showing for f in self.frame)[turn])]
 
-        # 1: the plane's weight and the least significant plane's time; the last plane
+        # 1: the plane's position in the order (from the anchor), the least significant plane's
+        # time; the last plane
         advance(1)
-        e = exponent(m, regs, pos, depth, "info_exp")
+        at = Signal(3)
         lsb = Signal.like(regs.lsb)
-        last1, dark1 = Signal(), Signal()
-        edark1 = Signal.like(show.dark)
-        nodark1 = Signal()
-        m.d.sync += [lsb.eq(Mux(show.lsb != 0, show.lsb, regs.lsb)), last1.eq(pos == depth - 1),
-                     dark1.eq(dark), edark1.eq(show.dark), nodark1.eq(show.dark == 0)]
-        e1 = Signal(3)
-        m.d.sync += e1.eq(e)
+        last0, dark0, depth0 = Signal(), Signal(), Signal(4)
+        edark0 = Signal.like(show.dark)
+        nodark0 = Signal()
+        m.d.sync += [at.eq(order_position(m, regs, pos, depth, "info_at")), depth0.eq(depth),
+                     lsb.eq(Mux(show.lsb != 0, show.lsb, regs.lsb)), last0.eq(pos == depth - 1),
+                     dark0.eq(dark), edark0.eq(show.dark), nodark0.eq(show.dark == 0)]
 
-        # 2: the plane's time
+        # 2: the plane's weight
         advance(2)
+        e = exponent(m, regs, at, depth0, "info_exp")
+        last1, dark1, nodark1 = Signal(), Signal(), Signal()
+        edark1 = Signal.like(show.dark)
+        lsb1 = Signal.like(regs.lsb)
+        e1 = Signal(3)
+        m.d.sync += [e1.eq(e), lsb1.eq(lsb), last1.eq(last0), dark1.eq(dark0), edark1.eq(edark0),
+                     nodark1.eq(nodark0)]
+
+        # 3: the plane's time
+        advance(3)
         plane = Signal(DURATION_BITS)
         last2, dark2, nodark2 = Signal(), Signal(), Signal()
         edark2 = Signal(DURATION_BITS)
-        m.d.sync += [plane.eq(lsb << e1), last2.eq(last1), dark2.eq(dark1), nodark2.eq(nodark1),
+        m.d.sync += [plane.eq(lsb1 << e1), last2.eq(last1), dark2.eq(dark1), nodark2.eq(nodark1),
                      edark2.eq(edark1)]
 
-        # 3: the comparisons, a limb at a time
-        advance(3)
+        # 4: the comparisons, a limb at a time
+        advance(4)
         big_above, big_same = limb_order(m, plane, regs.hide, "big")
         long_above, long_same = limb_order(m, edark2, regs.dark_gap, "long")
         plane3, edark3 = Signal(DURATION_BITS), Signal(DURATION_BITS)
         last3, dark3, nodark3 = Signal(), Signal(), Signal()
         m.d.sync += [plane3.eq(plane), edark3.eq(edark2), last3.eq(last2), dark3.eq(dark2), nodark3.eq(nodark2)]
 
-        # 4: the answers
-        advance(4)
+        # 5: the answers
+        advance(5)
         big, last4, nodark4 = Signal(), Signal(), Signal()
         delay = Signal(DURATION_BITS)
         m.d.sync += [big.eq(greater(big_above, big_same, or_equal=True)), last4.eq(last3), nodark4.eq(nodark3),

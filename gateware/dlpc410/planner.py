@@ -103,7 +103,7 @@ class Planner(wiring.Component):
         Every group of the reset mode is loaded and waits for a trigger (registered: as this
         cycle's state is; the frame control counts in its own decisions).
     job_due : Out(1)
-        A load job is on its way (it is written in a cycle or two).
+        A load job is on its way (it is written within three cycles).
     playing : Out(1)
         Some group plays a frame.
     ended : Out(1)

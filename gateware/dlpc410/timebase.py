@@ -4,35 +4,53 @@ A frame of ``depth`` planes shows its planes in the order of the registers: the 
 plane at display position ``j`` (the plane of weight ``2**e``), and the stored plane it reads,
 ``e`` above the frame's lowest stored plane (the store's answer, worked out there from the
 frame's depth and its sequence entry). Both are small tables (of ``depth`` and ``j``; of the
-lowest plane and ``e``), written as lookups, not sums, so no carry chain is made for them.
+lowest plane and ``e``), written as lookups, not sums, so no carry chain is made for them. The
+anchor register starts the order at a position of its own: ``(j + anchor) mod depth``, a
+lookup too.
 """
 
 from amaranth import Array, Signal
 
 from ..registers import PlaneOrder
 
-__all__ = ["exponent", "stored_plane"]
+__all__ = ["order_position", "exponent", "stored_plane"]
 
 
-def _table(function, rows=16):
-    """``function(a, j)`` as a lookup on ``a`` (0..rows-1) and ``j`` (0..7), 3-bit results."""
-    return Array(Array(function(a, j) & 7 for j in range(8)) for a in range(rows))
+def _table(function, rows=16, columns=8):
+    """``function(a, j)`` as a lookup on ``a`` (0..rows-1) and ``j`` (0..columns-1), 3-bit
+    results."""
+    return Array(Array(function(a, j) & 7 for j in range(columns)) for a in range(rows))
 
 
 _MSB_FIRST = _table(lambda depth, j: depth - 1 - j)
 
 
-def exponent(m, regs, j, depth, name):
-    """Weight exponent of display position ``j`` in a frame of ``depth`` planes, under the plane
-    order of ``regs`` (a :class:`~gateware.registers.Registers` view)."""
+#: The order's position shown at display position ``j`` from the ``anchor``: ``(j + anchor) mod
+#: depth``, a lookup on ``depth`` and ``j + anchor`` (0..14).
+_ROTATED = _table(lambda depth, at: at % depth if depth else at, columns=16)
+
+
+def order_position(m, regs, j, depth, name):
+    """The position in the plane order of ``regs`` that display position ``j`` of a frame of
+    ``depth`` planes shows: ``j`` counted from the ``anchor`` register, modulo ``depth``. (Its
+    callers register it before :func:`exponent`: the two lookups together are too deep for a
+    cycle.)"""
+    k = Signal(3, name=name)
+    m.d.comb += k.eq(_ROTATED[depth][j + regs.anchor])
+    return k
+
+
+def exponent(m, regs, k, depth, name):
+    """Weight exponent of the plane at position ``k`` of the plane order of ``regs`` (a
+    :class:`~gateware.registers.Registers` view) in a frame of ``depth`` planes."""
     e = Signal(3, name=name)
     with m.Switch(regs.order):
         with m.Case(PlaneOrder.MSB_FIRST):
-            m.d.comb += e.eq(_MSB_FIRST[depth][j])
+            m.d.comb += e.eq(_MSB_FIRST[depth][k])
         with m.Case(PlaneOrder.LSB_FIRST):
-            m.d.comb += e.eq(j)
+            m.d.comb += e.eq(k)
         with m.Default():
-            m.d.comb += e.eq(regs.order_table[j])
+            m.d.comb += e.eq(regs.order_table[k])
     return e
 
 
