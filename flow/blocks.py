@@ -88,6 +88,11 @@ def _clock_trim():
     return ClockTrim()
 
 
+def _trim_dac():
+    from gateware.sync.trim_dac import TrimDac
+    return TrimDac(200e6)
+
+
 #: Each block under one name: its class's, in snake case (``res.<name>.*``, ``blocks/<name>.v``).
 BLOCKS = {
     "receive_path": _receive_path,
@@ -106,6 +111,7 @@ BLOCKS = {
     "register_crossing": _register_crossing,
     "sync_master": _sync_master,
     "clock_trim": _clock_trim,
+    "trim_dac": _trim_dac,
 }
 
 

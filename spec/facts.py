@@ -20,13 +20,14 @@ forum       TI E2E forum answers (quoting the datasheet); Mathews et al., IEEE Q
 DLPU133     DLPC964 applications FPGA user guide (loading into settling mirrors)
 four-DMD    the tiled four-DLP9500 projector paper (2026), eq. 6-7 (450.6 Hz 8-bit, runs at 400 Hz)
 DS162       Xilinx Spartan-6 FPGA data sheet: DC and switching characteristics (PLL)
+AD5662      Analog Devices AD5662 16-bit nanoDAC data sheet (serial interface timing)
 """
 
 import enum
 from dataclasses import dataclass
 
-__all__ = ["Fact", "TIMING", "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "DmdType", "DMDS", "RowMode",
-           "BlockMode",
+__all__ = ["Fact", "TIMING", "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "VCXO_DAC", "DmdType", "DMDS",
+           "RowMode", "BlockMode",
            "TEST_DMD", "TEST_DMD4",
            "TEST_DMD_400", "TEST_DMD4_400"]
 
@@ -192,6 +193,25 @@ def frames_held(rows, columns):
 SPARTAN6 = {
     "pll_pfd_min": Fact(19e6, "Hz", "DS162 PLL specification (F_PFDMIN)", "medium",
                         "the phase detector's lowest input: the oscillator after the PLL's input divider"),
+}
+
+
+#: The AD5662 16-bit DAC that sets a VCXO's control voltage (the SVEC's White Rabbit VCXO DAC),
+#: as the clock loop's writer (:mod:`gateware.sync.trim_dac`) needs it: 2.7-5.5 V timing.
+VCXO_DAC = {
+    "sclk_max": Fact(30e6, "Hz", "AD5662 timing characteristics (t1, SCLK cycle, 33 ns min)", "medium"),
+    "t_sclk_half_min": Fact(13e-9, "s", "AD5662 timing characteristics (t2, t3: SCLK high, low)", "medium"),
+    "t_sync_to_sclk_fall": Fact(13e-9, "s", "AD5662 timing characteristics (t4: SYNC to SCLK falling)",
+                                "medium"),
+    "t_data_setup": Fact(5e-9, "s", "AD5662 timing characteristics (t5)", "medium"),
+    "t_data_hold": Fact(4.5e-9, "s", "AD5662 timing characteristics (t6)", "medium"),
+    "t_sync_high_min": Fact(33e-9, "s", "AD5662 timing characteristics (t8: SYNC high between writes)",
+                            "medium"),
+    "frame_bits": Fact(24, "bits", "AD5662 input shift register", "high",
+                       "DB23..DB18 don't care, DB17..DB16 power-down (00 normal), DB15..DB0 the code, MSB "
+                       "first, each taken on SCLK's falling edge; the output updates on the 24th; SYNC "
+                       "high before it abandons the write"),
+    "code_bits": Fact(16, "bits", "AD5662", "high", "straight binary: mid-scale 0x8000"),
 }
 
 

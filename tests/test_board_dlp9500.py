@@ -123,6 +123,14 @@ def test_tree_places_the_whole_link(svec_tree):
     # a serialiser per lane: 64 DIN, 4 DVALID, 4 DCLK
     assert len(re.findall(r"^\s+OSERDES2 #\(", v, re.M)) == 72
     assert re.search(rf"^\s+{SVEC_DDR3.module} mcb \(", v, re.M) and re.search(r"^\s+sfp_gmii pcs \(", v, re.M)
+    # the clock loop's DAC: the VCXO behind the 125 MHz reference (the reference design's pins)
+    assert {("vcxo_dac_0__sclk__io", "N27"), ("vcxo_dac_0__din__io", "P25"),
+            ("vcxo_dac_0__sync_n__io", "P26")} <= set(locs)
+    assert re.search(r"^\s+\S*\.trim_dac\s+trim_dac \(", v, re.M), "the DAC writer"
+    # the sync input on both edges in its pad: the falling half is the clock loop's detector
+    pads = [body for body in v.split("\nmodule ")[1:]
+            if re.match(r"\\projector_dlp9500\.trigger\S*\.sync_in\S* ", body)]
+    assert any("IDDR2 #(" in body.split("endmodule")[0] for body in pads), "sync_in's IDDR2"
 
 
 def test_tree_lints_clean(svec_tree):

@@ -8,7 +8,8 @@ gains are chosen for."""
 import random
 
 import numpy as np
-from amaranth import Module, Signal
+import pytest
+from amaranth import ClockDomain, ClockSignal, Module, Signal
 from amaranth.sim import Simulator
 
 from gateware.sync.clock_trim import ClockTrim, gains
@@ -33,10 +34,20 @@ def _arrivals(rng, period):
     return [(step, k >= 20 and rng.random() < 0.5) for k, step in enumerate(steps)]
 
 
-def test_clock_trim_follows_its_model():
+@pytest.mark.parametrize("pad", [False, True], ids=["sampled_here", "sampled_in_pad"])
+def test_clock_trim_follows_its_model(pad):
+    """``pad``: the falling-edge sample taken before the loop (as a board's DDR input register's
+    falling half), the loop built to take it (``sampled``)."""
     period = 1000
     m = Module()
-    m.submodules.dut = dut = ClockTrim()
+    m.submodules.dut = dut = ClockTrim(sampled=pad)
+    line = Signal()                     # the sync line
+    if pad:
+        m.domains.fall = ClockDomain("fall", clk_edge="neg")
+        m.d.comb += ClockSignal("fall").eq(ClockSignal("sync"))
+        m.d.fall += dut.sync_in.eq(line)
+    else:
+        m.d.comb += dut.sync_in.eq(line)
     now = Signal(16, init=0xFFF0)       # wraps during the run
     m.d.sync += now.eq(now + 1)
     m.d.comb += dut.now.eq(now)
@@ -54,9 +65,9 @@ def test_clock_trim_follows_its_model():
             # mid-cycle: before the falling edge, or after it (then the next one samples it)
             await ctx.delay(PERIOD_NS * (0.75 if late else 0.25) * 1e-9)
             sampled = (ctx.get(now) + late) & 0xFFFF
-            ctx.set(dut.sync_in, 1)
+            ctx.set(line, 1)
             await ctx.tick().repeat(4)
-            ctx.set(dut.sync_in, 0)
+            ctx.set(line, 0)
             await ctx.tick().repeat(SETTLE)
             model.pulse((sampled + SEEN_AFTER) & 0xFFFF)
             got = {name: ctx.get(getattr(dut, name)) for name in ("phase", "trim", "locked", "pulses", "slips")}

@@ -26,3 +26,5 @@ class AtlysProjectorPlatform(AtlysPlatform):
     memory = ATLYS_DDR2
     #: the Ethernet PHY: the 88E1111 on GMII
     ethernet = GmiiPins
+    #: no VCXO DAC: the clock loop's trim word goes nowhere (a tiled display needs a board with one)
+    vcxo_dac = False

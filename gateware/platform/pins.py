@@ -15,7 +15,7 @@ from gateware.mac.gmii import RxPins, TxPins
 from .blackbox import blackbox_verilog
 from .serdes import DCLK_BITS, Oserdes4, lane_bits
 
-__all__ = ["GmiiPins", "SfpGmiiPins", "SFP_MODULE", "Dlpc410Pins", "TriggerPins"]
+__all__ = ["GmiiPins", "SfpGmiiPins", "SFP_MODULE", "Dlpc410Pins", "TriggerPins", "VcxoDacPins"]
 
 #: The wrapper around the vendor's 1000BASE-X PCS/PMA on the SFP's GTP (not part of this tree).
 SFP_MODULE = "sfp_gmii"
@@ -245,20 +245,24 @@ class Dlpc410Pins(Elaboratable):
 
 
 class TriggerPins(Elaboratable):
-    """Trigger and sync in (IOB registers on ``dmd``), sync out, camera-trigger out and the
-    ready line to a sync master (IOB registers).
+    """Trigger in (an IOB register on ``dmd``), sync in (a DDR input register on ``dmd``: its
+    rising and its falling half), sync out, camera-trigger out and the ready line to a sync
+    master (IOB registers).
 
-    The inputs' IOB registers are the first synchronising stage; the core adds the rest.
+    The inputs' IOB registers are the first synchronising stage; the core adds the rest. The sync
+    input's falling half is the clock loop's phase detector: the loop holds the pulse's edge at
+    the falling edge, so the rising half, the sequencer's, takes it half a cycle from any change.
 
     Attributes
     ----------
-    trigger, sync_in : Signal, to the core (``dmd``, one IOB stage, not yet synchronised)
+    trigger, sync_in, sync_in_fall : Signal, to the core (``dmd``, not yet synchronised)
     sync, camera, ready : Signal, from the core
     """
 
     def __init__(self):
         self.trigger = Signal()
         self.sync_in = Signal()
+        self.sync_in_fall = Signal()
         self.sync = Signal()
         self.camera = Signal()
         self.ready = Signal()
@@ -271,10 +275,35 @@ class TriggerPins(Elaboratable):
                                  **{f"{direction}_domain": "dmd"})
             m.submodules[name] = buffer
             return buffer
-        trig, sync_in = pad("i", "trigger_in"), pad("i", "sync_in")
+        trig = pad("i", "trigger_in")
+        # both halves of the sync input leave the pad together, the falling one sampled first
+        m.submodules.sync_in = sync_in = io.DDRBuffer("i", platform.request("sync_in", 0, dir="-"), i_domain="dmd")
         sync, cam, ready = pad("o", "sync_out"), pad("o", "camera_trigger_out"), pad("o", "ready_out")
-        m.d.comb += [self.trigger.eq(trig.i), self.sync_in.eq(sync_in.i), sync.o.eq(self.sync),
+        m.d.comb += [self.trigger.eq(trig.i), self.sync_in.eq(sync_in.i[0]), self.sync_in_fall.eq(sync_in.i[1]),
+                     sync.o.eq(self.sync),
                      cam.o.eq(self.camera), ready.o.eq(self.ready)]
         return m
 
 
+class VcxoDacPins(Elaboratable):
+    """The serial lines of the DAC that sets the board's VCXO (``vcxo_dac``: SCLK, DIN and SYNC,
+    from :class:`~gateware.sync.trim_dac.TrimDac`), through IOB registers on ``dmd``: the three
+    leave on the same edge, a cycle after the writer's registers.
+
+    Attributes
+    ----------
+    sclk, din, sync_n : Signal, from the writer
+    """
+
+    LINES = ("sclk", "din", "sync_n")
+
+    def __init__(self):
+        self.sclk, self.din, self.sync_n = Signal(init=1), Signal(), Signal(init=1)
+
+    def elaborate(self, platform):
+        m = Module()
+        dac = platform.request("vcxo_dac", 0, dir={name: "-" for name in self.LINES})
+        for name in self.LINES:
+            m.submodules[f"vcxo_dac_{name}"] = pad = io.FFBuffer("o", getattr(dac, name), o_domain="dmd")
+            m.d.comb += pad.o.eq(getattr(self, name))
+        return m

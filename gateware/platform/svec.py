@@ -8,8 +8,8 @@ memory controllers of banks 4 and 5; Ethernet reaches it only through its SFP ca
 
 Pin locations are the SVEC's, from the SVEC project's HDL repository (ohwr.org/project/svec):
 the FMC slots and the P2 pins from the application FPGA's constraints of the first board
-revision (``svec_v0_afpga.ucf``), the clock, reset, DDR3 (bank 4) and SFP from the constraint
-files the current reference design builds with (``svec_base_common.ucf``, ``svec_base_ddr4.ucf``,
+revision (``svec_v0_afpga.ucf``), the clock, reset, DDR3 (bank 4), SFP and the VCXO's DAC from
+the constraint files the current reference design builds with (``svec_base_common.ucf``, ``svec_base_ddr4.ucf``,
 ``svec_base_wr.ucf``). Which signal of the DLPC410 goes on which of those pins is the adapter's
 assumption (:mod:`.dlpc410_adapter`, ``constraints/README.md``). Nothing here has been through
 ISE.
@@ -111,6 +111,11 @@ class SvecPlatform(XilinxPlatform):
                  Subsignal("tx_disable", Pins("AA25", dir="o"), LVCMOS33),
                  Subsignal("los", Pins("W25", dir="i"), LVCMOS33)),
         Resource("sfp_refclk", 0, DiffPairs("B19", "A19", dir="i")),
+        # the AD5662 that sets the 25 MHz VCXO the 125 MHz reference is locked to
+        # (``svec_base_wr.ucf``: pll25dac_sclk_o, pll25dac_din_o, pll25dac_sync_n_o)
+        Resource("vcxo_dac", 0,
+                 Subsignal("sclk", Pins("N27", dir="o")), Subsignal("din", Pins("P25", dir="o")),
+                 Subsignal("sync_n", Pins("P26", dir="o")), LVCMOS33),
     ]
     connectors = [_fmc_connector(0), _fmc_connector(1), _p2_connector()]
 
@@ -131,3 +136,5 @@ class SvecProjectorPlatform(SvecPlatform):
     memory = SVEC_DDR3
     #: the Ethernet PHY: the SFP cage through a 1000BASE-X PCS inside the FPGA
     ethernet = SfpGmiiPins
+    #: the clock loop pulls the 25 MHz VCXO behind ``clk125`` through its DAC (``vcxo_dac``)
+    vcxo_dac = True

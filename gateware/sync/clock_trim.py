@@ -59,10 +59,18 @@ def gains(period):
 class ClockTrim(wiring.Component):
     """The board's clock, phase-locked to the sync master's pulses (domain ``sync``).
 
+    Parameters
+    ----------
+    sampled : bool
+        ``sync_in`` is already the line's sample on the falling edge, taken in the input pad (a
+        DDR input register's falling half, presented in this domain: on a board, where the
+        sequencer takes the rising half of the same register); otherwise the loop samples the
+        line on the falling edge itself.
+
     Members
     -------
     sync_in : In(1)
-        The master's sync line (asynchronous).
+        The master's sync line (asynchronous), or its falling-edge sample (``sampled``).
     now : In(16)
         The time base's low bits (the sequencer's ``status.now``: its parity is the bus's).
     period : In(DURATION_BITS)
@@ -87,13 +95,21 @@ class ClockTrim(wiring.Component):
     pulses: Out(COUNTER_BITS)
     slips: Out(COUNTER_BITS)
 
+    def __init__(self, *, sampled=False):
+        self._sampled = sampled
+        super().__init__()
+
     def elaborate(self, platform):
         m = Module()
-        # the detector: the falling edge's sample, then a synchroniser into this domain
-        m.domains.fall = ClockDomain("fall", clk_edge="neg", local=True)
-        m.d.comb += [ClockSignal("fall").eq(ClockSignal("sync")), ResetSignal("fall").eq(ResetSignal("sync"))]
-        sampled, synced, last = Signal(), Signal(), Signal()
-        m.d.fall += sampled.eq(self.sync_in)
+        # the detector: the falling edge's sample (the pad's, or taken here), then a synchroniser
+        synced, last = Signal(), Signal()
+        if self._sampled:
+            sampled = self.sync_in
+        else:
+            m.domains.fall = ClockDomain("fall", clk_edge="neg", local=True)
+            m.d.comb += [ClockSignal("fall").eq(ClockSignal("sync")), ResetSignal("fall").eq(ResetSignal("sync"))]
+            sampled = Signal()
+            m.d.fall += sampled.eq(self.sync_in)
         m.submodules.synchroniser = FFSynchronizer(sampled, synced, stages=2)
         m.d.sync += last.eq(synced)
         edge = synced & ~last

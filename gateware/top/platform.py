@@ -4,13 +4,14 @@ Everything vendor-specific lives here and in :mod:`gateware.platform`; the core
 (:class:`gateware.top.system.Projector`) simulates without any of it.
 """
 
-from amaranth import ClockDomain, Elaboratable, Module
+from amaranth import ClockDomain, DomainRenamer, Elaboratable, Module
 from amaranth.lib import io, wiring
 
 from gateware.platform.clocks import DCLK_HZ, Spartan6Clocks
 from gateware.platform.mcb_instance import McbInstance
-from gateware.platform.pins import Dlpc410Pins, TriggerPins
+from gateware.platform.pins import Dlpc410Pins, TriggerPins, VcxoDacPins
 from gateware.registers import Registers
+from gateware.sync.trim_dac import TrimDac
 from spec import schedule
 from spec.facts import DMDS
 
@@ -35,7 +36,8 @@ def core(dmd, dclk_hz=DCLK_HZ):
     triggers held (the host replaces them with sequencer records, and arms the triggers)."""
     plan = schedule.plan(dmd, dclk_hz, depth=8, trigger_hold=True)
     return Projector(dmd, sync_hz=Spartan6Clocks.frequencies(dclk_hz)["sync"], beats=plan.params.beats,
-                     regs=Registers.const(plan.params.registers(dmd)), armed=False, **ADDRESSES)
+                     regs=Registers.const(plan.params.registers(dmd)), armed=False, sync_pad_sampled=True,
+                     **ADDRESSES)
 
 
 class PlatformTop(Elaboratable):
@@ -88,10 +90,17 @@ class PlatformTop(Elaboratable):
         m.d.comb += [
             projector.trigger_in.eq(trigger.trigger),
             projector.sync_in.eq(trigger.sync_in),
+            projector.sync_in_fall.eq(trigger.sync_in_fall),
             trigger.sync.eq(projector.sync_out),
             trigger.camera.eq(projector.camera_out),
             trigger.ready.eq(projector.ready_out),
         ]
+        # ---- The VCXO's DAC, on a board that carries one: the clock loop pulls the oscillator --
+        if platform.vcxo_dac:
+            m.submodules.trim_dac = dac = DomainRenamer("dmd")(TrimDac(schedule.FABRIC_HZ))
+            m.submodules.vcxo_dac = dac_pins = VcxoDacPins()
+            m.d.comb += [dac.trim.eq(projector.vcxo_trim),
+                         *[getattr(dac_pins, name).eq(getattr(dac, name)) for name in VcxoDacPins.LINES]]
         # ---- DDR2 or DDR3 through the memory controller ---------------------------------------
         m.submodules.mcb = mcb = McbInstance(memory=platform.memory, port0_domain="sync", port1_domain="dmd")
         wiring.connect(m, projector.mcb_write, mcb.port0)

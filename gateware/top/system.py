@@ -85,6 +85,9 @@ class Projector(wiring.Component):
         for 200 MHz.
     mdio_cycles : tuple(int, int), optional
         PHY reset and settle waits in ``sync`` cycles (simulations shorten them).
+    sync_pad_sampled : bool
+        The board samples the sync input on both edges in its pad: the clock loop takes the
+        falling half (``sync_in_fall``); otherwise it samples ``sync_in`` itself.
 
     Members
     -------
@@ -102,6 +105,10 @@ class Projector(wiring.Component):
         The DLPC410 applications interface (``dmd``).
     trigger_in, sync_in : In(1)
         TTL trigger and sync inputs (asynchronous).
+    sync_in_fall : In(1)
+        With ``sync_pad_sampled`` only: the sync input's sample on the falling edge of ``dmd``,
+        taken in the pad (the falling half of the DDR input register whose rising half is
+        ``sync_in``), for the clock loop's phase detector.
     sync_out, camera_out : Out(1)
         Frame shown; camera trigger (``dmd``).
     ready_out : Out(1)
@@ -117,7 +124,7 @@ class Projector(wiring.Component):
     """
 
     def __init__(self, dmd, *, mac, ip, port, regs, armed=True, sync_hz=125e6, slots=None, mdio_cycles=None,
-                 beats=1):
+                 beats=1, sync_pad_sampled=False):
         self._dmd = dmd
         self._addresses = dict(mac=mac, ip=ip, port=port)
         self._regs = regs
@@ -126,6 +133,7 @@ class Projector(wiring.Component):
         self._slots = slots_for(dmd) if slots is None else slots
         self._mdio_cycles = mdio_cycles or (None, None)
         self._beats = beats
+        self._sync_pad_sampled = sync_pad_sampled
         super().__init__({
             "gmii_rx": In(gmii.RxPins),
             "gmii_tx": Out(gmii.TxPins),
@@ -139,6 +147,7 @@ class Projector(wiring.Component):
             "dlpc": Out(interface.Signature(dmd.buses, beats)),
             "trigger_in": In(1),
             "sync_in": In(1),
+            **({"sync_in_fall": In(1)} if sync_pad_sampled else {}),
             "sync_out": Out(1),
             "camera_out": Out(1),
             "ready_out": Out(1),
@@ -211,8 +220,9 @@ class Projector(wiring.Component):
         ]
         m.submodules.soft_trigger = soft = PulseSynchronizer(i_domain="sync", o_domain="dmd")
         # a tiled display's board: its clock kept at the sync master's rate, the pulse on one edge
-        m.submodules.clock_trim = trim = DomainRenamer("dmd")(ClockTrim())
-        m.d.comb += [trim.sync_in.eq(self.sync_in), trim.now.eq(seq.status.now[:16]),
+        m.submodules.clock_trim = trim = DomainRenamer("dmd")(ClockTrim(sampled=self._sync_pad_sampled))
+        m.d.comb += [trim.sync_in.eq(self.sync_in_fall if self._sync_pad_sampled else self.sync_in),
+                     trim.now.eq(seq.status.now[:16]),
                      trim.period.eq(Mux(seq.regs.trigger == TriggerMode.SYNC, seq.regs.period, 0)),
                      self.vcxo_trim.eq(trim.trim)]
 
