@@ -19,6 +19,8 @@ locked: the boards keep the master's rate and take each pulse on the same edge.
   over the whole scene from one pulse to the next, in real time: the error either side of each
   seam) and off (the check of the extrapolation: the spread predicted from the 4-plane run's
   figures against the one measured).
+* The anchor register compared (:func:`anchors`): where in the plane order the frame starts on
+  the pulse, loops off, under three camera windows.
 * Extrapolated to the DLP7000's 8-bit frame (the schedule model's period) and to hours: a frame
   restarts on each pulse, so the spread depends on the clocks' difference at that moment, not on
   the run time: without the loops the crystals' tolerance (+-100 ppm at any temperature) bounds
@@ -32,11 +34,13 @@ import numpy as np
 
 from sim.bench.tables import label, pyplot, save_figure, write_table
 from sim.models import clock_trim
+from sim.tb.seq_sim import CAMERA_DELAY, CAMERA_RAMP
 from sim.tiled_rig import BOARD_PERIOD_FS, Oscillator, master_period, run_tiled, tiles
 from spec import schedule
 from spec.facts import DMDS, TEST_DMD
+from spec.registers import PlaneOrder
 
-__all__ = ["run", "OSCILLATORS", "MASTER", "FRAMES", "CHUNK"]
+__all__ = ["run", "anchors", "OSCILLATORS", "MASTER", "FRAMES", "CHUNK", "ANCHORS"]
 
 OSCILLATORS = [Oscillator(100, jitter_ps=10, seed=1), Oscillator(-100, jitter_ps=30, seed=3),
                Oscillator(37, seed=5), Oscillator(-61, ramp_ppm_per_s=1000, jitter_ps=20, seed=7)]
@@ -52,34 +56,98 @@ EIGHT_FRAMES = 250
 PPM_TOLERANCE = 100
 
 
-def _plan(depth):
-    return schedule.plan(TEST_DMD, 200e6, depth=depth, t_rst_s=20 / 200e6, t_settle_s=30 / 200e6)
+def _plan(depth, **kw):
+    return schedule.plan(TEST_DMD, 200e6, depth=depth, t_rst_s=20 / 200e6, t_settle_s=30 / 200e6, **kw)
 
 
 def _tiles():
     return tiles(TEST_DMD, len(OSCILLATORS), row_step=37)
 
 
-def _run(depth, frames, name, *, trim, traces=False):
-    plan = _plan(depth)
+def _run(depth, frames, name, *, trim, traces=False, **plan_kw):
+    plan = _plan(depth, **plan_kw)
     return run_tiled(TEST_DMD, plan.params, _tiles(), oscillators=OSCILLATORS, master=MASTER, frames=frames,
                      master_period_cycles=master_period(plan.frame_cycles), name=name, traces=traces, depth=depth,
                      trim=trim)
 
 
-def _seam_errors(run, lsb, first):
+def _boards(run):
+    """Every board's pins through the rule-checking DLPC410 model (once: the models keep their
+    state)."""
+    return [run.board_run(i, TEST_DMD) for i in range(len(OSCILLATORS))]
+
+
+def _seam_errors(run, boards, lsb, first, window=None):
     """Per frame from ``first`` to the one before the last, a camera over the whole scene from one sync
-    pulse to the next, in real time: the largest error (LSB) on the columns either side of a
-    seam, and anywhere."""
-    boards = [run.board_run(i, TEST_DMD) for i in range(len(OSCILLATORS))]
+    pulse to the next, in real time (or over ``window(k)``, ``(t0, t1)`` in ps): the largest error
+    (LSB) on the columns either side of a seam, and anywhere; and the pixels whose light, rounded
+    to a level, is not their image's. ``boards``: :func:`_boards`."""
     images = _tiles()
-    seams, anywhere = [], []
+    window = window or (lambda k: (run.syncs[k], run.syncs[k + 1]))
+    seams, anywhere, wrong = [], [], 0
     for k in range(max(first, 1), len(run.syncs) - 1):
-        errors = [run.light(i, b, run.syncs[k], run.syncs[k + 1], lsb) - images[i] for i, b in enumerate(boards)]
+        errors = [run.light(i, b, *window(k), lsb) - images[i] for i, b in enumerate(boards)]
         anywhere.append(max(float(np.abs(e).max()) for e in errors))
         seams.append(max(float(np.abs(np.stack([a[:, -1], b[:, 0]])).max())
                          for a, b in zip(errors, errors[1:], strict=False)))
-    return max(seams), max(anywhere)
+        wrong += sum(int(np.count_nonzero(np.round(e))) for e in errors)
+    return max(seams), max(anywhere), wrong
+
+
+#: The anchors compared, loops off: (the plane order, the anchor register). The frame starts on
+#: the pulse at the order's position ``anchor``; the four-DMD paper's is the MSB plane of an
+#: LSB-first frame.
+ANCHORS = {"lsb_first_from_lsb": (PlaneOrder.LSB_FIRST, 0), "lsb_first_from_msb": (PlaneOrder.LSB_FIRST, 7),
+           "msb_first_from_msb": (PlaneOrder.MSB_FIRST, 0), "msb_first_from_lsb": (PlaneOrder.MSB_FIRST, 7)}
+#: Frames of each anchor's run.
+ANCHOR_FRAMES = 40
+
+
+def _span_ps(run):
+    """The frame's light as every board shows it on average: from the sync pulse to its first
+    clocking pulse and to its last (the final dark pulse), in ps, the mirrors' switching delay
+    and half their ramp added."""
+    per_board = run.frame_pulses()
+    firsts = [f[0] - s for board in per_board for f, s in zip(board, run.syncs, strict=False) if len(f)]
+    lasts = [f[-1] - s for board in per_board for f, s in zip(board, run.syncs, strict=False) if len(f)]
+    motion = (CAMERA_DELAY + CAMERA_RAMP / 2) * BOARD_PERIOD_FS / 1000
+    return float(np.mean(firsts)) + motion, float(np.mean(lasts)) + motion
+
+
+def anchors():
+    """The anchor register compared, loops off (the drift the anchor would share out), 8-plane
+    frames: the seam error under a camera from one pulse to the next (the window holds the
+    frame), over the frame's light as the boards show it on average (the camera's exposure set to
+    the frame, triggered by the master), and the same lagging by 1 % of the frame. Table:
+    ``build/sync_anchors.csv``."""
+    figures, rows = {}, []
+    lsb = _plan(8).params.lsb
+    windows = {}
+    for name, (order, anchor) in ANCHORS.items():
+        run = _run(8, ANCHOR_FRAMES, f"sync_anchor_{name}", trim=False, traces=True, order=order, anchor=anchor)
+        t0, t1 = _span_ps(run)
+        lag = (t1 - t0) / 100
+        windows = {"pulse_to_pulse": None,
+                   "frame": lambda k, run=run, t0=t0, t1=t1: (run.syncs[k] + t0, run.syncs[k] + t1),
+                   "frame_lag_1pct": lambda k, run=run, t0=t0, t1=t1, lag=lag: (run.syncs[k] + t0 + lag,
+                                                                                run.syncs[k] + t1 + lag)}
+        boards = _boards(run)
+        errors = {window: _seam_errors(run, boards, lsb, 1, how) for window, how in windows.items()}
+        spread = float(run.spreads().max())
+        rows.append([name, order.name, anchor, f"{spread:.3f}",
+                     *[f"{errors[w][k]:.4f}" for w in windows for k in (0, 1)]])
+        figures[f"sync.spread_ns_max_untrimmed_{name}"] = (spread, "ns, loops off")
+        for window, (seam, *_) in errors.items():
+            figures[f"sync.seam_gray_error_lsb_max_untrimmed_{name}_{window}"] = (seam, "LSB, loops off")
+    write_table("sync_anchors", ["anchor", "order", "anchor_register", "spread_ns_max",
+                                 *[f"{w}_{what}_lsb_max" for w in windows for what in ("seam", "tile")]], rows)
+    names = list(ANCHORS)
+    for window in windows:
+        seams = [figures[f"sync.seam_gray_error_lsb_max_untrimmed_{n}_{window}"][0] for n in names]
+        # ties (to a thousandth of an LSB) go to the first
+        figures[f"sync.best_anchor_{window}"] = (int(np.argmin(np.round(seams, 3))),
+                                                 ", ".join(f"{i} {n}" for i, n in enumerate(names)))
+    return figures
 
 
 def _since_ns(run):
@@ -145,13 +213,14 @@ def run():
     # 8 planes: with the loops (every board's pins checked, the seams) and without (the check)
     eight = _run(8, EIGHT_FRAMES, "sync_spread_8planes", trim=True, traces=True)
     eight_locked = eight.locked_from()
-    seam, anywhere = _seam_errors(eight, _plan(8).params.lsb, eight_locked or 1)
+    seam, anywhere, wrong = _seam_errors(eight, _boards(eight), _plan(8).params.lsb, eight_locked or 1)
     loose8 = _run(8, 100, "sync_spread_8planes_untrimmed", trim=False)
     predicted = sampling_ns + difference * float(_since_ns(loose8)[-1])
     figures.update({
         "sync.spread_ns_max_8planes": (float(eight.spreads()[eight_locked:].max()), "ns, loops locked"),
         "sync.seam_gray_error_lsb_max": (seam, "LSB, window from pulse to pulse, either side of a seam"),
         "sync.tile_gray_error_lsb_max": (anywhere, "LSB, the same window, any pixel"),
+        "sync.gray_levels_wrong": (wrong, "pixels of every frame once locked whose light, rounded, is not their level"),
         "sync.spread_ns_max_8planes_untrimmed": (float(loose8.spreads().max()), "ns, 100 frames, loops off"),
         "sync.spread_ns_max_8planes_untrimmed_predicted_model": (predicted, "ns, from the 4-plane run's figures"),
     })
@@ -169,6 +238,7 @@ def run():
             "ns, DLP7000 8-bit frame, loops off, +-100 ppm"),
         "sync.wall_s": (long.wall_s + untrimmed.wall_s + eight.wall_s + loose8.wall_s, "s of simulation"),
     })
+    figures.update(anchors())
     return figures
 
 
@@ -225,5 +295,6 @@ def dlp9500():
 
 if __name__ == "__main__":
     import sys
-    for figure, (value, unit) in (dlp9500() if sys.argv[1:] == ["dlp9500"] else run()).items():
+    benches = {"dlp9500": dlp9500, "anchors": anchors}
+    for figure, (value, unit) in (benches[sys.argv[1]]() if sys.argv[1:] else run()).items():
         print(f"{figure:55s} {value:12.3f} {unit}")
