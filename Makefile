@@ -42,9 +42,11 @@ sim: $(STAMP)
 verilog: $(STAMP)
 	$(PY) -m flow verilog
 
-# LUT/FF/BRAM/DSP per block and in total on XC6SLX45 (Yosys synth_xilinx -family xc6s).
+# LUT/FF/BRAM/DSP per block and per board build (Yosys synth_xilinx -family xc6s, JOBS at a time):
+# the DLP7000's projector on the Atlys against its XC6SLX45, the DLP9500's on the SVEC against its
+# XC6SLX150T.
 resources: $(STAMP)
-	$(PY) -m flow resources
+	$(PY) -m flow resources --jobs $(JOBS)
 
 # Logic depth (LUT levels, carry chains) between flip-flops per clock domain of the core.
 timing: $(STAMP)

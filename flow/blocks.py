@@ -106,17 +106,11 @@ BLOCKS = {
     "read_widener": _read_widener,
     "sequencer": _sequencer,
     "sequencer_dlp9500": lambda: _sequencer("dlp9500"),
-    # the whole core for the four-bus DMD (no board carries it yet: no platform top to count)
-    "core_dlp9500": lambda: core("dlp9500"),
     "register_crossing": _register_crossing,
     "sync_master": _sync_master,
     "clock_trim": _clock_trim,
     "trim_dac": _trim_dac,
 }
-
-
-#: Blocks synthesised flattened: the WebAssembly ABC fails on a whole core's hierarchy.
-FLATTENED = {"core_dlp9500"}
 
 
 def core(dmd="dlp7000", dclk_hz=400e6):

@@ -11,9 +11,11 @@ def main(argv=None):
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("verilog", help="write the Spartan-6 ISE tree and every block's Verilog to build/spartan6")
     resources = sub.add_parser("resources", help="Yosys synth_xilinx -family xc6s: LUT/FF/BRAM/DSP per block and "
-                                                 "in total")
+                                                 "per board build (total: the DLP7000's, total_dlp9500: the "
+                                                 "DLP9500's)")
     resources.add_argument("--block", action="append", default=None,
-                           help="only this block of flow.blocks, no total (repeatable)")
+                           help="only this block of flow.blocks or board build of flow.resources.TOPS (repeatable)")
+    resources.add_argument("--jobs", type=int, default=1, help="Yosys runs at a time (default 1)")
     timing = sub.add_parser("timing", help="logic depth between flip-flops per clock domain (Yosys, xc6s)")
     timing.add_argument("--block", default=None, help="one block of flow.blocks instead of the core")
     timing.add_argument("--over", action="append", default=[], metavar="DOMAIN",
@@ -46,7 +48,7 @@ def main(argv=None):
         return run()
     if args.command == "resources":
         from flow.resources import main as run
-        return run(blocks=args.block)
+        return run(blocks=args.block, jobs=args.jobs)
     if args.command == "timing":
         from flow.timing import main as run
         return run(block=args.block, over=args.over)

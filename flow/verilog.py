@@ -14,6 +14,7 @@ import re
 import subprocess
 from pathlib import Path
 
+from amaranth.back import rtlil as amaranth_rtlil
 from amaranth.back import verilog as amaranth_verilog
 
 from flow.blocks import BLOCKS
@@ -25,15 +26,36 @@ def block_verilog(name):
     return amaranth_verilog.convert(BLOCKS[name](), name=name, emit_src=False, strip_internal_attrs=True)
 
 
-def emit_blocks(outdir):
+def block_rtlil(name):
+    return amaranth_rtlil.convert(BLOCKS[name](), name=name, emit_src=False)
+
+
+def emit_blocks(outdir, names=BLOCKS, *, rtlil=False):
+    """Write each block of ``names`` to ``outdir/blocks/<name>.v`` (``.il``: as RTLIL); returns
+    {name: path}."""
     outdir = Path(outdir) / "blocks"
     outdir.mkdir(parents=True, exist_ok=True)
     paths = {}
-    for name in BLOCKS:
-        path = outdir / f"{name}.v"
-        path.write_text(block_verilog(name))
+    for name in names:
+        path = outdir / f"{name}.{'il' if rtlil else 'v'}"
+        path.write_text(block_rtlil(name) if rtlil else block_verilog(name))
         paths[name] = path
     return paths
+
+
+def _rtlil_only(platform):
+    """The platform class ``platform`` writing only its design, as RTLIL (``<name>.il``)."""
+    return type(f"{platform.__name__}Rtlil", (platform,),
+                {"file_templates": {"{{name}}.il": "{{emit_rtlil()}}"}, "command_templates": []})
+
+
+def _extract(platform, top, name, outdir, *, rtlil=False, **kwargs):
+    """Write a build of ``top`` on the platform class ``platform`` to ``outdir``: its ISE tree, or
+    with ``rtlil`` only its design as RTLIL (``<name>.il``, what the resource report reads: Yosys
+    parses it in seconds, the Verilog of a whole projector in minutes)."""
+    if rtlil:
+        platform, kwargs["emit_src"] = _rtlil_only(platform), False
+    platform().build(top, name=name, do_build=False, **kwargs).extract(str(outdir))
 
 
 def platform_top():
@@ -46,33 +68,32 @@ def platform_top():
         return "bringup", BringupTop()
 
 
-def emit_platform(outdir):
+def emit_platform(outdir, *, rtlil=False):
     from gateware.platform import Board
     name, top = platform_top()
     extra = {}
     if name == "projector":
         from gateware.top.platform import UCF_EXTRA
         extra["add_constraints"] = UCF_EXTRA
-    plan = Board().build(top, name=name, do_build=False, **extra)
-    plan.extract(str(outdir))
+    _extract(Board, top, name, outdir, rtlil=rtlil, **extra)
     return name
 
 
-def emit_dlp9500(outdir, dmd="dlp9500"):
-    """The DLP9500 projector's ISE tree for its board (the SVEC) in ``outdir``; returns its top's
-    name. ``dmd`` another four-bus DMD (the tests' small one builds in seconds)."""
+def emit_dlp9500(outdir, dmd="dlp9500", *, rtlil=False):
+    """The DLP9500 projector's ISE tree for its board (the SVEC) in ``outdir`` (``rtlil``: its RTLIL
+    only); returns its top's name. ``dmd`` another four-bus DMD (the tests' small one builds in
+    seconds)."""
     from gateware.platform import BOARDS
     from gateware.top.platform import UCF_EXTRA, PlatformTop
     name = "projector_dlp9500"
-    BOARDS["svec"]().build(PlatformTop(dmd=dmd), name=name, do_build=False,
-                           add_constraints=UCF_EXTRA).extract(str(outdir))
+    _extract(BOARDS["svec"], PlatformTop(dmd=dmd), name, outdir, rtlil=rtlil, add_constraints=UCF_EXTRA)
     return name
 
 
-def emit_sync_master(outdir):
-    """The sync master's ISE tree in ``outdir``; returns its top's name."""
+def emit_sync_master(outdir, *, rtlil=False):
+    """The sync master's ISE tree in ``outdir`` (``rtlil``: its RTLIL only); returns its top's name."""
     from gateware.top.sync_master import SyncMasterPlatform, SyncMasterTop
-    SyncMasterPlatform().build(SyncMasterTop(), name="sync_master", do_build=False).extract(str(outdir))
+    _extract(SyncMasterPlatform, SyncMasterTop(), "sync_master", outdir, rtlil=rtlil)
     return "sync_master"
 
 
