@@ -45,3 +45,14 @@ def test_system_sequence_entries():
     report = system.run("test", testcase="sequence_entries_play_as_their_table_says")
     assert report["latency_cycles"] <= 8
     assert report["status"]["triggers_after_end"] == 1
+
+
+@pytest.mark.verilog
+def test_system_tiled_board_clock_loop():
+    """The clock loop inside the core, configured over GMII: it runs in SYNC mode with the
+    master's period, a pulse left out is a slip in the status reply, and it is off in another
+    mode (``sim/tb/system.py``, ``a_tiled_board_trims_its_clock``)."""
+    report = system.run("test", testcase="a_tiled_board_trims_its_clock")
+    assert report["status"]["clock_loop_slips"] == 1
+    assert len(report["trims"]) == 12 and all(report["trims"][1:])
+

@@ -21,6 +21,7 @@ goes on dark, the next trigger shows dark, the next frame sent is shown). Every 
 must be a whole, correct frame.
 """
 
+import dataclasses
 import json
 import time
 import zlib
@@ -50,7 +51,7 @@ from sim.scene import default_scene
 from sim.system import plan as run_plan
 from spec import records, wire
 from spec.facts import DMDS
-from spec.registers import PlaneOrder
+from spec.registers import PlaneOrder, TriggerMode
 
 SYNC_NS, GMII_NS, DMD_NS = 8.0, 8.0, 5.0
 HOST_MAC, HOST_IP, HOST_PORT = "02:00:00:00:00:99", "10.0.0.1", 40000
@@ -493,3 +494,40 @@ async def sequence_entries_play_as_their_table_says(dut):
     assert status["triggers_after_end"] == 1 and status["store_frames_complete"] == len(images), status
     assert status["sequence_entries_skipped"] == 0 and status["pulses_late"] == 0, status
     Path(p["report"]).write_text(json.dumps({"latency_cycles": pulses[0].cycle - pin, "status": status}))
+
+
+#: The sync master's period in the tiled board's test, in ``dmd`` cycles (beyond the clock loop's
+#: capture range, so that a pulse left out is a slip).
+TILED_PERIOD = 2000
+
+
+@cocotb.test()
+async def a_tiled_board_trims_its_clock(dut):
+    """A board of a tiled display, configured over GMII as a host does it: SYNC trigger mode with
+    the master's period. The sync pulses come every period on ``sync_in``: the clock loop runs
+    (``vcxo_trim`` leaves 0; the simulation's clock is exact and cannot be pulled, so the loop
+    never locks); a pulse left out is a slip in the status reply; back in trigger-pin mode the
+    loop is off and the trim word 0 again."""
+    system = await System.started(dut)
+    dmd, plan = system.dmd, system.plan
+    sync = dataclasses.replace(plan.params, trigger=TriggerMode.SYNC, period=TILED_PERIOD)
+    await system.records([codec.sequencer_record(sync.registers(dmd), system.next_sequence(), dmd=dmd),
+                          codec.control_record(system.next_sequence(), armed=1)])
+    trims = []
+    for k in range(12):
+        if k != 8:                                  # the ninth pulse left out: a slip
+            dut.sync_in.value = 1
+        await system.dmd_clock.cycles(4)
+        dut.sync_in.value = 0
+        await system.dmd_clock.cycles(TILED_PERIOD - 4)
+        trims.append(dut.vcxo_trim.value.to_signed())
+    status = await system.status()
+    assert status["drop_app_value"] == 0 and status["registers_applied"] >= 1, status
+    assert status["clock_loop_slips"] == 1 and status["clock_loop_locked"] == 0, status
+    assert all(t != 0 for t in trims[1:]), trims       # the first pulse only anchors the loop
+    # the trigger pin's mode, the period left set: the mode turns the loop off
+    pin = dataclasses.replace(plan.params, period=TILED_PERIOD)
+    await system.records([codec.sequencer_record(pin.registers(dmd), system.next_sequence(), dmd=dmd)])
+    await system.dmd_clock.cycles(8)
+    assert dut.vcxo_trim.value.to_signed() == 0, "the loop is off outside SYNC mode"
+    Path(system.p["report"]).write_text(json.dumps({"trims": trims, "status": status}))
