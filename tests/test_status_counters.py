@@ -53,5 +53,5 @@ def test_register_sets_counted_in_full():
 
 
 def test_clock_loop_slips_counted_in_full():
-    members = ClockTrim().signature.members
-    assert Shape.cast(members["slips"].shape).width == WIDTHS["clock_loop_slips"]
+    # the class's annotations: an instance never elaborated would be reported unused
+    assert Shape.cast(ClockTrim.__annotations__["slips"].shape).width == WIDTHS["clock_loop_slips"]

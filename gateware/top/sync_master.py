@@ -84,21 +84,29 @@ class SyncMasterTop(Elaboratable):
             m.d.comb += pad.o.eq(master.sync_out[k])
         m.submodules.camera = camera = io.FFBuffer("o", platform.request("camera_trigger_out", 0, dir="-"))
         m.d.comb += camera.o.eq(master.camera_out)
+        def pins(direction, name, count):
+            """Resource ``name`` 0..count-1 through plain buffers: their values, or their drives."""
+            values = []
+            for k in range(count):
+                m.submodules[f"{name}_{k}"] = buffer = io.Buffer(direction, platform.request(name, k, dir="-"))
+                values.append(buffer.i if direction == "i" else buffer.o)
+            return Cat(values)
+
         # the inputs are asynchronous: the master synchronises them
-        ready = Cat(platform.request("board_ready", k).i for k in range(boards))
-        m.d.comb += [master.ready.eq(ready), master.trigger_in.eq(platform.request("frame_trigger_in", 0).i)]
+        ready = pins("i", "board_ready", boards)
+        m.d.comb += [master.ready.eq(ready), master.trigger_in.eq(pins("i", "frame_trigger_in", 1))]
 
         # switches and buttons: synchronised; the button's rising edge is one software trigger
         switches = Signal(8)
-        m.submodules.switches = FFSynchronizer(Cat(platform.request("switch", k).i for k in range(8)), switches)
+        m.submodules.switches = FFSynchronizer(pins("i", "switch", 8), switches)
         button, was = Signal(), Signal()
-        m.submodules.button = FFSynchronizer(platform.request("button", 0).i, button)
+        m.submodules.button = FFSynchronizer(pins("i", "button", 1), button)
         m.d.sync += was.eq(button)
         m.d.comb += [master.mode.eq(TriggerMode(switches[0:2])), master.run.eq(switches[7]),
                      master.soft.eq(button & ~was)]
 
         # LEDs: the ready lines, and a toggle per pulse and per refusal
-        leds = Cat(platform.request("led", k).o for k in range(8))
+        leds = pins("o", "led", 8)
         toggles = Signal(3)
         for bit, counter in enumerate((master.pulses, master.not_ready, master.early)):
             m.d.comb += toggles[bit].eq(counter[0])
