@@ -69,11 +69,16 @@ def _script(top, design_name, blackbox_name, stat_name, flags):
             f"tee -q -o {stat_name} stat -json")
 
 
-def _failure(top, proc, log):
-    # once YoWASP's built-in ABC has run, Yosys's stdout and stderr are lost: its log file keeps
-    # the error
-    tail = log.read_text(errors="replace")[-3000:] if log.exists() else proc.stdout[-2000:]
-    return RuntimeError(f"yosys failed on {top} (log: {log}):\n{tail}{proc.stderr[-2000:]}")
+def run_yosys(script, top, workdir):
+    """Run a Yosys ``script`` on ``top`` in ``workdir`` (the only folder the WebAssembly Yosys
+    sees), its log in ``<top>.yosys.log`` there; a failure raises with the log's end. (Once
+    YoWASP's built-in ABC has run, Yosys's stdout and stderr are lost: the log keeps the error.)"""
+    log = Path(workdir) / f"{top}.yosys.log"
+    proc = subprocess.run([_yosys(), "-q", "-l", log.name, "-p", script], capture_output=True, text=True,
+                          cwd=workdir)
+    if proc.returncode != 0:
+        tail = log.read_text(errors="replace")[-3000:] if log.exists() else proc.stdout[-2000:]
+        raise RuntimeError(f"yosys failed on {top} (log: {log}):\n{tail}{proc.stderr[-2000:]}")
 
 
 def synthesise(design_path, top, *, iopads=False, blackboxes=(), flatten=True):
@@ -85,16 +90,13 @@ def synthesise(design_path, top, *, iopads=False, blackboxes=(), flatten=True):
     log there (``<top>.yosys.log``)."""
     design_path = Path(design_path).resolve()
     workdir = design_path.parent
-    stat, log = workdir / f"{top}.stat.json", workdir / f"{top}.yosys.log"
+    stat = workdir / f"{top}.stat.json"
     boxes = workdir / f"{top}.blackboxes.v" if blackboxes else None
     if boxes:
         boxes.write_text("\n".join(blackboxes))
     flags = ("" if iopads else " -noiopad") + (" -flatten" if flatten else "")
     script = _script(top, design_path.name, boxes and boxes.name, stat.name, flags)
-    proc = subprocess.run([_yosys(), "-q", "-l", log.name, "-p", script], capture_output=True, text=True,
-                          cwd=workdir)
-    if proc.returncode != 0:
-        raise _failure(top, proc, log)
+    run_yosys(script, top, workdir)
     return json.loads(stat.read_text())["design"]["num_cells_by_type"]
 
 

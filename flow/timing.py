@@ -20,7 +20,6 @@ is pipelined to: at most 4 LUT levels and one carry chain of at most 16 bits on 
 """
 
 import json
-import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -71,7 +70,7 @@ class Depth:
 
 def netlist(verilog, top, *, workdir):
     """Synthesise ``verilog`` for XC6S and return the flattened module's JSON netlist."""
-    from flow.resources import _yosys
+    from flow.resources import run_yosys
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     source = workdir / f"{top}.v"
@@ -79,9 +78,7 @@ def netlist(verilog, top, *, workdir):
     out = workdir / f"{top}.netlist.json"
     script = (f"read_verilog {source.name}; synth_xilinx -family xc6s -top {top} -flatten -noiopad -noclkbuf; "
               f"write_json {out.name}")
-    proc = subprocess.run([_yosys(), "-q", "-p", script], capture_output=True, text=True, cwd=workdir)
-    if proc.returncode != 0:
-        raise RuntimeError(f"yosys failed on {top}:\n{proc.stdout[-2000:]}{proc.stderr[-2000:]}")
+    run_yosys(script, top, workdir)
     return json.loads(out.read_text())["modules"][top]
 
 

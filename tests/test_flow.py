@@ -8,7 +8,7 @@ from amaranth.back import rtlil
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from flow import bench, resources, verilog
+from flow import bench, resources, timing, verilog
 from flow.blocks import BLOCKS
 from sim.harness.paths import build_dir
 
@@ -131,6 +131,8 @@ def test_yosys_failure_names_its_error(tmp_path):
     bad.write_text("module broken(input a, output b); missing m(.a(a), .b(b)); endmodule\n")
     with pytest.raises(RuntimeError, match="missing"):
         resources.synthesise(bad, "broken")
+    with pytest.raises(RuntimeError, match="missing"):         # the timing report's synthesis too
+        timing.netlist(bad.read_text(), "broken", workdir=tmp_path / "timing")
 
 
 def test_board_figures_give_the_share_of_its_device():
