@@ -90,7 +90,8 @@ def _clock_trim():
 
 def _trim_dac():
     from gateware.sync.trim_dac import TrimDac
-    return TrimDac(200e6)
+    from spec.schedule import FABRIC_HZ
+    return TrimDac(FABRIC_HZ)
 
 
 #: Each block under one name: its class's, in snake case (``res.<name>.*``, ``blocks/<name>.v``).

@@ -9,8 +9,8 @@ memory controllers of banks 4 and 5; Ethernet reaches it only through its SFP ca
 Pin locations are the SVEC's, from the SVEC project's HDL repository (ohwr.org/project/svec):
 the FMC slots and the P2 pins from the application FPGA's constraints of the first board
 revision (``svec_v0_afpga.ucf``), the clock, reset, DDR3 (bank 4), SFP and the VCXO's DAC from
-the constraint files the current reference design builds with (``svec_base_common.ucf``, ``svec_base_ddr4.ucf``,
-``svec_base_wr.ucf``). Which signal of the DLPC410 goes on which of those pins is the adapter's
+the constraint files the current reference design builds with (``svec_base_common.ucf``,
+``svec_base_ddr4.ucf``, ``svec_base_wr.ucf``). Which signal of the DLPC410 goes on which of those pins is the adapter's
 assumption (:mod:`.dlpc410_adapter`, ``constraints/README.md``). Nothing here has been through
 ISE.
 """

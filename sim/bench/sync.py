@@ -77,16 +77,17 @@ def _boards(run):
     return [run.board_run(i, TEST_DMD) for i in range(len(OSCILLATORS))]
 
 
-def _seam_errors(run, boards, lsb, first, window=None):
+def _seam_errors(run, boards, lsb, first, span=None):
     """Per frame from ``first`` to the one before the last, a camera over the whole scene from one sync
-    pulse to the next, in real time (or over ``window(k)``, ``(t0, t1)`` in ps): the largest error
-    (LSB) on the columns either side of a seam, and anywhere; and the pixels whose light, rounded
-    to a level, is not their image's. ``boards``: :func:`_boards`."""
+    pulse to the next, in real time (or over ``span``, ``(t0, t1)`` in ps after the pulse): the
+    largest error (LSB) on the columns either side of a seam, and anywhere; and the pixels whose
+    light, rounded to a level, is not their image's. ``boards``: :func:`_boards`."""
     images = _tiles()
-    window = window or (lambda k: (run.syncs[k], run.syncs[k + 1]))
     seams, anywhere, wrong = [], [], 0
     for k in range(max(first, 1), len(run.syncs) - 1):
-        errors = [run.light(i, b, *window(k), lsb) - images[i] for i, b in enumerate(boards)]
+        sync = run.syncs[k]
+        t0, t1 = (sync, run.syncs[k + 1]) if span is None else (sync + span[0], sync + span[1])
+        errors = [run.light(i, b, t0, t1, lsb) - images[i] for i, b in enumerate(boards)]
         anywhere.append(max(float(np.abs(e).max()) for e in errors))
         seams.append(max(float(np.abs(np.stack([a[:, -1], b[:, 0]])).max())
                          for a, b in zip(errors, errors[1:], strict=False)))
@@ -122,17 +123,14 @@ def anchors():
     ``build/sync_anchors.csv``."""
     figures, rows = {}, []
     lsb = _plan(8).params.lsb
-    windows = {}
+    windows = ("pulse_to_pulse", "frame", "frame_lag_1pct")
     for name, (order, anchor) in ANCHORS.items():
         run = _run(8, ANCHOR_FRAMES, f"sync_anchor_{name}", trim=False, traces=True, order=order, anchor=anchor)
         t0, t1 = _span_ps(run)
         lag = (t1 - t0) / 100
-        windows = {"pulse_to_pulse": None,
-                   "frame": lambda k, run=run, t0=t0, t1=t1: (run.syncs[k] + t0, run.syncs[k] + t1),
-                   "frame_lag_1pct": lambda k, run=run, t0=t0, t1=t1, lag=lag: (run.syncs[k] + t0 + lag,
-                                                                                run.syncs[k] + t1 + lag)}
+        spans = dict(zip(windows, (None, (t0, t1), (t0 + lag, t1 + lag)), strict=True))
         boards = _boards(run)
-        errors = {window: _seam_errors(run, boards, lsb, 1, how) for window, how in windows.items()}
+        errors = {window: _seam_errors(run, boards, lsb, 1, span) for window, span in spans.items()}
         spread = float(run.spreads().max())
         rows.append([name, order.name, anchor, f"{spread:.3f}",
                      *[f"{errors[w][k]:.4f}" for w in windows for k in (0, 1)]])
