@@ -20,6 +20,8 @@ __all__ = [
     "NET_COUNTERS", "RECORD_COUNTERS",
     "ROW_COUNTERS", "GEOMETRY", "APP_COUNTERS", "SYSTEM_STATUS", "STATUS_REPLY", "IMAGE_HEADER",
     "DELTA_HEADER",
+    "MASTER_CONFIG", "MASTER_CONTROL", "MASTER_RECORD_COUNTERS", "MASTER_STATUS", "MASTER_STATUS_REPLY",
+    "master_config_faults",
     "MAX_RECORD", "UDP_IP_OVERHEAD", "record_limit", "frame_newer",
     "register_wire", "registers_bits", "register_faults",
 ]
@@ -36,7 +38,7 @@ from .wire import size
 MAGIC = 0x444D
 #: Protocol version this tree speaks; records with any other version are dropped and counted.
 #: ``magic`` and ``version`` keep their places in every version, so that a projector can tell.
-VERSION = 9
+VERSION = 10
 #: IPv4 and UDP headers around a record: a record fills an MTU less these.
 UDP_IP_OVERHEAD = 28
 #: Largest record: a UDP payload inside a 9000-byte IP MTU (9000 - 20 IPv4 - 8 UDP).
@@ -51,6 +53,8 @@ class RecordType(_enum.IntEnum):
     SEQUENCER = 5
     ENTRY = 6
     DELTA = 7
+    MASTER_CONTROL = 8   # to a sync master: its settings, a software trigger
+    MASTER_STATUS = 9    # a sync master's answer to a status query
 
 
 class Action(_enum.IntFlag):
@@ -233,6 +237,62 @@ SYSTEM_STATUS = [
 
 #: Status reply body (after :data:`HEADER`).
 STATUS_REPLY = NET_COUNTERS + APP_COUNTERS + SYSTEM_STATUS
+
+
+#: The sync master's run-time configuration (a master control record sets it; times in the
+#: master's ``sync`` cycles, :data:`MASTER_STATUS`'s ``clock_hz``).
+MASTER_CONFIG = [
+    ("mode", 8),             # what starts a frame (spec.registers.TriggerMode, SYNC excepted)
+    ("armed", 8),            # 1: triggers are obeyed; 0: every trigger is ignored
+    ("period", -(-_registers.DURATION_BITS // 8) * 8),      # the periodic trigger's period
+    ("min_period", -(-_registers.DURATION_BITS // 8) * 8),  # a trigger sooner after a pulse is refused
+    ("width", 16),           # each sync and camera pulse's length
+]
+
+#: Master control record body: ``apply`` bit i makes MASTER_CONFIG field i take the record's
+#: value; ``action`` (:class:`Action`): SOFTWARE_TRIGGER, after the fields are set.
+MASTER_CONTROL = [("apply", 8), ("action", 8)] + MASTER_CONFIG
+
+#: The records a sync master keeps count of: those of :data:`RECORD_COUNTERS` that it can see.
+MASTER_RECORD_COUNTERS = [(name, width) for name, width in RECORD_COUNTERS
+                          if name in ("records_control", "records_status", "drop_app_magic", "drop_app_version",
+                                      "drop_app_type", "drop_app_length", "drop_app_value", "sequence_gaps")]
+
+#: What a sync master reports besides its network counters: its pulses and refusals, its
+#: boards' ready lines, the configuration in force, its MAC's verdicts.
+MASTER_STATUS = [
+    ("uptime_cycles", 48),   # sync cycles since reset
+    ("clock_hz", 32),        # the sync clock: the unit of every time in MASTER_CONFIG
+    ("boards", 8),           # sync outputs the master was built with
+    ("ready", 16),           # the boards' ready lines now (bit k: board k)
+    ("pulses", 32),          # sync pulses sent (one per frame, on every board's line)
+    ("not_ready", 32),       # triggers refused: a board was not ready
+    ("early", 32),           # triggers refused: sooner than min_period after the last pulse
+    *MASTER_CONFIG,
+    *[(name, width) for name, width in SYSTEM_STATUS if name.startswith("mac_")],
+]
+
+#: Master status reply body (after :data:`HEADER`).
+MASTER_STATUS_REPLY = NET_COUNTERS + MASTER_RECORD_COUNTERS + MASTER_STATUS
+
+
+def master_config_faults(config):
+    """Why a sync master cannot take a configuration (``{check: condition}``, as
+    :func:`register_faults`): ``config`` maps :data:`MASTER_CONFIG`'s names to the values the
+    record would leave in force (its own where it applies them, the others as they are). A
+    master has no sync input to obey (mode SYNC); each pulse ends before the next may start."""
+    modes = [m.value for m in _registers.TriggerMode if m != _registers.TriggerMode.SYNC]
+    return {
+        "mode": _any([config["mode"] == mode for mode in modes]) == 0,
+        "armed": config["armed"] > 1,
+        "period_fits": (config["period"] >> _registers.DURATION_BITS) != 0,
+        "min_period_fits": (config["min_period"] >> _registers.DURATION_BITS) != 0,
+        "width": config["width"] == 0,
+        "width_below_min_period": config["width"] >= config["min_period"],
+        "period_keepable": ((config["mode"] == _registers.TriggerMode.PERIODIC.value)
+                            & (config["period"] < config["min_period"])),
+    }
+
 
 
 def register_wire(values):
