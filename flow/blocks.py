@@ -34,7 +34,7 @@ def _endpoint():
 def _ethernet_port():
     from gateware.protocol.port import EthernetPort
     # The whole Ethernet side: receive MAC, stack and protocol, transmit MAC.
-    return EthernetPort(DMDS["dlp7000"], **_ADDRESSES)
+    return EthernetPort(_endpoint())
 
 
 def _xga_slots():

@@ -92,8 +92,10 @@ def emit_dlp9500(outdir, dmd="dlp9500", *, rtlil=False):
 
 def emit_sync_master(outdir, *, rtlil=False):
     """The sync master's ISE tree in ``outdir`` (``rtlil``: its RTLIL only); returns its top's name."""
+    from gateware.top.platform import UCF_EXTRA
     from gateware.top.sync_master import SyncMasterPlatform, SyncMasterTop
-    _extract(SyncMasterPlatform, SyncMasterTop(), "sync_master", outdir, rtlil=rtlil)
+    # (its network port crosses clock domains as the projector's does: the same timing ignores)
+    _extract(SyncMasterPlatform, SyncMasterTop(), "sync_master", outdir, rtlil=rtlil, add_constraints=UCF_EXTRA)
     return "sync_master"
 
 

@@ -285,8 +285,6 @@ def master_config_faults(config):
     return {
         "mode": _any([config["mode"] == mode for mode in modes]) == 0,
         "armed": config["armed"] > 1,
-        "period_fits": (config["period"] >> _registers.DURATION_BITS) != 0,
-        "min_period_fits": (config["min_period"] >> _registers.DURATION_BITS) != 0,
         "width": config["width"] == 0,
         "width_below_min_period": config["width"] >= config["min_period"],
         "period_keepable": ((config["mode"] == _registers.TriggerMode.PERIODIC.value)

@@ -54,6 +54,10 @@ PLANS = {
         {"vco": 1000, "outputs": {"sync": 8, "gmii_tx": 8}, "phases": {}},
         {"vco": 800, "outputs": {"io_data": 1, "io_dclk": 1, "dmd": 4}, "phases": {"io_dclk": 180.0}},
     ],
+    # no DLPC410 link: a tiled display's sync master (its network port and its pulses)
+    None: [
+        {"vco": 1000, "outputs": {"sync": 8, "gmii_tx": 8}, "phases": {}},
+    ],
 }
 #: The oscillator of the Atlys (the default input).
 INPUT_HZ = 100e6
@@ -79,7 +83,7 @@ class Spartan6Clocks(Elaboratable):
     rst_in : Signal
         Board reset button (active high).
     dclk_hz : float
-        DCLK: 400 MHz or 200 MHz.
+        DCLK: 400 MHz or 200 MHz; None: no DLPC410 link (the sync master's build).
     input_hz : float
         The oscillator's frequency (100 MHz on the Atlys, 125 MHz on the SVEC).
 

@@ -26,7 +26,7 @@ from ..registers import Registers, wire_registers
 from ..wire import byte_slice, layout
 from .layouts import piece_layout
 
-__all__ = ["Parser", "Query", "config_init", "CONFIG_LAYOUT", "ENTRY_LAYOUT"]
+__all__ = ["Parser", "Query", "capture", "follow_sequence", "config_init", "CONFIG_LAYOUT", "ENTRY_LAYOUT"]
 
 CONFIG_LAYOUT = layout(records.CONFIG)
 #: A sequence entry record's fields, as the store's entry table takes them.
@@ -45,6 +45,31 @@ class Query(data.Struct):
     """A status query: who asked, and the sequence number the answer echoes."""
     peer: Peer
     sequence: _SEQUENCE_BITS
+
+
+def capture(m, datagrams, index, captured, peer, length):
+    """Keep a record's first bytes: byte ``i`` of each datagram taken from ``datagrams`` into
+    byte ``i`` of ``captured`` (as many as it holds; ``index`` counts them, the caller zeroes
+    it between records), its sender into ``peer`` and its length into ``length``. A record
+    shorter than ``captured`` reads as zeros past its end, not as the record before it."""
+    size = len(captured) // 8
+    beat = datagrams.payload
+    with m.If(datagrams.valid & datagrams.ready):
+        m.d.sync += index.eq(index + 1)
+        with m.If(index == 0):
+            m.d.sync += [captured.eq(beat.data << 8 * (size - 1)), peer.eq(beat.peer), length.eq(beat.length)]
+        for i in range(1, size):
+            with m.If(index == i):
+                m.d.sync += byte_slice(captured, size, i, 1).eq(beat.data)
+
+
+def follow_sequence(m, sequence, gaps):
+    """Count in ``gaps`` a valid record whose ``sequence`` number is not the last one's + 1
+    (from the second record on). Called where a record is known valid."""
+    seen, last = Signal(), Signal.like(sequence)
+    with m.If(seen & (sequence != (last + 1)[:len(last)])):
+        m.d.sync += gaps.eq(gaps + 1)
+    m.d.sync += [seen.eq(1), last.eq(sequence)]
 
 
 def config_init(*, mac, ip, port, bit_depth=8, armed=False):
@@ -190,16 +215,7 @@ class Parser(wiring.Component):
         peer = Signal(Peer)
         length = Signal(OFFSET_BITS)
 
-        with m.If(taken):
-            m.d.sync += index.eq(index + 1)
-            with m.If(index == 0):
-                # a record shorter than its header reads as zeros there, not as the last one
-                m.d.sync += captured.eq(beat.data << 8 * (_CAPTURED - 1))
-            for i in range(1, _CAPTURED):
-                with m.If(index == i):
-                    m.d.sync += byte_slice(captured, _CAPTURED, i, 1).eq(beat.data)
-            with m.If(index == 0):
-                m.d.sync += [peer.eq(beat.peer), length.eq(beat.length)]
+        capture(m, self.datagrams, index, captured, peer, length)
 
         # The header each record type needs before it can be checked (the whole record, but for
         # an image record's pixels).
@@ -221,8 +237,6 @@ class Parser(wiring.Component):
         cause = self._cause(m, header, pixels, delta, control, sequencer, entry, length, needed)
         causes = self._CAUSES
 
-        sequence_seen = Signal()
-        sequence_last = Signal.like(header.sequence)
         position = Signal.like(self.pieces.payload.position)
         first = Signal()
 
@@ -244,9 +258,7 @@ class Parser(wiring.Component):
                             bump(f"drop_app_{name}")
                     m.next = "DISCARD"
                 with m.Else():
-                    with m.If(sequence_seen & (header.sequence != (sequence_last + 1)[:len(sequence_last)])):
-                        bump("sequence_gaps")
-                    m.d.sync += [sequence_seen.eq(1), sequence_last.eq(header.sequence)]
+                    follow_sequence(m, header.sequence, counters.sequence_gaps)
                     with m.Switch(header.type):
                         with m.Case(RecordType.IMAGE, RecordType.DELTA):
                             m.d.sync += [position.eq(pixels.offset), first.eq(1)]

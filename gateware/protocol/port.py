@@ -1,12 +1,13 @@
-"""The whole Ethernet side of the projector: GMII pins in and out, image rows and settings in ``sync``.
+"""The whole Ethernet side of a device: GMII pins in and out, its endpoint's ports in ``sync``.
 
-:class:`EthernetPort` puts the MACs (:mod:`gateware.mac`) around the
-:class:`~gateware.protocol.endpoint.Endpoint`; the system top uses it as one block. Three clock
+:class:`EthernetPort` puts the MACs (:mod:`gateware.mac`) around an endpoint: the projector's
+(:class:`~gateware.protocol.endpoint.Endpoint`: image rows, settings, sequencer registers) or a
+sync master's (:class:`~gateware.protocol.master.MasterEndpoint`); a top uses it as one block. Three clock
 domains: ``gmii_rx`` (the PHY's receive clock), ``gmii_tx`` (the transmit clock the FPGA drives)
 and ``sync`` (the rest of the design, any frequency that keeps up with 125 MB/s).
 """
 
-from amaranth import Module
+from amaranth import Module, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out, connect
 
@@ -14,9 +15,8 @@ from ..compose import forward, members
 from ..mac import gmii
 from ..mac.gmii_rx import counters_layout
 from ..mac.path import ReceivePath, TransmitPath
-from .endpoint import Endpoint
 
-__all__ = ["EthernetPort"]
+__all__ = ["EthernetPort", "report_port"]
 
 
 class EthernetPort(wiring.Component):
@@ -24,9 +24,9 @@ class EthernetPort(wiring.Component):
 
     Parameters
     ----------
-    dmd : :class:`spec.facts.DmdType`
-    mac, ip, port, armed, frame_bits, buffer_depth, beats
-        As :class:`~gateware.protocol.endpoint.Endpoint`'s.
+    endpoint : wiring.Component
+        The stack and protocol: ``rx`` and ``tx`` byte streams (:class:`~gateware.mac.layouts.ByteBeat`)
+        in ``sync``, and its own ports, which become this port's.
     max_frame : int
         Longest frame the receive MAC accepts, FCS included.
     rx_depth : int
@@ -48,17 +48,15 @@ class EthernetPort(wiring.Component):
         Frames dropped whole because the receive FIFO had no room (``sync`` fell behind).
     tx_underruns : Out(32)
         Frames aborted on the transmit pins because their bytes came late.
-    pixels, settings, trigger, registers, entries, sequence_start, status, net_counters, app_counters
-        The endpoint's members of these names, in ``sync`` (an image record's first pixel leaves
-        only after its frame passed every check, FCS included).
+    (the endpoint's members but ``rx`` and ``tx``)
+        In ``sync`` (an image record's first pixel leaves only after its frame passed every
+        check, FCS included).
     """
 
-    def __init__(self, dmd, *, mac, ip, port, armed=False, frame_bits=4, max_frame=gmii.MAX_JUMBO_FRAME_BYTES,
-                 rx_depth=16384, tx_depth=2048, buffer_depth=16384, beats=1):
+    def __init__(self, endpoint, *, max_frame=gmii.MAX_JUMBO_FRAME_BYTES, rx_depth=16384, tx_depth=2048):
         self._rx = ReceivePath(max_frame=max_frame, depth=rx_depth)
         self._tx = TransmitPath(depth=tx_depth)
-        self._endpoint = Endpoint(dmd, mac=mac, ip=ip, port=port, armed=armed, frame_bits=frame_bits,
-                                  buffer_depth=buffer_depth, beats=beats)
+        self._endpoint = endpoint
         super().__init__({
             "gmii_rx": In(gmii.RxPins),
             "gmii_tx": Out(gmii.TxPins),
@@ -94,3 +92,15 @@ class EthernetPort(wiring.Component):
             self.tx_underruns.eq(tx.underruns),
         ]
         return m
+
+
+def report_port(m, port, status, clock_hz):
+    """What every status reply says of the device and its port, into ``status`` (a view with the
+    fields of those names: ``uptime_cycles``, ``clock_hz``, ``mac_*``): ``sync`` cycles since
+    reset, ``clock_hz`` (the ``sync`` clock), and ``port``'s MAC verdicts and losses."""
+    uptime = Signal(48)
+    m.d.sync += uptime.eq(uptime + 1)
+    m.d.comb += [status.uptime_cycles.eq(uptime), status.clock_hz.eq(int(clock_hz)),
+                 status.mac_rx_dropped.eq(port.rx_dropped), status.mac_tx_underruns.eq(port.tx_underruns)]
+    for verdict, _ in port.mac_counters.shape():
+        m.d.comb += status[f"mac_{verdict}"].eq(port.mac_counters[verdict])

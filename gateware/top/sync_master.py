@@ -1,33 +1,50 @@
-"""The sync master's own build: :class:`~gateware.sync.master.SyncMaster` on the Atlys.
+"""The sync master's own build: :class:`SyncMasterCore` (the master and its network port) on the Atlys.
 
 A tiled display's main control board. Its pins sit on the Atlys's VHDCI connector (LVCMOS33, a
 bank the board's jumper sets to 3.3 V): one sync line and one ready line per projector board, the
 frame trigger in and the camera trigger out. Every output leaves from a flip-flop in its pad
 (``io.FFBuffer``, packed into the IOB by ISE), so that the sync pulses to the boards differ only by
-the pads' and the cables' skew. The ``sync`` domain is the board's 100 MHz oscillator.
+the pads' and the cables' skew. The board's 88E1111 PHY is its network port: a host sets the
+master's configuration and triggers it with master control records and reads its pulses and
+refusals in master status replies (``docs/protocol.md``). Clocks: ``sync`` and ``gmii_tx`` at
+125 MHz from a PLL on the board's 100 MHz oscillator, ``gmii_rx`` from the PHY.
 
-The frame timing is the build's (a lab rebuilds for another frame rate): the trigger period,
-the shortest frame period the boards keep and the pulse width, in seconds. The switches choose
-what starts a frame and arm it; button 0 is the software trigger (the host's trigger record on a
-build with a network port). The LEDs show the boards' ready lines, and each refusal for a board
-not ready or for a trigger too early toggles its LED.
+At power-up the master is disarmed, in EXTERNAL mode, with the build's frame timing (the trigger
+period, the shortest frame period the boards keep and the pulse width); the host changes them.
+Button 0 is a software trigger (obeyed in SOFTWARE mode, as the host's). The LEDs show the
+boards' ready lines, each pulse and each refusal (for a board not ready, for a trigger too
+early) toggles one, and the last shows the master armed.
 """
 
-from amaranth import Cat, Elaboratable, Module, Signal
+from amaranth import Cat, ClockDomain, Elaboratable, Module, Signal
 from amaranth.build import Attrs, Pins, Resource
-from amaranth.lib import io
+from amaranth.lib import io, wiring
 from amaranth.lib.cdc import FFSynchronizer
+from amaranth.lib.wiring import In, Out
 from amaranth_boards.atlys import AtlysPlatform
 
+from gateware.mac import gmii
+from gateware.mac.mdio import StatusPoller
+from gateware.platform.clocks import Spartan6Clocks
+from gateware.platform.pins import GmiiPins
+from gateware.protocol.master import MasterEndpoint, master_config_init
+from gateware.protocol.port import EthernetPort, report_port
 from gateware.registers import TriggerMode
 from gateware.sync.master import SyncMaster
+from spec import records
 
-__all__ = ["SyncMasterPlatform", "SyncMasterTop", "sync_master_resources", "BOARDS", "SYNC_HZ"]
+__all__ = ["SyncMasterCore", "SyncMasterPlatform", "SyncMasterTop", "sync_master_resources", "BOARDS",
+           "SYNC_HZ", "MASTER_ADDRESSES", "MASTER_MAX_FRAME"]
 
 #: Projector boards the build drives (the four-DMD projector).
 BOARDS = 4
-#: The ``sync`` domain: the Atlys's oscillator.
-SYNC_HZ = 100e6
+#: The ``sync`` domain: the PLL's 125 MHz (the GMII's byte rate).
+SYNC_HZ = Spartan6Clocks.frequencies(None)["sync"]
+#: The master's network addresses (build parameters).
+MASTER_ADDRESSES = dict(mac=0x02_44_4D_00_00_F0, ip=0xC0_A8_01_09, port=5000)
+#: Longest frame the master's MAC takes (FCS included): its records are short, so a standard
+#: frame with a VLAN tag; longer ones are dropped whole and counted (``mac_oversize``).
+MASTER_MAX_FRAME = 1522
 #: VHDCI pins (single-ended) for each board's sync line and ready line, the trigger and the camera.
 _SYNC_PINS = ("1", "3", "4", "6")
 _READY_PINS = ("35", "37", "38", "40")
@@ -51,40 +68,144 @@ class SyncMasterPlatform(AtlysPlatform):
     resources = AtlysPlatform.resources + sync_master_resources()
 
 
+class SyncMasterCore(wiring.Component):
+    """The sync master (:class:`~gateware.sync.master.SyncMaster`) behind its network port: what
+    the board's top wires to its pins. Domains: ``sync`` (the master, the protocol), ``gmii_rx``
+    and ``gmii_tx``.
+
+    Parameters
+    ----------
+    boards : int
+    config : dict
+        The configuration at reset (:func:`~gateware.protocol.master.master_config_init`; times in
+        ``sync`` cycles).
+    mac, ip, port : int
+        Network addresses.
+    sync_hz : float
+        The ``sync`` clock (reported in status replies; the PHY's management timing).
+    mdio_cycles : (int, int) or None
+        The PHY's reset and settle times in cycles (None: the facts table's; a simulation
+        shortens them).
+
+    Members
+    -------
+    gmii_rx : In(gmii.RxPins)
+    gmii_tx : Out(gmii.TxPins)
+    phy_reset_n, mdc, mdio_o, mdio_oe : Out(1); mdio_i : In(1)
+        PHY reset and management.
+    trigger_in : In(1)
+        The frame trigger pin (asynchronous).
+    button : In(1)
+        A software trigger, on its rising edge (asynchronous: a push button).
+    ready : In(boards)
+        The boards' ready lines (asynchronous).
+    sync_out : Out(boards); camera_out : Out(1)
+        The master's pulses (registers: the platform puts them in the pads).
+    armed : Out(1)
+        Triggers are obeyed.
+    pulses, not_ready, early : Out(32)
+        The master's counts (also in the status reply).
+    """
+
+    def __init__(self, boards=BOARDS, *, config, mac, ip, port, sync_hz=SYNC_HZ, mdio_cycles=None):
+        self._boards, self._sync_hz = boards, sync_hz
+        self._mdio_cycles = mdio_cycles or (None, None)
+        self._endpoint = MasterEndpoint(config, mac=mac, ip=ip, port=port)
+        self._master = SyncMaster(boards)
+        super().__init__({
+            "gmii_rx": In(gmii.RxPins),
+            "gmii_tx": Out(gmii.TxPins),
+            "phy_reset_n": Out(1), "mdc": Out(1), "mdio_o": Out(1), "mdio_oe": Out(1), "mdio_i": In(1),
+            "trigger_in": In(1),
+            "button": In(1),
+            "ready": In(boards),
+            "sync_out": Out(boards),
+            "camera_out": Out(1),
+            "armed": Out(1),
+            "pulses": Out(32), "not_ready": Out(32), "early": Out(32),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.ethernet = ethernet = EthernetPort(self._endpoint, max_frame=MASTER_MAX_FRAME, rx_depth=4096)
+        m.d.comb += [ethernet.gmii_rx.eq(self.gmii_rx), self.gmii_tx.eq(ethernet.gmii_tx)]
+        m.submodules.phy = phy = StatusPoller(self._sync_hz, reset_cycles=self._mdio_cycles[0],
+                                              settle_cycles=self._mdio_cycles[1])
+        m.d.comb += [self.phy_reset_n.eq(phy.phy_reset_n), self.mdc.eq(phy.mdc), self.mdio_o.eq(phy.mdio_o),
+                     self.mdio_oe.eq(phy.mdio_oe), phy.mdio_i.eq(self.mdio_i)]
+
+        # the master obeys the configuration in force; a host's trigger or the button's edge
+        m.submodules.master = master = self._master
+        settings = ethernet.settings
+        button, was = Signal(), Signal()
+        m.submodules.button_sync = FFSynchronizer(self.button, button)
+        m.d.sync += was.eq(button)
+        m.d.comb += [
+            master.mode.eq(TriggerMode(settings.mode[:len(master.mode.as_value())])),
+            master.run.eq(settings.armed[0]), master.period.eq(settings.period),
+            master.min_period.eq(settings.min_period), master.width.eq(settings.width),
+            master.trigger_in.eq(self.trigger_in), master.ready.eq(self.ready),
+            master.soft.eq(ethernet.trigger | (button & ~was)),
+            self.sync_out.eq(master.sync_out), self.camera_out.eq(master.camera_out),
+            self.armed.eq(settings.armed[0]),
+            self.pulses.eq(master.pulses), self.not_ready.eq(master.not_ready), self.early.eq(master.early),
+        ]
+
+        # the status reply: the master's counts, its boards' ready lines, what it obeys
+        status = ethernet.status
+        report_port(m, ethernet, status, self._sync_hz)
+        ready = Signal(self._boards)
+        m.submodules.ready_sync = FFSynchronizer(self.ready, ready)
+        m.d.comb += [status.boards.eq(self._boards), status.ready.eq(ready),
+                     status.pulses.eq(master.pulses), status.not_ready.eq(master.not_ready),
+                     status.early.eq(master.early),
+                     *[status[name].eq(settings[name]) for name, _ in records.MASTER_CONFIG]]
+        return m
+
+
 class SyncMasterTop(Elaboratable):
-    """The sync master for :class:`SyncMasterPlatform`.
+    """:class:`SyncMasterCore` on :class:`SyncMasterPlatform`.
 
     Parameters
     ----------
     boards : int
     period_s, min_period_s, width_s : float
-        The periodic trigger's period, the shortest frame period the boards keep (a trigger
-        sooner after the last pulse is refused), and each pulse's width.
-
-    Switches: 0-1 the trigger mode (:class:`~gateware.registers.TriggerMode`: 0 the pin, 1 the
-    period, 2 software, button 0; 3, the sync input, has no source here and obeys nothing), 7 arms. LEDs: 0-3 the boards
-    ready, 4 toggles at each pulse, 5 at each refusal for a board not ready, 6 for one too early.
+        The configuration at power-up (a host changes it): the periodic trigger's period, the
+        shortest frame period the boards keep (a trigger sooner after the last pulse is
+        refused), and each pulse's width.
     """
 
     def __init__(self, boards=BOARDS, *, period_s=1 / 400, min_period_s=1 / 460, width_s=1e-6):
         assert boards <= len(_SYNC_PINS)
         self._boards = boards
-        self._period, self._min_period, self._width = (round(t * SYNC_HZ) for t in (period_s, min_period_s, width_s))
+        period, min_period, width = (round(t * SYNC_HZ) for t in (period_s, min_period_s, width_s))
+        self._config = master_config_init(mode=TriggerMode.EXTERNAL, armed=False, period=period,
+                                          min_period=min_period, width=width)
 
     def elaborate(self, platform):
         m = Module()
         boards = self._boards
-        m.submodules.master = master = SyncMaster(boards)
-        m.d.comb += [master.period.eq(self._period), master.min_period.eq(self._min_period),
-                     master.width.eq(self._width)]
+
+        # clocks: sync and gmii_tx from the PLL, gmii_rx from the PHY
+        m.submodules.clk_buf = clk_buf = io.Buffer("i", platform.request(platform.default_clk, dir="-"))
+        m.submodules.rst_buf = rst_buf = io.Buffer("i", platform.request(platform.default_rst, dir="-"))
+        m.domains += [*Spartan6Clocks.domains(None), ClockDomain("gmii_rx")]
+        m.submodules.clocks = clocks = Spartan6Clocks(clk_buf.i, rst_buf.i, None, platform.default_clk_frequency)
+        m.submodules.gmii = pins = GmiiPins(clocks.locked)
+
+        m.submodules.core = core = SyncMasterCore(boards, config=self._config, **MASTER_ADDRESSES)
+        m.d.comb += [core.gmii_rx.eq(pins.rx), pins.tx.eq(core.gmii_tx),
+                     pins.phy_reset_n.eq(core.phy_reset_n), pins.mdc.eq(core.mdc), pins.mdio_o.eq(core.mdio_o),
+                     pins.mdio_oe.eq(core.mdio_oe), core.mdio_i.eq(pins.mdio_i)]
 
         # the outputs from flip-flops in their pads
         for k in range(boards):
             m.submodules[f"sync{k}"] = pad = io.FFBuffer("o", platform.request("board_sync", k, dir="-"))
-            m.d.comb += pad.o.eq(master.sync_out[k])
+            m.d.comb += pad.o.eq(core.sync_out[k])
         m.submodules.camera = camera = io.FFBuffer("o", platform.request("camera_trigger_out", 0, dir="-"))
-        m.d.comb += camera.o.eq(master.camera_out)
-        def pins(direction, name, count):
+        m.d.comb += camera.o.eq(core.camera_out)
+
+        def pins_of(direction, name, count):
             """Resource ``name`` 0..count-1 through plain buffers: their values, or their drives."""
             values = []
             for k in range(count):
@@ -92,23 +213,12 @@ class SyncMasterTop(Elaboratable):
                 values.append(buffer.i if direction == "i" else buffer.o)
             return Cat(values)
 
-        # the inputs are asynchronous: the master synchronises them
-        ready = pins("i", "board_ready", boards)
-        m.d.comb += [master.ready.eq(ready), master.trigger_in.eq(pins("i", "frame_trigger_in", 1))]
+        # the inputs are asynchronous: the core synchronises them
+        ready = pins_of("i", "board_ready", boards)
+        m.d.comb += [core.ready.eq(ready), core.trigger_in.eq(pins_of("i", "frame_trigger_in", 1)),
+                     core.button.eq(pins_of("i", "button", 1))]
 
-        # switches and buttons: synchronised; the button's rising edge is one software trigger
-        switches = Signal(8)
-        m.submodules.switches = FFSynchronizer(pins("i", "switch", 8), switches)
-        button, was = Signal(), Signal()
-        m.submodules.button = FFSynchronizer(pins("i", "button", 1), button)
-        m.d.sync += was.eq(button)
-        m.d.comb += [master.mode.eq(TriggerMode(switches[0:2])), master.run.eq(switches[7]),
-                     master.soft.eq(button & ~was)]
-
-        # LEDs: the ready lines, and a toggle per pulse and per refusal
-        leds = pins("o", "led", 8)
-        toggles = Signal(3)
-        for bit, counter in enumerate((master.pulses, master.not_ready, master.early)):
-            m.d.comb += toggles[bit].eq(counter[0])
-        m.d.comb += leds.eq(Cat(ready, toggles))
+        # LEDs: the ready lines, a toggle per pulse and per refusal, armed
+        toggles = Cat(counter[0] for counter in (core.pulses, core.not_ready, core.early))
+        m.d.comb += pins_of("o", "led", 8).eq(Cat(ready, toggles, core.armed))
         return m

@@ -26,7 +26,8 @@ from gateware.dlpc410.register_crossing import RegisterCrossing
 from gateware.dlpc410.sequencer import Sequencer
 from gateware.mac import gmii
 from gateware.mac.mdio import StatusPoller
-from gateware.protocol.port import EthernetPort
+from gateware.protocol.endpoint import Endpoint
+from gateware.protocol.port import EthernetPort, report_port
 from gateware.queue import AsyncQueue
 from gateware.registers import LSB_BITS, TriggerMode
 from gateware.store import mcb
@@ -160,8 +161,8 @@ class Projector(wiring.Component):
         dmd = self._dmd
 
         # ---- Ethernet: GMII MAC, stack and application protocol (gmii_rx / gmii_tx -> sync) ------
-        m.submodules.ethernet = ethernet = EthernetPort(dmd, frame_bits=FRAME_BITS, armed=self._armed,
-                                                        beats=self._beats, **self._addresses)
+        m.submodules.ethernet = ethernet = EthernetPort(Endpoint(dmd, frame_bits=FRAME_BITS, armed=self._armed,
+                                                                 beats=self._beats, **self._addresses))
         m.d.comb += [ethernet.gmii_rx.eq(self.gmii_rx), self.gmii_tx.eq(ethernet.gmii_tx)]
 
         m.submodules.phy = phy = StatusPoller(self._sync_hz, reset_cycles=self._mdio_cycles[0],
@@ -246,10 +247,8 @@ class Projector(wiring.Component):
         ]
 
         # ---- Status: what the status reply reports, carried into sync ---------------------------
-        uptime = Signal(48)
-        m.d.sync += uptime.eq(uptime + 1)
-        m.d.comb += [ethernet.status.uptime_cycles.eq(uptime), ethernet.status.clock_hz.eq(int(self._sync_hz))]
         status = ethernet.status
+        report_port(m, ethernet, status, self._sync_hz)
         for name, source in (("triggers", seq.status.triggers), ("trigger_overruns", seq.status.overruns),
                              ("frames_shown", seq.status.frames), ("triggers_early", seq.status.early),
                              ("triggers_held", seq.status.held),
@@ -269,12 +268,8 @@ class Projector(wiring.Component):
                                                                       o_domain="sync")
         m.submodules.clock_loop_locked_cdc = FFSynchronizer(trim.locked, status.clock_loop_locked[0])
         m.d.comb += [slips.i.eq(trim.slips), status.clock_loop_slips.eq(slips.o)]
-        for verdict, _ in ethernet.mac_counters.shape():
-            m.d.comb += status[f"mac_{verdict}"].eq(ethernet.mac_counters[verdict])
         store_counts = store.counters
         m.d.comb += [
-            status.mac_rx_dropped.eq(ethernet.rx_dropped),
-            status.mac_tx_underruns.eq(ethernet.tx_underruns),
             status.store_frames_complete.eq(store_counts.frames_complete),
             status.store_frames_replaced.eq(store_counts.frames_replaced),
             status.store_frames_abandoned.eq(store_counts.frames_abandoned),

@@ -9,6 +9,7 @@ from amaranth import Module
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
+from gateware.protocol.endpoint import Endpoint
 from gateware.protocol.port import EthernetPort
 from sim.models.frames import Addresses
 from spec.facts import DMDS
@@ -51,4 +52,4 @@ class EthernetPins(wiring.Component):
 def build(dmd="dlp7000"):
     """The port as tested and benchmarked: the shipping geometry, the test addresses."""
     a = Addresses()
-    return EthernetPins(EthernetPort(DMDS[dmd], mac=a.mac, ip=a.ip, port=a.port))
+    return EthernetPins(EthernetPort(Endpoint(DMDS[dmd], mac=a.mac, ip=a.ip, port=a.port)))

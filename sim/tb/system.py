@@ -24,37 +24,31 @@ must be a whole, correct frame.
 import dataclasses
 import json
 import time
-import zlib
 from pathlib import Path
 
 import cocotb
 import numpy as np
 from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
+from cocotb.triggers import ClockCycles, RisingEdge, Timer
 from cocotb.utils import get_sim_time
-from scapy.layers.inet import IP, UDP
-from scapy.layers.l2 import Ether
-from scapy.packet import Raw
 
 from gateware.dlpc410.sequencer import Status as SequencerStatus
-from gateware.mac.gmii import TxPins
 from gateware.store.slots import SlotCounters
 from host import codec
 from sim.harness.cocotb_run import params
-from sim.harness.layout import fields, unpack
-from sim.models import gmii
+from sim.harness.layout import unpack
 from sim.models.camera import Camera, to_lsb
 from sim.models.dlpc410 import CocotbAdapter, Dlpc410
 from sim.models.mcb import CocotbPort, McbModel
 from sim.models.net import Model
 from sim.scene import default_scene
 from sim.system import plan as run_plan
+from sim.tb.gmii_host import GmiiHost
 from spec import records, wire
 from spec.facts import DMDS
 from spec.registers import PlaneOrder, TriggerMode
 
 SYNC_NS, GMII_NS, DMD_NS = 8.0, 8.0, 5.0
-HOST_MAC, HOST_IP, HOST_PORT = "02:00:00:00:00:99", "10.0.0.1", 40000
 
 
 def _address(text):
@@ -91,7 +85,7 @@ class Edges:
         assert _now_ps() == target, "the clock's edges are not where they were counted"
 
 
-class System:
+class System(GmiiHost):
     def __init__(self, dut, p):
         self.dut, self.p = dut, p
         self.dmd = DMDS[p["dmd"]]
@@ -100,13 +94,9 @@ class System:
         self.dlpc = Dlpc410(self.dmd, clock_hz=1e9 / DMD_NS, rst_active_cycles=p["t_rst"],
                             settle_cycles=p["t_settle"], init_cycles=p["init_cycles"],
                             init_grace_cycles=p["init_grace"], check_training=p.get("check_training", True))
-        self.net = Model(self.dmd, _address(p["mac"]), _address(p["ip"]), p["port"])
+        super().__init__(dut, p["mac"], p["ip"], p["port"],
+                         net=Model(self.dmd, _address(p["mac"]), _address(p["ip"]), p["port"]))
         self.dmd_clock = None            # the dmd clock's edges, once started
-        self.frames_sent = 0
-        self.mac = {"good": 0, "bad_fcs": 0}
-        self.sequence = 0                # the host's record counter, as host.Client keeps it
-        self.replies = []                # UDP payloads of frames on the transmit pins
-        self.tx_frames = []              # every frame on the transmit pins (no FCS)
 
     @classmethod
     async def started(cls, dut):
@@ -138,7 +128,7 @@ class System:
         cocotb.start_soon(CocotbPort(dut, "mcb_read", dut.dmd_clk, self.memory.ports[1], DMD_NS).run())
         # resting through quiet stretches: the testbench reads the model's commands, not its cycle
         self.adapter = cocotb.start_soon(CocotbAdapter(self.dlpc, dut, dut.dmd_clk, rest=True).run())
-        cocotb.start_soon(self._receive_tx())
+        self.listen()
         self.counted_from = self.dmd_clock.count()
 
     @property
@@ -147,41 +137,7 @@ class System:
         included (the count the DLPC410 model's cycles follow)."""
         return self.dmd_clock.count() - self.counted_from
 
-    async def _receive_tx(self):
-        """Frames on the GMII transmit pins: preamble and SFD stripped, FCS checked. The pins
-        are registered on the transmit clock: sampled mid-cycle (falling edge) every cycle of a
-        frame, and between frames only once they change."""
-        pins, edge, frame = self.dut.gmii_tx, FallingEdge(self.dut.gmii_tx_clk), bytearray()
-        tx = {name: (offset, mask) for name, offset, mask in fields(TxPins)}
-        (d, d_mask), (en, _), (er, _) = tx["d"], tx["en"], tx["er"]
-        while True:
-            await edge
-            value = pins.value.to_unsigned()
-            assert not value >> er & 1, "tx_er on the transmit pins"
-            if value >> en & 1:
-                frame.append(value >> d & d_mask)
-                continue
-            if frame:
-                assert frame[:8] == gmii.PREAMBLE, "preamble or SFD wrong"
-                body = bytes(frame[8:])
-                assert zlib.crc32(body) == 0x2144DF1C, "bad FCS on a transmitted frame"
-                self.tx_frames.append(body[:-4])
-                packet = Ether(body[:-4])
-                if UDP in packet:
-                    self.replies.append(bytes(packet[UDP].payload))
-                frame = bytearray()
-            await pins.value_change
-
     # -- what the host sends ----------------------------------------------------------------
-
-    def datagram(self, payload, *, port=None):
-        p = self.p
-        return bytes(Ether(src=HOST_MAC, dst=p["mac"]) / IP(src=HOST_IP, dst=p["ip"])
-                     / UDP(sport=HOST_PORT, dport=p["port"] if port is None else port) / Raw(payload))
-
-    def next_sequence(self, count=1):
-        first, self.sequence = self.sequence, self.sequence + count
-        return first
 
     def image(self, picture, frame):
         encoded = codec.image_records(picture, frame, sequence=self.sequence)
@@ -189,23 +145,7 @@ class System:
         return encoded
 
     async def send(self, frames, bad_fcs=()):
-        """Drive GMII with ``frames`` (Ethernet frames, no FCS): preamble, FCS (corrupted for the
-        indices in ``bad_fcs``), minimum gaps. The reference model sees each as the MAC will."""
-        edge = RisingEdge(self.dut.gmii_rx_clk)
-        self.frames_sent += len(frames)
-        for i, frame in enumerate(frames):
-            wire = bytearray(gmii.wire_bytes(frame))
-            bad = i in bad_fcs
-            if bad:
-                wire[-1] ^= 0x40
-            self.mac["bad_fcs" if bad else "good"] += 1
-            self.net.frame(frame, bad)
-            for byte in gmii.PREAMBLE + bytes(wire):
-                await edge
-                self.dut.gmii_rx.value = byte | (1 << 8)
-            for _ in range(gmii.MIN_GAP):
-                await edge
-                self.dut.gmii_rx.value = 0
+        await super().send(frames, bad_fcs)
         self.sent_at = self.dmd_cycle
 
     async def delivered(self):
@@ -224,19 +164,6 @@ class System:
         """Send records, each in its own datagram to the projector, and wait until they have
         taken effect."""
         await self.deliver([self.datagram(r) for r in encoded])
-
-    async def status(self):
-        """Ask for a status reply over GMII; its fields as a dict."""
-        sequence = self.next_sequence()
-        count = len(self.replies)
-        await self.send([self.datagram(codec.status_query(sequence))])
-        for _ in range(200):
-            await ClockCycles(self.dut.clk, 100)
-            for raw in self.replies[count:]:
-                head, body, _rest = codec.decode(raw)
-                if head["type"] == records.RecordType.STATUS_REPLY and head["sequence"] == sequence:
-                    return body
-        raise AssertionError("no status reply on the transmit pins")
 
     # -- triggers and what the DMD shows ---------------------------------------------------
 
