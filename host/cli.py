@@ -1,11 +1,12 @@
 """Command line: ``python -m host send IMAGE...``, ``configure``, ``arm``/``disarm``, ``trigger`` and
-``status``.
+``status``; ``master ADDRESS`` for a tiled display's sync master.
 
 ``send`` sizes records to the path MTU (``--mtu`` to say it), continues after the newest frame id
 the projector has (``--frame`` to choose), sends each frame at the smallest bit depth that shows it
 within ``--tolerance`` LSB (``--depth`` to fix it), with ``--delta`` sends a scene's images as delta
 frames of the last whole frame where few rows changed, and checks in a status reply that the
-projector took every record (``--no-check`` not to)."""
+projector took every record (``--no-check`` not to). ``master`` sets the sync master's trigger
+(times in seconds), fires a software trigger and prints its status."""
 
 import argparse
 import dataclasses
@@ -18,7 +19,7 @@ from spec import plan_search, schedule
 from spec.facts import DMDS, SETTLE_READINGS
 from spec.registers import PlaneOrder, ResetMode, TriggerMode
 
-from .client import DEFAULT_PORT, DELTA_ROWS, Client, ClientError, period_fault
+from .client import DEFAULT_PORT, DELTA_ROWS, Client, ClientError, MasterClient, period_fault
 
 __all__ = ["main", "describe"]
 
@@ -90,6 +91,29 @@ def describe(plan):
             f"set by {plan.binds}")
 
 
+def _print_status(status):
+    for name, value in status.items():
+        print(f"{name:24} {value}")
+
+
+def _master(args):
+    """``master``: configure the sync master, then fire a software trigger, then print its
+    status, as asked (its status alone when nothing is)."""
+    settings = {"mode": TriggerMode[args.mode.upper()] if args.mode else None, "armed": args.armed,
+                "period_s": args.period, "min_period_s": args.min_period, "width_s": args.width}
+    settings = {name: value for name, value in settings.items() if value is not None}
+    with MasterClient(args.address, args.port, timeout=args.timeout) as master:
+        if settings:
+            now = master.configure(**settings)
+            print(f"sync master: mode {TriggerMode(now['mode']).name.lower()}, "
+                  f"{'armed' if now['armed'] else 'disarmed'}, period {now['period']}, "
+                  f"min_period {now['min_period']}, width {now['width']} cycles")
+        if args.trigger:
+            master.trigger()
+        if args.status or not (settings or args.trigger):
+            _print_status(master.status())
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m host", description=__doc__)
     parser.add_argument("--address", default="192.168.1.10", help="projector IPv4 address")
@@ -157,9 +181,29 @@ def main(argv=None):
                        ("trigger", "a software trigger (the sequencer's trigger mode must be software)")):
         sub.add_parser(name, help=text)
     sub.add_parser("status", help="print the projector's counters")
+    master = sub.add_parser("master", help="a tiled display's sync master: set its trigger, fire it, "
+                                           "print its status (the default)")
+    master.add_argument("address", help="the sync master's IPv4 address")
+    # SUPPRESS: without --port here, the one given before the command (or its default) holds
+    master.add_argument("--port", type=int, default=argparse.SUPPRESS,
+                        help=f"the master's UDP port (default: --port before the command, {DEFAULT_PORT})")
+    master.add_argument("--mode", choices=[m.name.lower() for m in TriggerMode if m != TriggerMode.SYNC],
+                        help="what starts a frame: the trigger pin, a period, a software trigger (--trigger)")
+    arming = master.add_mutually_exclusive_group()
+    arming.add_argument("--arm", dest="armed", action="store_const", const=True, help="obey triggers")
+    arming.add_argument("--disarm", dest="armed", action="store_const", const=False, help="ignore every trigger")
+    master.add_argument("--period", type=float, metavar="S", help="periodic trigger: seconds between frames")
+    master.add_argument("--min-period", type=float, metavar="S",
+                        help="seconds from a pulse before the next trigger is obeyed (the boards' frame period)")
+    master.add_argument("--width", type=float, metavar="S", help="seconds each sync and camera pulse lasts")
+    master.add_argument("--trigger", action="store_true", help="fire a software trigger (after the settings)")
+    master.add_argument("--status", action="store_true", help="print the master's counters and settings")
     args = parser.parse_args(argv)
 
     try:
+        if args.command == "master":
+            _master(args)
+            return 0
         if args.command == "configure":
             dmd, plan = _plan(args)
             print(f"{dmd.name}, {args.depth}-bit: {describe(plan)}")
@@ -195,8 +239,7 @@ def main(argv=None):
             elif args.command == "trigger":
                 client.control(software_trigger=True)
             else:
-                for name, value in client.status().items():
-                    print(f"{name:24} {value}")
+                _print_status(client.status())
     except (ClientError, ValueError) as error:
         print(f"error: {error}", file=sys.stderr)
         return 1

@@ -22,6 +22,10 @@ What it does for the user:
   record taken and every row handed on; otherwise :class:`ClientError` says what the projector
   counted instead (fragments, overflow, refused rows, ...). A delta the projector refused because
   it no longer holds the key frame is sent again as a whole frame.
+
+:class:`MasterClient` talks to the sync master of a tiled display over the same link: it sets
+the master's trigger in seconds, refusing before it sends what the master would drop, fires
+software triggers and reads its status.
 """
 
 import dataclasses
@@ -38,7 +42,7 @@ from spec.registers import TriggerMode
 
 from . import codec, levels
 
-__all__ = ["Client", "ClientError", "Sent", "DEFAULT_PORT", "DELTA_ROWS", "path_mtu", "period_fault"]
+__all__ = ["Client", "MasterClient", "ClientError", "Sent", "DEFAULT_PORT", "DELTA_ROWS", "path_mtu", "period_fault"]
 
 DEFAULT_PORT = 5000
 #: A starting point for ``delta``: a delta then sends at most half a whole frame's pixels; an
@@ -142,35 +146,17 @@ def path_mtu(sock):
         return None
 
 
-class Client:
-    """Talks to one projector.
+class _Link:
+    """What a client of any of the protocol's devices does: a connected UDP socket that sends
+    with the don't-fragment flag, paced; record sequence numbers; the status query, answered by
+    a record of type :attr:`_REPLY` (a subclass's)."""
 
-    Parameters
-    ----------
-    address : str
-        The projector's IPv4 address.
-    port : int
-        Its UDP port.
-    timeout : float
-        Seconds to wait for a status reply.
-    rate : float or None
-        Pacing: at most this many bytes of records per second (None: as fast as the socket
-        takes them). The gateware keeps up with a full gigabit line; pacing protects switches
-        and the host's own buffers.
-    mtu : int or None
-        IP MTU of the path to the projector; default: what the operating system knows (the
-        route's MTU, lowered by any ICMP "fragmentation needed" it has seen), else 1,500.
-    check : bool
-        After each frame, read a status reply and raise :class:`ClientError` if the projector
-        did not take every record and hand on every row.
-    """
+    _REPLY = None
 
-    def __init__(self, address, port=DEFAULT_PORT, *, timeout=1.0, rate=None, mtu=None, check=True,
-                 bind=("0.0.0.0", 0)):
+    def __init__(self, address, port=DEFAULT_PORT, *, timeout=1.0, rate=None, mtu=None, bind=("0.0.0.0", 0)):
         self.peer = (address, port)
         self.timeout = timeout
         self.rate = rate
-        self.check = check
         self.sequence = 0
         self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
@@ -183,15 +169,9 @@ class Client:
             raise ClientError(f"cannot reach {address}:{port}: {error}") from error
         self._sock.settimeout(timeout)
         self.mtu = mtu or path_mtu(self._sock) or 1500
-        self.limit = records.record_limit(self.mtu)
-        if self.limit <= records.DELTA_HEADER:
-            raise ClientError(f"an MTU of {self.mtu} bytes leaves no room for pixels")
         self._paced_since = None
         self._paced_bytes = 0
-        self._depth = None         # the bit depth this client last set
-        self._next_frame = None    # the frame id to send next (known after the first status)
         self._last = None          # the last status reply read
-        self._key = None           # the last whole frame sent, (id, Quantised): the base of deltas
 
     def close(self):
         self._sock.close()
@@ -239,6 +219,73 @@ class Client:
         for record in encoded:
             self._send(record)
         return len(encoded)
+
+    # -- status ------------------------------------------------------------------------------
+
+    def status(self, retries=2):
+        """Ask for a status reply (the device's: a projector's, a sync master's) and return its
+        fields as a dict."""
+        for _attempt in range(retries + 1):
+            sequence = self._next()
+            self._send(codec.status_query(sequence))
+            deadline = time.monotonic() + self.timeout
+            while (left := deadline - time.monotonic()) > 0:
+                self._sock.settimeout(left)
+                try:
+                    raw = self._sock.recv(65536)
+                except socket.timeout:
+                    break
+                except OSError as error:
+                    raise ClientError(f"no status from {self.peer[0]}:{self.peer[1]}: {error}") \
+                        from error
+                try:
+                    head, body, _rest = codec.decode(raw)
+                except codec.ProtocolError as error:
+                    raise ClientError(f"bad status reply from {self.peer[0]}:{self.peer[1]}: {error}") \
+                        from error
+                if head["type"] == self._REPLY and head["sequence"] == sequence:
+                    self._last = body
+                    return body
+        raise ClientError(f"no status reply from {self.peer[0]}:{self.peer[1]} "
+                          f"after {retries + 1} tries of {self.timeout} s")
+
+
+class Client(_Link):
+    """Talks to one projector.
+
+    Parameters
+    ----------
+    address : str
+        The projector's IPv4 address.
+    port : int
+        Its UDP port.
+    timeout : float
+        Seconds to wait for a status reply.
+    rate : float or None
+        Pacing: at most this many bytes of records per second (None: as fast as the socket
+        takes them). The gateware keeps up with a full gigabit line; pacing protects switches
+        and the host's own buffers.
+    mtu : int or None
+        IP MTU of the path to the projector; default: what the operating system knows (the
+        route's MTU, lowered by any ICMP "fragmentation needed" it has seen), else 1,500.
+    check : bool
+        After each frame, read a status reply and raise :class:`ClientError` if the projector
+        did not take every record and hand on every row.
+    """
+
+    _REPLY = RecordType.STATUS_REPLY
+
+    def __init__(self, address, port=DEFAULT_PORT, *, timeout=1.0, rate=None, mtu=None, check=True,
+                 bind=("0.0.0.0", 0)):
+        super().__init__(address, port, timeout=timeout, rate=rate, mtu=mtu, bind=bind)
+        self.check = check
+        self.limit = records.record_limit(self.mtu)
+        if self.limit <= records.DELTA_HEADER:
+            self.close()
+            raise ClientError(f"an MTU of {self.mtu} bytes leaves no room for pixels")
+        self._depth = None         # the bit depth this client last set
+        self._next_frame = None    # the frame id to send next (known after the first status)
+        self._key = None           # the last whole frame sent, (id, Quantised): the base of deltas
 
     # -- frames ------------------------------------------------------------------------------
 
@@ -425,28 +472,69 @@ class Client:
         self._send(codec.sequencer_record(plan.params.registers(dmd), self._next(), dmd=dmd,
                                           beats=plan.params.beats))
 
-    def status(self, retries=2):
-        """Ask for a status reply and return its fields as a dict."""
-        for _attempt in range(retries + 1):
-            sequence = self._next()
-            self._send(codec.status_query(sequence))
-            deadline = time.monotonic() + self.timeout
-            while (left := deadline - time.monotonic()) > 0:
-                self._sock.settimeout(left)
-                try:
-                    raw = self._sock.recv(65536)
-                except socket.timeout:
-                    break
-                except OSError as error:
-                    raise ClientError(f"no status from {self.peer[0]}:{self.peer[1]}: {error}") \
-                        from error
-                try:
-                    head, body, _rest = codec.decode(raw)
-                except codec.ProtocolError as error:
-                    raise ClientError(f"bad status reply from {self.peer[0]}:{self.peer[1]}: {error}") \
-                        from error
-                if head["type"] == RecordType.STATUS_REPLY and head["sequence"] == sequence:
-                    self._last = body
-                    return body
-        raise ClientError(f"no status reply from {self.peer[0]}:{self.peer[1]} "
-                          f"after {retries + 1} tries of {self.timeout} s")
+
+class MasterClient(_Link):
+    """Talks to the sync master of a tiled display (``docs/protocol.md``, Master control record).
+
+    Parameters
+    ----------
+    address : str
+        The master's IPv4 address.
+    port : int
+        Its UDP port.
+    timeout : float
+        Seconds to wait for a status reply.
+    rate, mtu, bind
+        As :class:`Client`'s (a master's records are short: they hardly matter).
+    """
+
+    _REPLY = RecordType.MASTER_STATUS
+
+    def configure(self, *, mode=None, armed=None, period_s=None, min_period_s=None, width_s=None):
+        """Set the given settings (the others keep their values) in one master control record.
+
+        Times are in seconds, sent as whole cycles of the master's clock (``clock_hz`` from a
+        status reply read first, rounded to the nearest). The configuration the record would
+        leave in force is checked as the master checks it
+        (:func:`spec.records.master_config_faults`, and each value against its field's width);
+        one it would drop raises :class:`ClientError` naming the failed checks, before anything
+        is sent.
+
+        Parameters
+        ----------
+        mode : spec.registers.TriggerMode or int, optional
+            What starts a frame: EXTERNAL (the trigger pin), PERIODIC or SOFTWARE (:meth:`trigger`).
+        armed : bool, optional
+            Triggers are obeyed only while armed.
+        period_s, min_period_s, width_s : float, optional
+            The periodic trigger's period; the shortest time from one pulse to the next trigger
+            obeyed (the frame period every board keeps); each sync and camera pulse's length.
+
+        Returns
+        -------
+        dict
+            The configuration now in force (:data:`spec.records.MASTER_CONFIG`'s fields, in cycles).
+        """
+        status = self.status()
+        fields = {name: int(value) for name, value in (("mode", mode), ("armed", armed)) if value is not None}
+        fields |= {name: round(seconds * status["clock_hz"])
+                   for name, seconds in (("period", period_s), ("min_period", min_period_s), ("width", width_s))
+                   if seconds is not None}
+        widths = dict(records.MASTER_CONFIG)
+        merged = {name: fields.get(name, status[name]) for name in widths}
+        faults = records.master_config_faults(merged)
+        # a value wider than its field does not go on the wire at all: a failed check as well
+        faults |= {f"{name}_fits": True for name, value in fields.items() if not 0 <= value < 1 << widths[name]}
+        failed = [check for check, bad in faults.items() if bad]
+        if failed:
+            now = ", ".join(f"{name} {value}" for name, value in merged.items())
+            raise ClientError(f"the sync master cannot take this configuration ({now}; times in cycles of "
+                              f"{status['clock_hz']} Hz): {', '.join(failed)}")
+        self._send(codec.master_control_record(self._next(), **fields))
+        return merged
+
+    def trigger(self):
+        """Fire one software trigger (a master control record setting nothing). The master obeys
+        it only in mode SOFTWARE, armed, with every board ready and ``min_period`` passed since
+        its last pulse; its status counts what it refused (``not_ready``, ``early``)."""
+        self._send(codec.master_control_record(self._next(), software_trigger=True))

@@ -8,7 +8,7 @@ from spec.schedule import row_cycles
 
 __all__ = ["ProtocolError", "header", "image_record", "image_records", "changed_rows", "sequence_records",
            "pixels_per_record", "control_record", "sequencer_record", "entry_record", "status_query",
-           "status_reply", "decode",
+           "status_reply", "master_control_record", "master_status_reply", "decode",
            "SEQUENCE_MASK", "DEFAULT_LIMIT"]
 
 #: Record sequence numbers wrap at this mask.
@@ -104,18 +104,34 @@ def sequence_records(images, first_frame=0, *, sequence=0, limit=DEFAULT_LIMIT):
     return out
 
 
-def control_record(sequence=0, *, software_trigger=False, sequence_start=False, **config):
-    """A control record setting the given :data:`~spec.records.CONFIG` fields
-    (others unchanged) and optionally firing a software trigger or playing the sequence's
-    entries from the first (``sequence_start``, after the fields are set)."""
-    names = [name for name, _ in records.CONFIG]
+def _settings_record(record_type, table, fields, sequence, action, config):
+    """A record of ``table`` (``apply``, ``action``, then the ``fields`` table) that sets the
+    given ``config`` fields, its ``apply`` bit i set for each given field i, and does ``action``."""
+    names = [name for name, _ in fields]
     unknown = set(config) - set(names)
     if unknown:
         raise KeyError(f"not a configuration field: {sorted(unknown)}")
     apply = sum(1 << names.index(name) for name in config)
+    body = wire.pack(table, {"apply": apply, "action": int(action), **config})
+    return header(record_type, sequence) + body
+
+
+def control_record(sequence=0, *, software_trigger=False, sequence_start=False, **config):
+    """A control record setting the given :data:`~spec.records.CONFIG` fields
+    (others unchanged) and optionally firing a software trigger or playing the sequence's
+    entries from the first (``sequence_start``, after the fields are set)."""
     action = (Action.SOFTWARE_TRIGGER if software_trigger else 0) | (Action.SEQUENCE_START if sequence_start else 0)
-    body = wire.pack(records.CONTROL, {"apply": apply, "action": int(action), **config})
-    return header(RecordType.CONTROL, sequence) + body
+    return _settings_record(RecordType.CONTROL, records.CONTROL, records.CONFIG, sequence, action, config)
+
+
+def master_control_record(sequence=0, *, software_trigger=False, **config):
+    """A sync master's control record setting the given :data:`~spec.records.MASTER_CONFIG`
+    fields (others unchanged; times in the master's cycles) and optionally firing a software
+    trigger after they are set. The master drops a record whose configuration it cannot take
+    (:func:`spec.records.master_config_faults`, checked by :meth:`host.client.MasterClient.configure`)."""
+    action = Action.SOFTWARE_TRIGGER if software_trigger else 0
+    return _settings_record(RecordType.MASTER_CONTROL, records.MASTER_CONTROL, records.MASTER_CONFIG, sequence,
+                            action, config)
 
 
 def sequencer_record(registers, sequence=0, *, dmd=None, beats=1):
@@ -165,6 +181,11 @@ def status_reply(sequence, values):
     return header(RecordType.STATUS_REPLY, sequence) + wire.pack(records.STATUS_REPLY, values)
 
 
+def master_status_reply(sequence, values):
+    """A sync master's status reply record (what its gateware sends; used by test servers)."""
+    return header(RecordType.MASTER_STATUS, sequence) + wire.pack(records.MASTER_STATUS_REPLY, values)
+
+
 _BODIES = {
     RecordType.IMAGE: records.IMAGE,
     RecordType.DELTA: records.DELTA,
@@ -173,6 +194,8 @@ _BODIES = {
     RecordType.STATUS_REPLY: records.STATUS_REPLY,
     RecordType.SEQUENCER: records.SEQUENCER,
     RecordType.ENTRY: records.ENTRY,
+    RecordType.MASTER_CONTROL: records.MASTER_CONTROL,
+    RecordType.MASTER_STATUS: records.MASTER_STATUS_REPLY,
 }
 
 

@@ -1,16 +1,21 @@
 """The host client and CLI against an in-process UDP server on 127.0.0.1 that plays projector
 with the reference models: the endpoint's (records, rows, counters) and the store's frame-slot
 policy (which frames it takes, which rows it refuses, which whole frame a delta frame takes its
-other rows from); a software trigger shows the newest complete frame."""
+other rows from); a software trigger shows the newest complete frame.
+
+The sync master's client and ``python -m host master`` against one that plays sync master as
+``docs/protocol.md`` describes it; its record bytes are checked against encodings written out
+here with :mod:`struct`."""
 
 import dataclasses
 import socket
+import struct
 import threading
 
 import numpy as np
 import pytest
 
-from host import Client, ClientError, cli, codec, levels
+from host import Client, ClientError, MasterClient, cli, codec, levels
 from sim.models.net import Model
 from sim.models.slots import SlotPolicy
 from spec import records
@@ -20,29 +25,30 @@ from spec.registers import PlaneOrder, TriggerMode
 #: The store's refusals, summed into the status reply's ``store_rows_refused``.
 REFUSALS = ("rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot", "rows_no_base")
 SHAPE = (TEST_DMD.rows, TEST_DMD.columns)
+#: The common header: magic "DM", version, type, sequence.
+HEADER = ">HBBB"
+#: A sync master's MASTER_CONFIG fields in ``apply`` bit order, as the protocol page lists them.
+NAMES = ("mode", "armed", "period", "min_period", "width")
+STATUS_QUERY, MASTER_CONTROL, MASTER_STATUS = 3, 8, 9
 
 
-class FakeProjector:
-    """Decodes every datagram with the reference model, stores its rows with the store's policy;
-    answers status queries (or, with ``mode``, answers badly or not at all)."""
+class LoopbackDevice:
+    """A device on a UDP socket of 127.0.0.1 (``port``), served by a thread once started: each
+    datagram is kept in ``received`` and handed to :meth:`take`, whose answer (bytes; None for
+    none) goes back to its sender."""
 
-    def __init__(self, mode="good"):
+    def __init__(self):
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.bind(("127.0.0.1", 0))
         self.sock.settimeout(0.05)
         self.port = self.sock.getsockname()[1]
-        self.model = Model(TEST_DMD, 0x020000000001, 0x7F000001, self.port, frame_bits=16)
-        self.store = SlotPolicy(TEST_DMD.rows, slots=4)
-        self.shown = None
-        self.depths = []            # bit depth of each frame the store completed
-        self.kinds = {}             # frame id -> (base, carried) of its image records
-        self.stored = {}            # (frame id, row) -> the row's bytes the store took
-        self.mode = mode
-        self.status_values = {}     # status fields the test sets
         self.received = []
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._serve, daemon=True)
+
+    def start(self):
         self._thread.start()
+        return self
 
     def _serve(self):
         while not self._stop.is_set():
@@ -51,35 +57,63 @@ class FakeProjector:
             except socket.timeout:
                 continue
             self.received.append(raw)
-            replies_before, rows_before = len(self.model.replies), len(self.model.rows)
-            if self.model.record(raw) == "image":
-                body = codec.decode(raw)[1]
-                self.kinds[body["frame"]] = (body.get("base", 0), body.get("carried", 0))
-            for frame, row, data in self.model.rows[rows_before:]:
-                complete = self.store.counters["frames_complete"]
-                base, carried = self.kinds[frame]
-                # a whole frame's row is the policy's row(frame, row, depth) with base and carried at their defaults
-                delta = {"base": base, "carried": carried} if carried else {}
-                if self.store.row(frame, row, self.model.config["bit_depth"], **delta):
-                    self.stored[frame, row] = data
-                if self.store.counters["frames_complete"] > complete:
-                    self.depths.append(self.store.frames[frame]["depth"])
-            if self.model.triggers and self.store.can_answer():
-                self.model.triggers = 0
-                if self.shown is not None:
-                    self.store.release(self.shown)
-                self.shown = self.store.ask()
-            if len(self.model.replies) > replies_before and self.mode != "silent":
-                sequence = self.model.replies[-1][1]["sequence"]
-                values = {name: self.model.counters.get(name, 0) for name, _ in records.STATUS_REPLY}
-                values["store_rows_refused"] = sum(self.store.counters.get(name, 0) for name in REFUSALS)
-                values["store_rows_no_base"] = self.store.counters.get("rows_no_base", 0)
-                values["shown_frame"] = self.shown or 0
-                values.update(self.status_values)
-                reply = codec.status_reply(sequence, values)
-                if self.mode == "garbled":
-                    reply = reply[:20]
+            reply = self.take(raw)
+            if reply is not None:
                 self.sock.sendto(reply, sender)
+
+    def take(self, raw):
+        raise NotImplementedError
+
+    def close(self):
+        self._stop.set()
+        self._thread.join()
+        self.sock.close()
+
+
+class FakeProjector(LoopbackDevice):
+    """Decodes every datagram with the reference model, stores its rows with the store's policy;
+    answers status queries (or, with ``mode``, answers badly or not at all)."""
+
+    def __init__(self, mode="good"):
+        super().__init__()
+        self.model = Model(TEST_DMD, 0x020000000001, 0x7F000001, self.port, frame_bits=16)
+        self.store = SlotPolicy(TEST_DMD.rows, slots=4)
+        self.shown = None
+        self.depths = []            # bit depth of each frame the store completed
+        self.kinds = {}             # frame id -> (base, carried) of its image records
+        self.stored = {}            # (frame id, row) -> the row's bytes the store took
+        self.mode = mode
+        self.status_values = {}     # status fields the test sets
+
+    def take(self, raw):
+        replies_before, rows_before = len(self.model.replies), len(self.model.rows)
+        if self.model.record(raw) == "image":
+            body = codec.decode(raw)[1]
+            self.kinds[body["frame"]] = (body.get("base", 0), body.get("carried", 0))
+        for frame, row, data in self.model.rows[rows_before:]:
+            complete = self.store.counters["frames_complete"]
+            base, carried = self.kinds[frame]
+            # a whole frame's row is the policy's row(frame, row, depth) with base and carried at their defaults
+            delta = {"base": base, "carried": carried} if carried else {}
+            if self.store.row(frame, row, self.model.config["bit_depth"], **delta):
+                self.stored[frame, row] = data
+            if self.store.counters["frames_complete"] > complete:
+                self.depths.append(self.store.frames[frame]["depth"])
+        if self.model.triggers and self.store.can_answer():
+            self.model.triggers = 0
+            if self.shown is not None:
+                self.store.release(self.shown)
+            self.shown = self.store.ask()
+        if len(self.model.replies) == replies_before or self.mode == "silent":
+            return None
+        sequence = self.model.replies[-1][1]["sequence"]
+        values = {name: self.model.counters.get(name, 0) for name, _ in records.STATUS_REPLY}
+        values["store_rows_refused"] = sum(self.store.counters.get(name, 0) for name in REFUSALS)
+        values["store_rows_no_base"] = self.store.counters.get("rows_no_base", 0)
+        values["shown_frame"] = self.shown or 0
+        values.update(self.status_values)
+        reply = codec.status_reply(sequence, values)
+        return reply[:20] if self.mode == "garbled" else reply
 
     def image(self, frame):
         """The image frame ``frame`` shows: its own rows, and its base's where a delta carries none."""
@@ -88,15 +122,10 @@ class FakeProjector:
                 for row in range(TEST_DMD.rows)]
         return np.frombuffer(b"".join(rows), np.uint8).reshape(SHAPE)
 
-    def close(self):
-        self._stop.set()
-        self._thread.join()
-        self.sock.close()
-
 
 @pytest.fixture
 def projector(request):
-    server = FakeProjector(getattr(request, "param", "good"))
+    server = FakeProjector(getattr(request, "param", "good")).start()
     yield server
     server.close()
 
@@ -475,3 +504,197 @@ def test_cli_sequence_plays_an_entry_table(projector, tmp_path):
     table.write_text('[{"slot": 0, "dark": 5}]')
     assert cli.main(base + ["sequence", *map(str, paths), "--entries", str(table)]) == 1
     assert len(projector.received) == sent
+
+
+# -- a tiled display's sync master ------------------------------------------------------------
+
+def control_bytes(sequence, apply, action, mode=0, armed=0, period=0, min_period=0, width=0):
+    """A master control record (21 bytes), field by field."""
+    return (struct.pack(HEADER + "BBBB", 0x444D, 10, MASTER_CONTROL, sequence, apply, action, mode, armed)
+            + period.to_bytes(5, "big") + min_period.to_bytes(5, "big") + struct.pack(">H", width))
+
+
+class FakeMaster(LoopbackDevice):
+    """A tiled display's sync master as ``docs/protocol.md`` describes it: checks each record in
+    its order (magic, version, type, length, the configuration it would leave in force), drops
+    and counts the first failure; applies a valid control record's fields and then its software
+    trigger (a pulse in mode SOFTWARE, armed); answers a status query with a master status
+    reply. Reads the records with :mod:`struct`, not the codec."""
+
+    CLOCK_HZ = 125_000_000
+
+    def __init__(self):
+        super().__init__()
+        self.config = {"mode": 0, "armed": 0, "period": 0, "min_period": 125_000, "width": 125}
+        self.counters = {name: 0 for name, _ in records.MASTER_RECORD_COUNTERS} | {"pulses": 0}
+        self._previous = None          # the last valid record's sequence number
+
+    def kinds(self):
+        return [raw[3] for raw in self.received]
+
+    def _drop(self, counter):
+        self.counters[counter] += 1
+
+    def take(self, raw):
+        if len(raw) < 5 or struct.unpack_from(">H", raw)[0] != 0x444D:
+            return self._drop("drop_app_magic")
+        _magic, version, kind, sequence = struct.unpack_from(HEADER, raw)
+        if version != 10:
+            return self._drop("drop_app_version")
+        if kind not in (STATUS_QUERY, MASTER_CONTROL):
+            return self._drop("drop_app_type")
+        if len(raw) != {STATUS_QUERY: 5, MASTER_CONTROL: 21}[kind]:
+            return self._drop("drop_app_length")
+        if kind == MASTER_CONTROL:
+            apply, action, mode, armed = raw[5:9]
+            fields = {"mode": mode, "armed": armed, "period": int.from_bytes(raw[9:14], "big"),
+                      "min_period": int.from_bytes(raw[14:19], "big"), "width": struct.unpack_from(">H", raw, 19)[0]}
+            merged = {name: fields[name] if apply >> i & 1 else self.config[name] for i, name in enumerate(NAMES)}
+            if any(records.master_config_faults(merged).values()):
+                return self._drop("drop_app_value")
+        if self._previous is not None and sequence != (self._previous + 1) & 0xFF:
+            self.counters["sequence_gaps"] += 1
+        self._previous = sequence
+        if kind == MASTER_CONTROL:
+            self.config = merged
+            self.counters["records_control"] += 1
+            if action & 1 and merged["mode"] == TriggerMode.SOFTWARE and merged["armed"]:
+                self.counters["pulses"] += 1
+            return None
+        self.counters["records_status"] += 1
+        return codec.master_status_reply(sequence, {**self.counters, **self.config, "clock_hz": self.CLOCK_HZ,
+                                                    "boards": 4, "ready": 0b1111})
+
+
+@pytest.fixture
+def master():
+    server = FakeMaster().start()
+    yield server
+    server.close()
+
+
+def test_master_control_record_bytes():
+    """Only the given fields' ``apply`` bits, the software trigger as action bit 0; an unknown
+    field is refused as the projector's control record refuses one."""
+    raw = codec.master_control_record(7, software_trigger=True, mode=2, period=0x0102030405, width=300)
+    assert raw == control_bytes(7, 0b10101, 1, mode=2, period=0x0102030405, width=300)
+    assert codec.master_control_record(300, armed=1, min_period=9) == control_bytes(300 & 0xFF, 0b01010, 0,
+                                                                                    armed=1, min_period=9)
+    head, body, rest = codec.decode(raw)
+    assert (head["type"], head["sequence"], rest) == (MASTER_CONTROL, 7, b"")
+    assert body == {"apply": 0b10101, "action": 1, "mode": 2, "armed": 0, "period": 0x0102030405,
+                    "min_period": 0, "width": 300}
+    with pytest.raises(KeyError, match="bit_depth"):
+        codec.master_control_record(bit_depth=8)
+    # the projector's control record, built by the same helper, keeps its own table
+    assert codec.control_record(1, armed=1)[5:8] == struct.pack(">HB", 0b10, 0)
+
+
+def test_master_status_reply_decodes():
+    """Type 9, 192 bytes: the network counters, the master's record counters, then its own
+    figures (offsets as the protocol page gives them)."""
+    values = {"records_status": 11, "uptime_cycles": 2**47 + 5, "clock_hz": 125_000_000, "boards": 4,
+              "ready": 0b1011, "pulses": 77, "mode": 1, "period": 2**39 + 1, "width": 125, "mac_tx_underruns": 3}
+    raw = codec.master_status_reply(300, values)
+    assert len(raw) == 192 and struct.unpack_from(HEADER, raw) == (0x444D, 10, MASTER_STATUS, 300 & 0xFF)
+    assert struct.unpack_from(">I", raw, 93)[0] == 11                   # records_status
+    assert int.from_bytes(raw[121:127], "big") == 2**47 + 5              # uptime_cycles
+    assert struct.unpack_from(">IBHI", raw, 127) == (125_000_000, 4, 0b1011, 77)
+    assert raw[146] == 1 and int.from_bytes(raw[148:153], "big") == 2**39 + 1
+    assert struct.unpack_from(">H", raw, 158)[0] == 125 and struct.unpack_from(">I", raw, 188)[0] == 3
+    head, body, rest = codec.decode(raw)
+    assert head["type"] == MASTER_STATUS and rest == b""
+    assert {name: body[name] for name in values} == values
+    assert body["drop_app_magic"] == 0 and len(body) == len(records.MASTER_STATUS_REPLY)
+    with pytest.raises(codec.ProtocolError, match="record type 9 is 192 bytes, got 193"):
+        codec.decode(raw + b"\0")
+
+
+def test_status_waits_for_each_devices_own_reply(master):
+    """A master client reads the master's status; a projector client waits for a projector's
+    reply and takes the master's for none."""
+    with MasterClient("127.0.0.1", master.port) as client:
+        status = client.status()
+    assert (status["clock_hz"], status["boards"], status["ready"]) == (125_000_000, 4, 0b1111)
+    assert status["min_period"] == 125_000 and status["records_status"] == 1
+    with Client("127.0.0.1", master.port, timeout=0.1) as client:
+        with pytest.raises(ClientError, match="no status reply from 127.0.0.1.*after 1 tries"):
+            client.status(retries=0)
+    assert master.counters["records_status"] == 2
+
+
+def test_configure_sends_cycles_of_the_masters_clock(master):
+    """Seconds become the nearest whole cycle of the clock the status gives; one record applies
+    just the fields given, the others keep the values in force."""
+    with MasterClient("127.0.0.1", master.port) as client:
+        now = client.configure(mode=TriggerMode.PERIODIC, armed=True, period_s=0.0040000031, min_period_s=0.0035,
+                               width_s=1.006e-6)
+        expected = {"mode": 1, "armed": 1, "period": 500_000, "min_period": 437_500, "width": 126}
+        assert now == expected
+        client.status()              # the record has been taken when its answer comes
+        assert master.config == expected
+        assert master.received[1] == control_bytes(1, 0b11111, 0, **expected)
+        assert client.configure(width_s=2e-6) == {**expected, "width": 250}
+        client.status()
+    assert master.received[4] == control_bytes(4, 0b10000, 0, width=250)
+    assert master.config == {**expected, "width": 250}
+    assert master.kinds() == [STATUS_QUERY, MASTER_CONTROL, STATUS_QUERY, STATUS_QUERY, MASTER_CONTROL, STATUS_QUERY]
+    assert master.counters["records_control"] == 2 and master.counters["sequence_gaps"] == 0
+
+
+@pytest.mark.parametrize(("settings", "failed"), [
+    ({"width_s": 0.002}, "width_below_min_period, width_fits$"),     # 250,000 cycles: over 16 bits
+    ({"min_period_s": 1e-6}, "width_below_min_period$"),             # 125 cycles, as long as the pulse
+    ({"mode": TriggerMode.SYNC}, ": mode$"),
+    ({"armed": 2}, ": armed$"),
+    ({"mode": TriggerMode.PERIODIC, "period_s": 0.0005}, "period_keepable$"),   # under min_period
+    ({"period_s": 2**40 / 125e6}, "period_fits$"),
+    ({"period_s": -1.0}, "period_fits"),
+])
+def test_configure_refuses_what_the_master_would_drop(master, settings, failed):
+    """Checked on the configuration the record would leave in force, before anything is sent:
+    the master sees the status query and no control record."""
+    with MasterClient("127.0.0.1", master.port) as client:
+        with pytest.raises(ClientError, match=f"the sync master cannot take this configuration .*{failed}"):
+            client.configure(**settings)
+        client.status()
+    assert master.kinds() == [STATUS_QUERY, STATUS_QUERY]
+    assert master.config["min_period"] == 125_000 and master.counters["drop_app_value"] == 0
+
+
+def test_trigger_sends_the_software_trigger_alone(master):
+    with MasterClient("127.0.0.1", master.port) as client:
+        client.configure(mode=TriggerMode.SOFTWARE, armed=True)
+        client.trigger()
+        assert client.status()["pulses"] == 1
+    assert master.received[2] == struct.pack(HEADER + "BB", 0x444D, 10, MASTER_CONTROL, 2, 0, 1) + bytes(14)
+    assert master.config == {"mode": 2, "armed": 1, "period": 0, "min_period": 125_000, "width": 125}
+
+
+def test_cli_master(master, capsys):
+    """``python -m host master ADDRESS``: settings in seconds, then the trigger, then the status;
+    the status alone when nothing else is asked; a configuration the master would drop refused
+    before it is sent."""
+    base = ["--timeout", "1", "master", "127.0.0.1", "--port", str(master.port)]
+    assert cli.main(base + ["--mode", "software", "--arm", "--period", "0.002", "--min-period", "0.001",
+                            "--width", "2e-6", "--trigger", "--status"]) == 0
+    out = capsys.readouterr().out
+    assert "sync master: mode software, armed, period 250000, min_period 125000, width 250 cycles\n" in out
+    assert "\npulses                   1\n" in out and "\nclock_hz                 125000000\n" in out
+    assert master.config == {"mode": 2, "armed": 1, "period": 250_000, "min_period": 125_000, "width": 250}
+    assert master.kinds() == [STATUS_QUERY, MASTER_CONTROL, MASTER_CONTROL, STATUS_QUERY]
+    assert master.received[2][5:7] == bytes([0, 1])                     # the trigger applies nothing
+    # --port before the command serves as well; with nothing asked, the status alone
+    assert cli.main(["--port", str(master.port), "master", "127.0.0.1"]) == 0
+    assert "\nrecords_control          2\n" in capsys.readouterr().out
+    assert cli.main(base + ["--disarm"]) == 0
+    assert master.received[-1] == control_bytes(1, 0b00010, 0) and master.config["armed"] == 0
+    assert "disarmed" in capsys.readouterr().out
+    sent = len(master.received)
+    assert cli.main(base + ["--width", "0.01"]) == 1
+    assert "error: the sync master cannot take this configuration" in (err := capsys.readouterr().err)
+    assert "width_fits" in err and master.kinds()[sent:] == [STATUS_QUERY]
+    for wrong in (["--arm", "--disarm"], ["--mode", "sync"], ["--period", "soon"]):
+        with pytest.raises(SystemExit) as leaving:
+            cli.main(base + wrong)
+        assert leaving.value.code == 2
