@@ -49,6 +49,10 @@ def test_sync_master_tree_drives_every_board_from_a_pad_flip_flop():
         assert f'NET "{name}" LOC=' in ucf, name
     for name in outputs:
         assert f'NET "{name}" SLEW=FAST;' in ucf, name
+    # its network port: the PHY's pins, its receive clock constrained, the synchronisers ignored
+    for name in ("rx_clk__io", "rx_data__io<7>", "rx_dv__io", "tx_data__io<7>", "tx_en__io", "gtx_clk__io"):
+        assert f'NET "eth_gmii_0__{name}" LOC=' in ucf, name
+    assert 'PERIOD "PRDgmii/rx_clk/i" 8.0 ns' in ucf and '"cdc_first_stages" TIG' in ucf
     # each output's buffer module holds its flip-flop, marked for the pad
     modules = {text.split("(")[0].strip(): text for text in (out / f"{top}.v").read_text().split("\nmodule ")[1:]}
     for buffer in [f"sync{k}" for k in range(BOARDS)] + ["camera"]:

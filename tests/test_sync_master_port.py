@@ -8,19 +8,17 @@ from gateware.protocol.master import master_config_init
 from gateware.registers import TriggerMode
 from gateware.top.sync_master import SYNC_HZ, SyncMasterCore
 from sim.harness import cocotb_run
+from sim.tb.gmii_host import address_value
 
 ADDRESSES = {"mac": "02:44:4d:00:00:f0", "ip": "192.168.1.9", "port": 5000}
 
-
-def _int(text):
-    return int(text.replace(":", ""), 16) if ":" in text else int.from_bytes(bytes(map(int, text.split("."))), "big")
 
 
 @pytest.mark.verilog
 @pytest.mark.parametrize("boards", [4, 12])     # four tiles; three groups of four
 def test_sync_master_core_over_gmii(boards):
     config = master_config_init(mode=TriggerMode.EXTERNAL, armed=False, period=1000, min_period=400, width=3)
-    core = SyncMasterCore(boards, config=config, mac=_int(ADDRESSES["mac"]), ip=_int(ADDRESSES["ip"]),
+    core = SyncMasterCore(boards, config=config, mac=address_value(ADDRESSES["mac"]), ip=address_value(ADDRESSES["ip"]),
                           port=ADDRESSES["port"], mdio_cycles=(20, 20))
     cocotb_run.run(core, toplevel="sync_master_core", module="sim.tb.master_core", key=str(boards),
                    params={"boards": boards, "clock_hz": int(SYNC_HZ), "config": config, **ADDRESSES})

@@ -35,7 +35,8 @@ _REPLY_PARTS = {"net": records.NET_COUNTERS, "records": records.MASTER_RECORD_CO
 
 def master_config_init(*, mode, armed, period, min_period, width):
     """The configuration a sync master starts with (build parameters; times in its cycles)."""
-    return {"mode": getattr(mode, "value", mode), "armed": int(armed), "period": period, "min_period": min_period, "width": width}
+    return {"mode": getattr(mode, "value", mode), "armed": int(armed), "period": period, "min_period": min_period,
+            "width": width}
 
 
 class MasterParser(wiring.Component):

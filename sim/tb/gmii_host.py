@@ -22,9 +22,14 @@ from sim.harness.layout import fields
 from sim.models import gmii
 from spec import records
 
-__all__ = ["GmiiHost", "HOST_MAC", "HOST_IP", "HOST_PORT"]
+__all__ = ["GmiiHost", "HOST_MAC", "HOST_IP", "HOST_PORT", "address_value"]
 
 HOST_MAC, HOST_IP, HOST_PORT = "02:00:00:00:00:99", "10.0.0.1", 40000
+
+
+def address_value(text):
+    """A MAC (``02:00:...``) or IPv4 (``10.0.0.1``) address as text -> its value."""
+    return int(text.replace(":", ""), 16) if ":" in text else int.from_bytes(bytes(map(int, text.split("."))), "big")
 
 
 class GmiiHost:

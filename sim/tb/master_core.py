@@ -19,18 +19,16 @@ import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Timer
 
+from host import codec
 from sim.harness.cocotb_run import params
 from sim.models.master_net import MasterModel
-from sim.tb.gmii_host import GmiiHost
+from sim.tb.gmii_host import GmiiHost, address_value
 from spec import records, wire
 from spec.records import Action, RecordType
 from spec.registers import TriggerMode
 
 NS = 8.0
 
-
-def _address(text):
-    return int(text.replace(":", ""), 16) if ":" in text else int.from_bytes(bytes(map(int, text.split("."))), "big")
 
 
 class Pulses:
@@ -87,7 +85,8 @@ class Host(GmiiHost):
 async def a_master_driven_over_gmii(dut):
     p = params()
     boards, clock_hz = p["boards"], p["clock_hz"]
-    model = MasterModel(dmd=None, mac=_address(p["mac"]), ip=_address(p["ip"]), port=p["port"], master=dict(p["config"]))
+    model = MasterModel(dmd=None, mac=address_value(p["mac"]), ip=address_value(p["ip"]), port=p["port"],
+                        master=dict(p["config"]))
     host = Host(dut, p["mac"], p["ip"], p["port"], net=model)
     everyone = (1 << boards) - 1
     for name, value in (("gmii_rx", 0), ("trigger_in", 0), ("button", 0), ("ready", everyone), ("mdio_i", 1)):
@@ -191,7 +190,9 @@ async def a_master_driven_over_gmii(dut):
     # -- the periodic mode: pulses a period apart ------------------------------------------------------
     period = 700
     first = len(pulses.starts)
-    await host.records([host.control(mode=TriggerMode.PERIODIC, period=period)])
+    # (this one as the host library encodes it)
+    await host.records([codec.master_control_record(host.next_sequence(), mode=TriggerMode.PERIODIC,
+                                                    period=period)])
     await ClockCycles(dut.clk, 10 * period)
     await host.records([host.control(armed=0)])
     await ClockCycles(dut.clk, 2 * period)

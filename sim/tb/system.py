@@ -43,16 +43,13 @@ from sim.models.mcb import CocotbPort, McbModel
 from sim.models.net import Model
 from sim.scene import default_scene
 from sim.system import plan as run_plan
-from sim.tb.gmii_host import GmiiHost
+from sim.tb.gmii_host import GmiiHost, address_value
 from spec import records, wire
 from spec.facts import DMDS
 from spec.registers import PlaneOrder, TriggerMode
 
 SYNC_NS, GMII_NS, DMD_NS = 8.0, 8.0, 5.0
 
-
-def _address(text):
-    return int(text.replace(":", ""), 16) if ":" in text else int.from_bytes(bytes(map(int, text.split("."))), "big")
 
 
 def _now_ps():
@@ -95,7 +92,7 @@ class System(GmiiHost):
                             settle_cycles=p["t_settle"], init_cycles=p["init_cycles"],
                             init_grace_cycles=p["init_grace"], check_training=p.get("check_training", True))
         super().__init__(dut, p["mac"], p["ip"], p["port"],
-                         net=Model(self.dmd, _address(p["mac"]), _address(p["ip"]), p["port"]))
+                         net=Model(self.dmd, address_value(p["mac"]), address_value(p["ip"]), p["port"]))
         self.dmd_clock = None            # the dmd clock's edges, once started
 
     @classmethod
