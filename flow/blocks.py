@@ -83,6 +83,12 @@ def _sync_master():
     return SyncMaster(BOARDS)
 
 
+def _sync_master_core():
+    """The sync master behind its network port, as its board builds it."""
+    from gateware.top.sync_master import board_core
+    return board_core()
+
+
 def _clock_trim():
     from gateware.sync.clock_trim import ClockTrim
     return ClockTrim()
@@ -109,6 +115,7 @@ BLOCKS = {
     "sequencer_dlp9500": lambda: _sequencer("dlp9500"),
     "register_crossing": _register_crossing,
     "sync_master": _sync_master,
+    "sync_master_core": _sync_master_core,
     "clock_trim": _clock_trim,
     "trim_dac": _trim_dac,
 }

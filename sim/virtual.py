@@ -36,7 +36,8 @@ from sim.harness import cocotb_run
 from sim.harness.paths import build_dir
 from sim.models.net import ones_sum
 
-__all__ = ["unavailable", "Namespace", "serve", "demo", "PROJECTOR", "HOST_ADDRESS"]
+__all__ = ["unavailable", "Namespace", "serve", "serve_master", "demo", "master_demo", "PROJECTOR",
+           "HOST_ADDRESS"]
 
 PROJECTOR, HOST_ADDRESS, TAP = "10.0.0.2", "10.0.0.1/24", "vp0"
 #: Bounds of the demo's waits (wall seconds): the Verilator build and start, one host command.
@@ -94,10 +95,16 @@ class Namespace:
         return done.stdout
 
 
+def _run_files(out, seconds):
+    """What every virtual device's testbench is told: its TAP, how long to run, and its files in
+    ``out`` (it writes ``ready`` once up, stops when ``stop`` exists, then writes ``report``)."""
+    return {"tap": TAP, "seconds": seconds, "out": str(out), "ready": str(out / "ready.json"),
+            "stop": str(out / "stop"), "report": str(out / "report.json")}
+
+
 def _params(out, seconds):
     from sim.system import PARAMS
-    return {**PARAMS, "tap": TAP, "seconds": seconds, "out": str(out), "ready": str(out / "ready.json"),
-            "stop": str(out / "stop"), "report": str(out / "report.json")}
+    return {**PARAMS, **_run_files(out, seconds)}
 
 
 def serve(out, seconds):
@@ -108,13 +115,29 @@ def serve(out, seconds):
                           timeout_s=seconds + START_S)
 
 
-def _start(ns, out, seconds):
+#: The virtual sync master's build: four boards, every time in its 125 MHz cycles, disarmed.
+MASTER_BOARDS, MASTER_CONFIG = 4, {"mode": 0, "armed": 0, "period": 125_000, "min_period": 12_500, "width": 125}
+
+
+def serve_master(out, seconds):
+    """Run the virtual sync master in this process's namespace, at :data:`PROJECTOR`'s address."""
+    from gateware.top.sync_master import SyncMasterCore
+    from sim.tb.gmii_host import address_value
+    p = {**_run_files(Path(out), seconds), "mac": "02:44:4d:00:00:f0", "ip": PROJECTOR, "port": 5000,
+         "boards": MASTER_BOARDS}
+    core = SyncMasterCore(MASTER_BOARDS, config=MASTER_CONFIG, mac=address_value(p["mac"]),
+                          ip=address_value(PROJECTOR), port=p["port"], mdio_cycles=(20, 20))
+    return cocotb_run.run(core, toplevel="sync_master_core", module="sim.tb.virtual_master", key="virtual",
+                          params=p, timeout_s=seconds + START_S)
+
+
+def _start(ns, out, seconds, device="serve"):
     for name in ("ready.json", "stop", "report.json"):
         (out / name).unlink(missing_ok=True)
     for png in out.glob("frame*.png"):
         png.unlink()
     log = open(out / "simulation.log", "w")    # noqa: SIM115 (the process outlives this call)
-    server = subprocess.Popen(ns.argv([sys.executable, "-m", "sim.virtual", "serve", str(out), str(seconds)]),
+    server = subprocess.Popen(ns.argv([sys.executable, "-m", "sim.virtual", device, str(out), str(seconds)]),
                               stdout=log, stderr=subprocess.STDOUT)
     deadline = time.monotonic() + START_S
     while not (out / "ready.json").exists():
@@ -225,6 +248,34 @@ def demo(seconds=600, log=print, python=sys.executable, cwd=None):
     return report
 
 
+def master_demo(seconds=300, log=print):
+    """The host CLI's ``master`` command in the namespace against the virtual sync master: its
+    status, a configuration (software triggers, armed, a shortest frame period and a pulse width)
+    with a trigger, its status again; returns the report (the pulses read on the pins, their
+    lengths, the CLI's output)."""
+    reason = unavailable()
+    if reason:
+        raise RuntimeError(f"virtual sync master: {reason}")
+    out = build_dir("virtual", "master")
+    host = [sys.executable, "-m", "host", "--timeout", "20", "master", PROJECTOR]
+    steps = {}
+    with Namespace() as ns:
+        log(f"virtual sync master: building and starting its core in network namespace {ns.name} ...")
+        server = _start(ns, out, seconds, "serve-master")
+        try:
+            steps["status_before"] = ns.run(host + ["--status"])
+            steps["configured"] = ns.run(host + ["--mode", "software", "--arm", "--min-period", "1e-4",
+                                                 "--width", "2e-7", "--trigger"])
+            steps["status_after"] = ns.run(host + ["--status"])
+        finally:
+            report = _stop(server, out)
+    if report is None:
+        raise RuntimeError(f"the virtual sync master wrote no report: see {out / 'simulation.log'}")
+    return {**report, **steps}
+
+
 if __name__ == "__main__":
     if sys.argv[1] == "serve":
         serve(Path(sys.argv[2]), float(sys.argv[3]))
+    elif sys.argv[1] == "serve-master":
+        serve_master(Path(sys.argv[2]), float(sys.argv[3]))

@@ -59,3 +59,23 @@ def test_installed_host_cli_through_the_kernel_to_the_core(tmp_path):
     after = dict(line.split()[:2] for line in report["status_after"].splitlines() if len(line.split()) >= 2)
     assert after["frames_shown"] == "1" and after["triggers"] == "1"
     assert report["frames_received"] > 0 and report["frames_sent"] > 0 and report["stopped"] == "file"
+
+
+@pytest.mark.verilog
+@pytest.mark.skipif(REASON is not None, reason=f"virtual projector: {REASON}")
+def test_host_cli_drives_the_sync_master_through_the_kernel():
+    """``python -m host master`` in the namespace, through the kernel's ARP, IP and UDP, to the
+    sync master's generated Verilog: its status, then software triggers armed and one fired: one
+    pulse on the pins, of the width asked for, and the status says so."""
+    report = virtual.master_demo(seconds=300, log=lambda _text: None)
+
+    def fields(text):
+        return dict(line.split()[:2] for line in text.splitlines() if len(line.split()) >= 2)
+    before, after = fields(report["status_before"]), fields(report["status_after"])
+    assert (before["pulses"], before["armed"], before["records_control"]) == ("0", "0", "0")
+    assert "software" in report["configured"]
+    assert (after["pulses"], after["armed"], after["mode"], after["records_control"]) == ("1", "1", "2", "2")
+    assert after["width"] == "25" and after["min_period"] == "12500"       # 0.2 us, 100 us at 125 MHz
+    # the pins: one pulse on every board's line and the camera's at once, 25 cycles long
+    assert report["pulses"] == 1 and report["widths"] == [25]
+    assert report["frames_received"] > 0 and report["frames_sent"] > 0 and report["stopped"] == "file"

@@ -177,9 +177,24 @@ class TxCrossing(wiring.Component):
         ahead = Signal(width)
         m.d.comb += ahead.eq(written.o - taken)
         whole_frame = (ahead != 0) & ~ahead[-1]
-        full = fifo.r_level >= self._depth - 1
+        # The FIFO's fill as the read side sees it: bytes written (crossed as a count, late: never
+        # more than the fill, and below zero while the bytes read overtake the late count, so
+        # signed) less bytes read. Not the FIFO's own ``r_level``, whose Gray decode a synthesis
+        # chains through every bit (a dozen LUT levels before the transmit MAC).
+        m.submodules.bytes_in = bytes_in = CountSynchronizer(width, i_domain=w, o_domain=r)
+        with m.If(self.i.valid & self.i.ready):
+            m.d[w] += bytes_in.i.eq(bytes_in.i + 1)
+        bytes_out, fill = Signal(width), Signal(width)
+        with m.If(out.valid & out.ready):
+            m.d[r] += bytes_out.eq(bytes_out + 1)
+        m.d.comb += fill.eq(bytes_in.o - bytes_out)
+        full = ~fill[-1] & (fill >= self._depth - 1)
+        # whether a frame may start, registered: a cycle late it errs only towards waiting, but
+        # in the cycle after a frame's last byte, when it still counts that frame (masked)
+        offer, ended = Signal(), Signal()
+        m.d[r] += [offer.eq(whole_frame | full), ended.eq(self.o.valid & self.o.ready & self.o.payload.last)]
         m.d.comb += [
-            self.o.valid.eq(out.valid & (sending | whole_frame | full)),
+            self.o.valid.eq(out.valid & (sending | (offer & ~ended))),
             self.o.payload.eq(out.payload),
             out.ready.eq(self.o.ready & self.o.valid),
         ]

@@ -6,11 +6,12 @@ Their counters are carried into ``sync`` with :class:`gateware.cdc.CountSynchron
 logic reads every figure in its own domain.
 """
 
-from amaranth import Module
+from amaranth import DomainRenamer, Module
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from ..cdc import CountSynchronizer
+from ..queue import Queue
 from . import gmii
 from .cdc import RxCrossing, TxCrossing
 from .gmii_rx import Receiver, counters_layout
@@ -18,6 +19,9 @@ from .gmii_tx import Transmitter
 from .layouts import ByteBeat
 
 __all__ = ["ReceivePath", "TransmitPath"]
+
+#: Bytes of each registered stage around the transmit crossing (three keep a byte a cycle flowing).
+_STAGE_DEPTH = 4
 
 
 class ReceivePath(wiring.Component):
@@ -106,8 +110,14 @@ class TransmitPath(wiring.Component):
         m = Module()
         m.submodules.crossing = crossing = TxCrossing(depth=self._depth)
         m.submodules.mac = mac = Transmitter(counter_width=self._counter_width)
-        wiring.connect(m, wiring.flipped(self.frames), crossing.i)
-        wiring.connect(m, crossing.o, mac.frames)
+        # registered stages on both sides of the crossing: the sender's logic, the FIFO's flags
+        # and frame counts, and the MAC's next byte are each a cycle's logic, not one path
+        m.submodules.entry = entry = Queue(ByteBeat, depth=_STAGE_DEPTH)
+        wiring.connect(m, wiring.flipped(self.frames), entry.w_stream)
+        wiring.connect(m, entry.r_stream, crossing.i)
+        m.submodules.stage = stage = DomainRenamer("gmii_tx")(Queue(ByteBeat, depth=_STAGE_DEPTH))
+        wiring.connect(m, crossing.o, stage.w_stream)
+        wiring.connect(m, stage.r_stream, mac.frames)
         m.d.comb += self.gmii.eq(mac.gmii)
         m.submodules.underruns_cdc = sync = CountSynchronizer(self._counter_width,
                                                               i_domain="gmii_tx", o_domain="sync")

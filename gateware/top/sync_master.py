@@ -33,7 +33,7 @@ from gateware.registers import TriggerMode
 from gateware.sync.master import SyncMaster
 from spec import records
 
-__all__ = ["SyncMasterCore", "SyncMasterPlatform", "SyncMasterTop", "sync_master_resources", "BOARDS",
+__all__ = ["SyncMasterCore", "SyncMasterPlatform", "SyncMasterTop", "board_core", "sync_master_resources", "BOARDS",
            "SYNC_HZ", "MASTER_ADDRESSES", "MASTER_MAX_FRAME"]
 
 #: Projector boards the build drives (the four-DMD projector).
@@ -163,6 +163,15 @@ class SyncMasterCore(wiring.Component):
         return m
 
 
+def board_core(boards=BOARDS, *, period_s=1 / 400, min_period_s=1 / 460, width_s=1e-6):
+    """The :class:`SyncMasterCore` the board builds: disarmed, EXTERNAL, the given frame timing
+    (seconds, in :data:`SYNC_HZ` cycles), at :data:`MASTER_ADDRESSES`."""
+    period, min_period, width = (round(t * SYNC_HZ) for t in (period_s, min_period_s, width_s))
+    config = master_config_init(mode=TriggerMode.EXTERNAL, armed=False, period=period, min_period=min_period,
+                                width=width)
+    return SyncMasterCore(boards, config=config, **MASTER_ADDRESSES)
+
+
 class SyncMasterTop(Elaboratable):
     """:class:`SyncMasterCore` on :class:`SyncMasterPlatform`.
 
@@ -170,17 +179,14 @@ class SyncMasterTop(Elaboratable):
     ----------
     boards : int
     period_s, min_period_s, width_s : float
-        The configuration at power-up (a host changes it): the periodic trigger's period, the
-        shortest frame period the boards keep (a trigger sooner after the last pulse is
-        refused), and each pulse's width.
+        The configuration at power-up (:func:`board_core`; a host changes it): the periodic
+        trigger's period, the shortest frame period the boards keep (a trigger sooner after the
+        last pulse is refused), and each pulse's width.
     """
 
-    def __init__(self, boards=BOARDS, *, period_s=1 / 400, min_period_s=1 / 460, width_s=1e-6):
+    def __init__(self, boards=BOARDS, **timing):
         assert boards <= len(_SYNC_PINS)
-        self._boards = boards
-        period, min_period, width = (round(t * SYNC_HZ) for t in (period_s, min_period_s, width_s))
-        self._config = master_config_init(mode=TriggerMode.EXTERNAL, armed=False, period=period,
-                                          min_period=min_period, width=width)
+        self._boards, self._timing = boards, timing
 
     def elaborate(self, platform):
         m = Module()
@@ -193,7 +199,7 @@ class SyncMasterTop(Elaboratable):
         m.submodules.clocks = clocks = Spartan6Clocks(clk_buf.i, rst_buf.i, None, platform.default_clk_frequency)
         m.submodules.gmii = pins = GmiiPins(clocks.locked)
 
-        m.submodules.core = core = SyncMasterCore(boards, config=self._config, **MASTER_ADDRESSES)
+        m.submodules.core = core = board_core(boards, **self._timing)
         m.d.comb += [core.gmii_rx.eq(pins.rx), pins.tx.eq(core.gmii_tx),
                      pins.phy_reset_n.eq(core.phy_reset_n), pins.mdc.eq(core.mdc), pins.mdio_o.eq(core.mdio_o),
                      pins.mdio_oe.eq(core.mdio_oe), core.mdio_i.eq(pins.mdio_i)]

@@ -108,24 +108,31 @@ async def virtual_projector(dut):
     camera = Camera8(system, p["out"])
     cocotb.start_soon(camera.run())
 
+    report = await bridge(dut, system, p)
+    Path(p["report"]).write_text(json.dumps({**report, "shown": camera.shown, "dmd_cycles": system.dmd_cycle}))
+
+
+async def bridge(dut, host, p):
+    """Carry frames between the TAP ``p["tap"]`` and ``host`` (a started
+    :class:`~sim.tb.gmii_host.GmiiHost` on ``dut``'s GMII pins) until ``p["seconds"]`` of wall
+    time have passed or the file ``p["stop"]`` exists; writes ``p["ready"]`` once the TAP is open.
+    Returns the frames each way and what stopped it."""
     fd = open_tap(p["tap"])
-    forwarded, received = len(system.tx_frames), 0
+    forwarded, received = len(host.tx_frames), 0
     stop, deadline = Path(p["stop"]), time.monotonic() + p["seconds"]
     Path(p["ready"]).write_text(json.dumps({"ip": p["ip"], "mac": p["mac"], "port": p["port"]}))
-    dut._log.info("virtual projector up on %s", p["tap"])
+    dut._log.info("up on %s", p["tap"])
     try:
         while time.monotonic() < deadline and not stop.exists():
             frames = waiting(fd)
             if frames:
                 received += len(frames)
-                await system.send(frames)
+                await host.send(frames)
             else:
                 await ClockCycles(dut.clk, POLL_CYCLES)
-            for frame in system.tx_frames[forwarded:]:
+            for frame in host.tx_frames[forwarded:]:
                 os.write(fd, frame)
-            forwarded = len(system.tx_frames)
+            forwarded = len(host.tx_frames)
     finally:
         os.close(fd)
-    Path(p["report"]).write_text(json.dumps({
-        "frames_received": received, "frames_sent": forwarded, "shown": camera.shown,
-        "dmd_cycles": system.dmd_cycle, "stopped": "file" if stop.exists() else "time"}))
+    return {"frames_received": received, "frames_sent": forwarded, "stopped": "file" if stop.exists() else "time"}
