@@ -90,7 +90,7 @@ def test_ready_paths():
 
 
 @pytest.mark.parametrize("check", [
-    *[c for c in blocks.checks() if c.block in ("Countdown", "SlotStates")],
+    *[c for c in blocks.checks() if c.block in ("Countdown", "SlotStates", "SyncMaster")],
     *[c for c in store.store_checks()],
 ], ids=lambda c: c.key)
 def test_checks_quick(check):

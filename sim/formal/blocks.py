@@ -14,7 +14,7 @@ definition; :func:`register_crossing_check` that the sequencer's registers chang
 import dataclasses
 from dataclasses import dataclass, field
 
-from amaranth import Signal
+from amaranth import Mux, Signal
 from amaranth.asserts import AnyConst
 from amaranth.hdl import Assert, Assume, Fragment
 
@@ -92,6 +92,11 @@ def _status_reply():
     return StatusReply()
 
 
+def _master_parser():
+    from gateware.protocol.master import MasterParser, master_config_init
+    return MasterParser(master_config_init(mode=0, armed=0, period=100, min_period=10, width=2))
+
+
 def _serialiser():
     from gateware.bitplane.serialiser import Serialiser
     return Serialiser(FORMAL_DMD, lanes=8, frame_bits=2)
@@ -159,6 +164,7 @@ STREAM_BLOCKS = [
     StreamBlock("Stack", _stack, depth=16),
     StreamBlock("Parser", _parser, depth=20, induction=4),
     StreamBlock("StatusReply", _status_reply, depth=20, induction=4),
+    StreamBlock("MasterParser", _master_parser, depth=20, induction=4),
     StreamBlock("Serialiser", _serialiser, depth=24, induction=4),
     StreamBlock("RowIngest", _row_ingest, depth=24, induction=4),
     StreamBlock("SlotCrossing", _slot_crossing, depth=40, domains=("dmd", "sync"),
@@ -299,6 +305,56 @@ def slot_states_check():
                  depth=8, induction=4, quick=8)
 
 
+# -- SyncMaster ------------------------------------------------------------------------------------
+
+def _sync_master_top(boards=3):
+    from amaranth.lib.cdc import FFSynchronizer
+
+    from gateware.sync.master import SyncMaster
+    dut = SyncMaster(boards)
+
+    def pulses_keep_their_rules(m, top):
+        # the frame timing held from the start (as the master's configuration holds between
+        # records), any trigger source, any ready lines: every board's line and the camera's the
+        # same on every cycle; a pulse starts only on a trigger obeyed (armed, every board ready
+        # as the master synchronised its lines, ``min_period`` since the last start), lasts
+        # ``width`` cycles, and is counted once
+        min_period, width = AnyConst(6), AnyConst(4)
+        m.d.comb += [dut.min_period.eq(min_period), dut.width.eq(width), Assume(width >= 1),
+                     Assume(width < min_period)]
+        ready = Signal(boards)
+        m.submodules.ready_sync = FFSynchronizer(dut.ready, ready)    # what the master sees
+        out, was, seen, since, high = dut.sync_out, Signal(), Signal(), Signal(7), Signal(5)
+        started = out[0] & ~was
+        m.d.sync += [was.eq(out[0]), seen.eq(seen | started),
+                     since.eq(Mux(started, 1, Mux(since == 127, 127, since + 1))),
+                     high.eq(Mux(out[0], Mux(high == 31, 31, high + 1), 0))]
+        counted, pulses_before, allowed = Signal(), Signal.like(dut.pulses), Signal()
+        m.d.sync += [pulses_before.eq(dut.pulses), allowed.eq(dut.run & ready.all())]
+        m.d.comb += [Assert(out == Mux(out[0], (1 << boards) - 1, 0), "every sync line the same"),
+                     Assert(dut.camera_out == out[0], "the camera line with them")]
+        pending = Signal()          # a trigger obeyed last cycle: its pulse starts now
+        m.d.sync += pending.eq(dut.pulses != pulses_before)
+        m.d.comb += counted.eq(dut.pulses != pulses_before)
+        with m.If(started):
+            m.d.comb += Assert(pending, "a pulse starts only the cycle after a trigger is obeyed")
+        with m.If(counted):
+            m.d.comb += [Assert(allowed, "obeyed only while armed with every board ready"),
+                         Assert(dut.pulses == pulses_before + 1, "counted once")]
+        with m.If(started & seen & (since != 127)):
+            m.d.comb += Assert(since >= min_period, "pulses at least min_period apart")
+        with m.If(was & ~out[0]):
+            m.d.comb += Assert(high == width, "each pulse lasts width cycles")
+
+    return FormalTop(dut, [pulses_keep_their_rules], driven=("min_period", "width"))
+
+
+def sync_master_check():
+    return Check("pulses: on every line at once, only when obeyed, min_period apart, width long", "SyncMaster",
+                 _sync_master_top, depth=40, induction=20, quick=24)
+
+
 def checks():
     """Every check of this module."""
-    return [*stream_checks(), countdown_check(), register_crossing_check(), slot_states_check()]
+    return [*stream_checks(), countdown_check(), register_crossing_check(), slot_states_check(),
+            sync_master_check()]
