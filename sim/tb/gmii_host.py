@@ -11,7 +11,9 @@ The core's ports, as Amaranth's Verilog names them: ``gmii_rx`` (a packed
 import zlib
 
 import cocotb
-from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge
+from cocotb.clock import Clock
+from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
+from cocotb.utils import get_sim_time
 from scapy.layers.inet import IP, UDP
 from scapy.layers.l2 import Ether
 from scapy.packet import Raw
@@ -22,7 +24,7 @@ from sim.harness.layout import fields
 from sim.models import gmii
 from spec import records
 
-__all__ = ["GmiiHost", "HOST_MAC", "HOST_IP", "HOST_PORT", "address_value"]
+__all__ = ["GmiiHost", "HOST_MAC", "HOST_IP", "HOST_PORT", "address_value", "start_clocks"]
 
 HOST_MAC, HOST_IP, HOST_PORT = "02:00:00:00:00:99", "10.0.0.1", 40000
 
@@ -30,6 +32,27 @@ HOST_MAC, HOST_IP, HOST_PORT = "02:00:00:00:00:99", "10.0.0.1", 40000
 def address_value(text):
     """A MAC (``02:00:...``) or IPv4 (``10.0.0.1``) address as text -> its value."""
     return int(text.replace(":", ""), 16) if ":" in text else int.from_bytes(bytes(map(int, text.split("."))), "big")
+
+
+async def start_clocks(dut, periods_ns, *, held=4):
+    """Start ``dut``'s clocks (``{"clk": ns, "gmii_rx_clk": ns, ...}``), each a quarter
+    nanosecond after the one before (so that no two domains' edges coincide), with each domain's
+    reset (``rst`` for ``clk``, ``<domain>_rst`` for ``<domain>_clk``) held until ``held`` cycles
+    of the first have passed. Returns each clock's start time in picoseconds (its first rising
+    edge)."""
+    resets = [getattr(dut, "rst" if name == "clk" else name[:-len("clk")] + "rst") for name in periods_ns]
+    for rst in resets:
+        rst.value = 1
+    started = {}
+    for i, (name, ns) in enumerate(periods_ns.items()):
+        if i:
+            await Timer(250, "ps")
+        started[name] = round(get_sim_time("ps"))
+        cocotb.start_soon(Clock(getattr(dut, name), ns, unit="ns").start())
+    await ClockCycles(getattr(dut, next(iter(periods_ns))), held)
+    for rst in resets:
+        rst.value = 0
+    return started
 
 
 class GmiiHost:

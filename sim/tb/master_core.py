@@ -16,13 +16,12 @@ model's, field by field.
 """
 
 import cocotb
-from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Timer
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 
 from host import codec
 from sim.harness.cocotb_run import params
 from sim.models.master_net import MasterModel
-from sim.tb.gmii_host import GmiiHost, address_value
+from sim.tb.gmii_host import GmiiHost, address_value, start_clocks
 from spec import records, wire
 from spec.records import Action, RecordType
 from spec.registers import TriggerMode
@@ -87,16 +86,7 @@ async def start(dut, host, boards):
     for name, value in (("gmii_rx", 0), ("trigger_in", 0), ("button", 0), ("ready", (1 << boards) - 1),
                         ("mdio_i", 1)):
         getattr(dut, name).value = value
-    for rst in (dut.rst, dut.gmii_rx_rst, dut.gmii_tx_rst):
-        rst.value = 1
-    cocotb.start_soon(Clock(dut.clk, NS, unit="ns").start())
-    await Timer(250, "ps")
-    cocotb.start_soon(Clock(dut.gmii_rx_clk, NS, unit="ns").start())
-    await Timer(250, "ps")
-    cocotb.start_soon(Clock(dut.gmii_tx_clk, NS, unit="ns").start())
-    await ClockCycles(dut.clk, 4)
-    for rst in (dut.rst, dut.gmii_rx_rst, dut.gmii_tx_rst):
-        rst.value = 0
+    await start_clocks(dut, {"clk": NS, "gmii_rx_clk": NS, "gmii_tx_clk": NS})
     host.listen()
     pulses = Pulses(dut, boards)
     cocotb.start_soon(pulses.run())

@@ -28,8 +28,7 @@ from pathlib import Path
 
 import cocotb
 import numpy as np
-from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles, RisingEdge, Timer
+from cocotb.triggers import RisingEdge, Timer
 from cocotb.utils import get_sim_time
 
 from gateware.dlpc410.sequencer import Status as SequencerStatus
@@ -43,7 +42,7 @@ from sim.models.mcb import CocotbPort, McbModel
 from sim.models.net import Model
 from sim.scene import default_scene
 from sim.system import plan as run_plan
-from sim.tb.gmii_host import GmiiHost, address_value
+from sim.tb.gmii_host import GmiiHost, address_value, start_clocks
 from spec import records, wire
 from spec.facts import DMDS
 from spec.registers import PlaneOrder, TriggerMode
@@ -60,9 +59,9 @@ class Edges:
     """The rising edges of a clock that cocotb's :class:`Clock` starts now (high first): counted
     from the simulation time, and waited for without waking the testbench on every one."""
 
-    def __init__(self, clock, period_ns):
+    def __init__(self, clock, period_ns, *, first=None):
         self.clock, self.period = clock, round(period_ns * 1000)
-        self.first = _now_ps()
+        self.first = _now_ps() if first is None else first
 
     def count(self):
         """Rising edges so far, the one at this instant included."""
@@ -108,19 +107,9 @@ class System(GmiiHost):
         dut.trigger_in.value = 0
         dut.sync_in.value = 0
         dut.mdio_i.value = 1
-        for rst in (dut.rst, dut.gmii_rx_rst, dut.gmii_tx_rst, dut.dmd_rst):
-            rst.value = 1
-        cocotb.start_soon(Clock(dut.clk, SYNC_NS, unit="ns").start())
-        await Timer(250, "ps")
-        cocotb.start_soon(Clock(dut.gmii_rx_clk, GMII_NS, unit="ns").start())
-        await Timer(250, "ps")
-        cocotb.start_soon(Clock(dut.gmii_tx_clk, GMII_NS, unit="ns").start())
-        await Timer(250, "ps")
-        cocotb.start_soon(Clock(dut.dmd_clk, DMD_NS, unit="ns").start())
-        self.dmd_clock = Edges(dut.dmd_clk, DMD_NS)
-        await ClockCycles(dut.clk, 4)
-        for rst in (dut.rst, dut.gmii_rx_rst, dut.gmii_tx_rst, dut.dmd_rst):
-            rst.value = 0
+        started = await start_clocks(dut, {"clk": SYNC_NS, "gmii_rx_clk": GMII_NS, "gmii_tx_clk": GMII_NS,
+                                           "dmd_clk": DMD_NS})
+        self.dmd_clock = Edges(dut.dmd_clk, DMD_NS, first=started["dmd_clk"])
         cocotb.start_soon(CocotbPort(dut, "mcb_write", dut.clk, self.memory.ports[0], SYNC_NS).run())
         cocotb.start_soon(CocotbPort(dut, "mcb_read", dut.dmd_clk, self.memory.ports[1], DMD_NS).run())
         # resting through quiet stretches: the testbench reads the model's commands, not its cycle
