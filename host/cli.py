@@ -72,9 +72,14 @@ def _plan(args):
         plan = schedule.plan(dmd, args.dclk, reset_mode=ResetMode[args.reset_mode], order=PlaneOrder[args.order],
                              **common)
     trigger = TriggerMode[args.trigger.upper()]
-    period = round(args.period * schedule.FABRIC_HZ) if args.period else plan.trigger_cycles
-    params = dataclasses.replace(plan.params, trigger=trigger,
-                                 period=period if trigger == TriggerMode.PERIODIC else plan.params.period)
+    given = round(args.period * schedule.FABRIC_HZ)
+    if trigger == TriggerMode.PERIODIC:
+        period = given or plan.trigger_cycles
+    elif trigger == TriggerMode.SYNC:
+        period = given          # the sync master's period: the clock loop's (0: the loop off)
+    else:
+        period = plan.params.period
+    params = dataclasses.replace(plan.params, trigger=trigger, period=period)
     plan = dataclasses.replace(plan, params=params)
     fault = period_fault(plan)
     if fault:
@@ -165,7 +170,9 @@ def main(argv=None):
                            help="what starts a frame: the trigger pin, a period, a software trigger "
                                 "(python -m host trigger) or the sync input")
     configure.add_argument("--period", type=float, default=0.0,
-                           help="periodic trigger: seconds between frames (default: the fastest the plan allows)")
+                           help="periodic trigger: seconds between frames (default: the fastest the plan allows); "
+                                "sync: the sync master's period, which turns the board's clock loop on (default: "
+                                "off)")
     configure.add_argument("--t-rst", default=None,
                            help="RST_ACTIVE time to plan with, in cycles from the pulse, or 'measured': the "
                                 "longest the projector has seen (status rst_active_cycles_max; default: the "

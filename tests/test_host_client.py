@@ -377,10 +377,20 @@ def test_cli_configure_says_the_rate_and_sends_the_plan(projector, capsys):
     assert model.counters["records_sequencer"] == 1 and model.counters["drop_app_value"] == 0
     assert model.registers == [records.register_wire(plan.params.registers(TEST_DMD))]
     assert model.config["bit_depth"] == 6 and model.config["armed"] == 1
+    def configured(*options):
+        """The register set the projector took from ``configure`` with ``options`` (a status
+        round trip after it: the fake projector handles records in order, on its own thread)."""
+        assert cli.main(base + ["configure", "--dmd", "test", "--dclk", "200e6", "--depth", "6", *options]) == 0
+        assert cli.main(base + ["status"]) == 0
+        return model.registers[-1]
+
     # the anchor register: the frame starts at that position of the order (a tiled display's pulse)
-    assert cli.main(base + ["configure", "--dmd", "test", "--dclk", "200e6", "--depth", "6", "--order",
-                            "LSB_FIRST", "--anchor", "5"]) == 0
-    assert model.registers[-1]["anchor"] == 5 and model.registers[-1]["order"] == PlaneOrder.LSB_FIRST
+    taken = configured("--order", "LSB_FIRST", "--anchor", "5")
+    assert taken["anchor"] == 5 and taken["order"] == PlaneOrder.LSB_FIRST
+    # a tiled display's board: the sync master's period (in dmd cycles) turns its clock loop on
+    taken = configured("--trigger", "sync", "--period", "0.0025")
+    assert (taken["trigger"], taken["period"]) == (TriggerMode.SYNC, 500_000)
+    assert configured("--trigger", "sync")["period"] == 0
 
 
 def test_sequencer_record_refuses_what_the_projector_would_drop():
@@ -687,8 +697,9 @@ def test_cli_master(master, capsys):
     # --port before the command serves as well; with nothing asked, the status alone
     assert cli.main(["--port", str(master.port), "master", "127.0.0.1"]) == 0
     assert "\nrecords_control          2\n" in capsys.readouterr().out
-    assert cli.main(base + ["--disarm"]) == 0
-    assert master.received[-1] == control_bytes(1, 0b00010, 0) and master.config["armed"] == 0
+    # (with the status after it: the fake master handles records in order, on its own thread)
+    assert cli.main(base + ["--disarm", "--status"]) == 0
+    assert master.received[-2] == control_bytes(1, 0b00010, 0) and master.config["armed"] == 0
     assert "disarmed" in capsys.readouterr().out
     sent = len(master.received)
     assert cli.main(base + ["--width", "0.01"]) == 1
