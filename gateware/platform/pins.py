@@ -40,6 +40,9 @@ class EthernetPins(Elaboratable):
     mdio_i : Signal, to the core
     """
 
+    #: The management lines, by the names a core's ports and these attributes share.
+    MANAGEMENT = ("phy_reset_n", "mdc", "mdio_o", "mdio_oe")
+
     def __init__(self, locked):
         self._locked = locked
         self.rx = Signal(RxPins)
@@ -49,6 +52,12 @@ class EthernetPins(Elaboratable):
         self.mdio_o = Signal()
         self.mdio_oe = Signal()
         self.mdio_i = Signal()
+
+    def connect(self, m, core):
+        """Wire ``core``'s GMII and management ports (``gmii_rx``, ``gmii_tx``, ``phy_reset_n``,
+        ``mdc``, ``mdio_o``, ``mdio_oe``, ``mdio_i``) to this PHY."""
+        m.d.comb += [core.gmii_rx.eq(self.rx), self.tx.eq(core.gmii_tx), core.mdio_i.eq(self.mdio_i),
+                     *[getattr(self, name).eq(getattr(core, name)) for name in self.MANAGEMENT]]
 
 
 class GmiiPins(EthernetPins):

@@ -48,6 +48,8 @@ class SyncMaster(wiring.Component):
         A host's trigger: a one-cycle pulse.
     ready : In(boards)
         The boards' ready lines (asynchronous).
+    ready_seen : Out(boards)
+        The ready lines as the master obeys them (synchronised).
     sync_out : Out(boards)
         The sync pulses, all the same cycles.
     camera_out : Out(1)
@@ -68,6 +70,7 @@ class SyncMaster(wiring.Component):
             "trigger_in": In(1),
             "soft": In(1),
             "ready": In(boards),
+            "ready_seen": Out(boards),
             "sync_out": Out(boards),
             "camera_out": Out(1),
             "pulses": Out(32),
@@ -80,7 +83,7 @@ class SyncMaster(wiring.Component):
         m.submodules.trigger = trigger = Trigger()
         m.d.comb += [trigger.mode.eq(self.mode), trigger.period.eq(self.period), trigger.run.eq(self.run),
                      trigger.pin.eq(self.trigger_in), trigger.soft.eq(self.soft)]
-        ready = Signal(self._boards)
+        ready = self.ready_seen
         m.submodules.ready_sync = FFSynchronizer(self.ready, ready)
         m.submodules.spacing = spacing = Countdown(DURATION_BITS)   # since the last pulse
         m.submodules.hold = hold = Countdown(16)                     # the pulse being sent

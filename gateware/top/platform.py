@@ -81,11 +81,7 @@ class PlatformTop(Elaboratable):
 
         # ---- The core ------------------------------------------------------------------------
         m.submodules.core = projector = core(dmd, self._dclk_hz)
-        m.d.comb += [projector.gmii_rx.eq(gmii.rx), gmii.tx.eq(projector.gmii_tx)]
-        m.d.comb += [
-            gmii.phy_reset_n.eq(projector.phy_reset_n), gmii.mdc.eq(projector.mdc),
-            gmii.mdio_o.eq(projector.mdio_o), gmii.mdio_oe.eq(projector.mdio_oe), projector.mdio_i.eq(gmii.mdio_i),
-        ]
+        gmii.connect(m, projector)
         wiring.connect(m, projector.dlpc, dlpc.bus)
         m.d.comb += [
             projector.trigger_in.eq(trigger.trigger),

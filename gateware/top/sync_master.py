@@ -23,6 +23,7 @@ from amaranth.lib.cdc import FFSynchronizer
 from amaranth.lib.wiring import In, Out
 from amaranth_boards.atlys import AtlysPlatform
 
+from gateware.compose import forward, members
 from gateware.mac import gmii
 from gateware.mac.mdio import StatusPoller
 from gateware.platform.clocks import Spartan6Clocks
@@ -45,6 +46,8 @@ MASTER_ADDRESSES = dict(mac=0x02_44_4D_00_00_F0, ip=0xC0_A8_01_09, port=5000)
 #: Longest frame the master's MAC takes (FCS included): its records are short, so a standard
 #: frame with a VLAN tag; longer ones are dropped whole and counted (``mac_oversize``).
 MASTER_MAX_FRAME = 1522
+#: The PHY's reset and management lines, the poller's ports the core takes as its own.
+_PHY_LINES = ("phy_reset_n", "mdc", "mdio_o", "mdio_oe", "mdio_i")
 #: VHDCI pins (single-ended) for each board's sync line and ready line, the trigger and the camera.
 _SYNC_PINS = ("1", "3", "4", "6")
 _READY_PINS = ("35", "37", "38", "40")
@@ -112,10 +115,11 @@ class SyncMasterCore(wiring.Component):
         self._mdio_cycles = mdio_cycles or (None, None)
         self._endpoint = MasterEndpoint(config, mac=mac, ip=ip, port=port)
         self._master = SyncMaster(boards)
+        self._phy = StatusPoller(sync_hz, reset_cycles=self._mdio_cycles[0], settle_cycles=self._mdio_cycles[1])
         super().__init__({
             "gmii_rx": In(gmii.RxPins),
             "gmii_tx": Out(gmii.TxPins),
-            "phy_reset_n": Out(1), "mdc": Out(1), "mdio_o": Out(1), "mdio_oe": Out(1), "mdio_i": In(1),
+            **members(self._phy, _PHY_LINES),
             "trigger_in": In(1),
             "button": In(1),
             "ready": In(boards),
@@ -129,10 +133,8 @@ class SyncMasterCore(wiring.Component):
         m = Module()
         m.submodules.ethernet = ethernet = EthernetPort(self._endpoint, max_frame=MASTER_MAX_FRAME, rx_depth=4096)
         m.d.comb += [ethernet.gmii_rx.eq(self.gmii_rx), self.gmii_tx.eq(ethernet.gmii_tx)]
-        m.submodules.phy = phy = StatusPoller(self._sync_hz, reset_cycles=self._mdio_cycles[0],
-                                              settle_cycles=self._mdio_cycles[1])
-        m.d.comb += [self.phy_reset_n.eq(phy.phy_reset_n), self.mdc.eq(phy.mdc), self.mdio_o.eq(phy.mdio_o),
-                     self.mdio_oe.eq(phy.mdio_oe), phy.mdio_i.eq(self.mdio_i)]
+        m.submodules.phy = self._phy
+        forward(m, self, self._phy, _PHY_LINES)
 
         # the master obeys the configuration in force; a host's trigger or the button's edge
         m.submodules.master = master = self._master
@@ -154,9 +156,7 @@ class SyncMasterCore(wiring.Component):
         # the status reply: the master's counts, its boards' ready lines, what it obeys
         status = ethernet.status
         report_port(m, ethernet, status, self._sync_hz)
-        ready = Signal(self._boards)
-        m.submodules.ready_sync = FFSynchronizer(self.ready, ready)
-        m.d.comb += [status.boards.eq(self._boards), status.ready.eq(ready),
+        m.d.comb += [status.boards.eq(self._boards), status.ready.eq(master.ready_seen),
                      status.pulses.eq(master.pulses), status.not_ready.eq(master.not_ready),
                      status.early.eq(master.early),
                      *[status[name].eq(settings[name]) for name, _ in records.MASTER_CONFIG]]
@@ -200,9 +200,7 @@ class SyncMasterTop(Elaboratable):
         m.submodules.gmii = pins = GmiiPins(clocks.locked)
 
         m.submodules.core = core = board_core(boards, **self._timing)
-        m.d.comb += [core.gmii_rx.eq(pins.rx), pins.tx.eq(core.gmii_tx),
-                     pins.phy_reset_n.eq(core.phy_reset_n), pins.mdc.eq(core.mdc), pins.mdio_o.eq(core.mdio_o),
-                     pins.mdio_oe.eq(core.mdio_oe), core.mdio_i.eq(pins.mdio_i)]
+        pins.connect(m, core)
 
         # the outputs from flip-flops in their pads
         for k in range(boards):
