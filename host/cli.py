@@ -61,16 +61,18 @@ def _t_rst(args):
 def _plan(args):
     dmd = DMDS[args.dmd]
     common = dict(depth=args.depth, exposure_s=args.exposure, words_per_cycle=args.read_rate,
-                  t_rst_cycles=_t_rst(args), reading=args.settle_reading, anchor=args.anchor)
+                  t_rst_cycles=_t_rst(args), reading=args.settle_reading, anchor=args.anchor,
+                  strict_rst=args.rst_active == "strict")
     if args.best:
         found = plan_search.find(dmd, args.dclk, **common)
         print(f"plan finder: every reset mode, plane order and hide threshold under the {args.settle_reading} "
-              f"settle reading\n{found.table()}\n"
+              f"settle reading and the {args.rst_active} RST_ACTIVE reading\n{found.table()}\n"
               f"fastest: {found.binds}")
         plan = found.plan
     else:
-        plan = schedule.plan(dmd, args.dclk, reset_mode=ResetMode[args.reset_mode], order=PlaneOrder[args.order],
-                             **common)
+        order = PlaneOrder.TABLE if args.order == "INTERLEAVED" else PlaneOrder[args.order]
+        plan = schedule.plan(dmd, args.dclk, reset_mode=ResetMode[args.reset_mode],
+                             **plan_search.order_kwargs(order, args.depth), **common)
     trigger = TriggerMode[args.trigger.upper()]
     given = round(args.period * schedule.FABRIC_HZ)
     if trigger == TriggerMode.PERIODIC:
@@ -160,7 +162,8 @@ def main(argv=None):
                            help="search every reset mode, plane order and hide threshold for the fastest legal "
                                 "plan (spec.plan_search; about two minutes on the DLP7000) instead of "
                                 "--reset-mode and --order")
-    configure.add_argument("--order", default="MSB_FIRST", choices=["MSB_FIRST", "LSB_FIRST"])
+    configure.add_argument("--order", default="MSB_FIRST", choices=["MSB_FIRST", "LSB_FIRST", "INTERLEAVED"],
+                           help="plane order; INTERLEAVED: each short plane behind a long one (7 1 6 2 5 3 4 0)")
     configure.add_argument("--anchor", type=int, default=0, choices=range(8),
                            help="the position in the plane order a frame starts at (modulo its depth), "
                                 "where the trigger or a tiled display's sync pulse lands (default 0)")
@@ -183,6 +186,10 @@ def main(argv=None):
                            help="what the mirror settle time forbids: 'ti' (default; TI: no load while the "
                                 "mirrors settle) or 'paper' (the four-DMD paper's reading, which TI's documents "
                                 "forbid: loads while they settle, pulses a settle time apart); docs/bounds.md")
+    configure.add_argument("--rst-active", default="strict", choices=["strict", "loose"],
+                           help="what RST_ACTIVE forbids: 'strict' (default; any pulse while it is high) or "
+                                "'loose' (a pulse of the blocks whose own RST_ACTIVE window is open, as TI's "
+                                "phased rates suggest; docs/dlpc410_model.md)")
     configure.add_argument("--dry-run", action="store_true", help="say the rate, send nothing")
     for name, text in (("arm", "let triggers reach the sequencer"), ("disarm", "ignore every trigger"),
                        ("trigger", "a software trigger (the sequencer's trigger mode must be software)")):

@@ -7,8 +7,11 @@ the smallest legal hide threshold (a plane at least ``hide`` long has the next p
 it: the settle path and a load must fit in it). :func:`find` tries every reset mode and plane
 order, and each higher hide threshold (a plane length: more planes then end in a dark pulse
 instead), keeps what the schedule model plays with no pulse late (:func:`spec.schedule.on_time`),
-and returns the fastest. Under TI's rules a higher threshold is never faster, and neither is
-least significant plane first; they are tried so that the table says so rather than assuming it.
+and returns the fastest. The orders are most significant plane first, least significant first,
+and :func:`interleaved` (each short plane behind a long one, so that the loads a short plane
+must hide, the tight ones, fall far apart in the frame: phased groups then stagger less). Under
+TI's rules a higher threshold is never faster, and neither is least significant plane first;
+they are tried so that the table says so rather than assuming it.
 The loose RST_ACTIVE reading is tried only when asked (``strict_rst=False``): TI's rule is the
 default. ``python -m host configure --best`` uses it before sending, and prints the table.
 """
@@ -20,9 +23,32 @@ from dataclasses import dataclass, replace
 from .registers import PlaneOrder, ResetMode
 from .schedule import Frame, Plan, exponents, frame_period, on_time, plan
 
-__all__ = ["Candidate", "Found", "find", "ORDERS"]
+__all__ = ["Candidate", "Found", "find", "interleaved", "order_kwargs", "ORDERS"]
 
-ORDERS = (PlaneOrder.MSB_FIRST, PlaneOrder.LSB_FIRST)
+#: The plane orders tried (``TABLE``: :func:`interleaved`).
+ORDERS = (PlaneOrder.MSB_FIRST, PlaneOrder.LSB_FIRST, PlaneOrder.TABLE)
+
+
+def interleaved(depth):
+    """Weight exponents in display order: the longest plane, the second shortest, the next
+    longest, the third shortest, ..., the shortest last (before the frame's final dark pulse);
+    for 8 bits 7 1 6 2 5 3 4 0."""
+    out, hi, lo = [], depth - 1, 1
+    while hi >= lo:
+        out.append(hi)
+        hi -= 1
+        if lo <= hi:
+            out.append(lo)
+            lo += 1
+    return tuple(out + [0])
+
+
+def order_kwargs(order, depth):
+    """:func:`spec.schedule.plan`'s arguments for one of :data:`ORDERS`."""
+    if order == PlaneOrder.TABLE:
+        table = interleaved(depth)
+        return {"order": order, "order_table": table + tuple(range(depth, 8))}
+    return {"order": order}
 
 
 @dataclass
@@ -39,8 +65,12 @@ class Candidate:
     def rate_hz(self):
         return self.plan.rate_hz if self.plan else 0.0
 
+    @property
+    def order_name(self):
+        return "INTERLEAVED" if self.order == PlaneOrder.TABLE else self.order.name
+
     def describe(self):
-        head = f"{self.reset_mode.name:6} {self.order.name:9} hide {self.hide:>7}"
+        head = f"{self.reset_mode.name:6} {self.order_name:11} hide {self.hide:>7}"
         if self.plan is None:
             return f"{head}  not legal: {self.why}"
         p = self.plan
@@ -61,7 +91,7 @@ class Found:
     @property
     def binds(self):
         b = self.best
-        return f"{b.reset_mode.name}, {b.order.name}, hide {b.hide}: {b.plan.binds}"
+        return f"{b.reset_mode.name}, {b.order_name}, hide {b.hide}: {b.plan.binds}"
 
     def table(self):
         return "\n".join(("* " if c is self.best else "  ") + c.describe() for c in self.candidates)
@@ -80,7 +110,7 @@ def _higher_hides(base, depth):
 def _candidates(dmd, dclk_hz, depth, mode, order, hides, plan_kwargs):
     """The candidates of one reset mode and plane order: the plan, then each higher hide."""
     try:
-        base = plan(dmd, dclk_hz, depth=depth, reset_mode=mode, order=order, **plan_kwargs)
+        base = plan(dmd, dclk_hz, depth=depth, reset_mode=mode, **order_kwargs(order, depth), **plan_kwargs)
     except ValueError as error:
         return [Candidate(ResetMode(mode), order, 0, why=str(error))]
     out, frame = [Candidate(ResetMode(mode), order, base.params.hide, base)], Frame(0, depth)

@@ -24,13 +24,16 @@ then the group is loaded with what its next pulse shows:
 Loading a group: for each block, its rows (one row cycle each, ``row_period`` apart) when the
 occupancy map says the plane has a bit set in the block, else one block clear
 (``clear_row_cycles`` row cycles). Loads are served in the order they were queued (the order of
-the pulses that freed them).
+the pulses that freed them); a dark pulse's clears are queued apart and go first, once the
+group's memory may change: they need no data from the store, and they have the shortest
+deadline there is (the least significant plane's time less the settle path).
 
 The command bus makes one decision every even cycle on which no row cycle is running (the
 DLPC410 runs at DCLK/2, so gaps are even): a pulse whose time has come and whose group is
 loaded, if the RST_ACTIVE rule allows it (strict: ``t_rst`` after any pulse; otherwise after the
-same group's); else the next load operation, if its group's settle time is over, the row pacing
-allows it, and no loaded pulse falls due before the operation ends; else nothing. A pulse that
+same group's); else the oldest dark pulse's next clear if its group's settle time is over, or
+else the next load operation, if its group's settle time is over and the row pacing allows it;
+each only if no loaded pulse falls due before the operation ends; else nothing. A pulse that
 cannot be made on time is made late and counted (the plan below never lets that happen).
 
 A trigger strobe at cycle ``s`` is obeyed when every group is loaded and waiting: group ``g``'s
@@ -332,7 +335,8 @@ class _Model:
         self.st = [_Group() for _ in range(self.G)]
         self.res = Result([], [])
         self.res.groups = self.st
-        self.queue = []                     # [group, ops, index]
+        self.queue = []                     # loads: [group, ops, index]
+        self.darks = []                     # dark clears, apart: [group, ops, index]
         self.frames = _Frames([Frame(0, 1)] if p.source == Source.PRNG else frames, self.res)
         self.strobes = sorted(strobes)
         self.si = 0                         # strobes handled
@@ -362,6 +366,12 @@ class _Model:
         """Queue the load of frame ``fi``'s display position ``j`` (None: clears) for group g."""
         dmd, frame = self.dmd, self.res.shown[fi]
         ops = []
+        if j is None:
+            # a dark pulse's clears: queued apart, served before any load once the group's
+            # memory may change (they need no data, and their window is the shortest plane's)
+            self.darks.append([g, [("clear", b) for b in self.grp[g]], 0])
+            self.st[g].loaded_at = None
+            return
         for b in self.grp[g]:
             if j is not None:
                 plane = frame.stored_plane(self.exps_of(fi)[j])
@@ -471,6 +481,7 @@ class _Model:
         self.ended = False
         self.queued_at = t + max(wait, 1) + self.G + 1
         self.queue.clear()
+        self.darks.clear()
         for g in range(self.G):
             self.st[g].pos = ("plane", fi, 0)
             self.st[g].writable = max(self.st[g].writable, t + self.p.reload_lead + wait)
@@ -515,8 +526,9 @@ class _Model:
     # -- the bus -----------------------------------------------------------------------------
 
     def decide(self, t):
-        """The bus's decision at an even free cycle: a due pulse, else the next load operation,
-        else nothing. Returns True when a pulse was made."""
+        """The bus's decision at an even free cycle: a due pulse, else the next clear of the
+        oldest dark pulse's group once its memory may change, else the next load operation, else
+        nothing. Returns True when a pulse was made."""
         p, st, res, R = self.p, self.st, self.res, self.R
         rst_ok = [t - (self.rst_any if p.strict_rst else st[g].rst_free) >= 0 for g in range(self.G)]
         due = [g for g in range(self.G) if st[g].pending and st[g].loaded_at is not None
@@ -541,8 +553,9 @@ class _Model:
             self.bus_free = t + R
             self.after_pulse(g, t)
             return True
-        if self.queue:
-            g, ops, i = self.queue[0]
+        queue = self.darks if self.darks and t >= st[self.darks[0][0]].writable else self.queue
+        if queue:
+            g, ops, i = queue[0]
             op, arg = ops[i]
             length = R if op == "row" else self.dmd.clear_row_cycles * R
             imminent = any(st[h].pending and st[h].loaded_at is not None and st[h].loaded_at <= t
@@ -554,9 +567,9 @@ class _Model:
                 if op == "row":
                     self.next_row = t + self.row_period
                 self.bus_free = t + length
-                self.queue[0][2] += 1
-                if self.queue[0][2] == len(ops):
-                    self.queue.pop(0)
+                queue[0][2] += 1
+                if queue[0][2] == len(ops):
+                    queue.pop(0)
                     st[g].loaded_at = t + length
         return False
 
@@ -572,6 +585,8 @@ class _Model:
         for s in st:
             if s.pending and s.loaded_at is not None:
                 cands.append(max(s.pulse_at, s.rst_free if not p.strict_rst else self.rst_any))
+        if self.darks:
+            cands.append(st[self.darks[0][0]].writable)
         if self.queue:
             g, ops, i = self.queue[0]
             cands.append(max(st[g].writable, self.next_row) if ops[i][0] == "row" else st[g].writable)
@@ -807,8 +822,8 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
 def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
     """Phased PWM with groups spread apart instead of on the LSB lattice: every group plays the
     plain timeline (dark gaps not rounded to LSB multiples) ``stagger`` after the one before.
-    Loads are served in the order of the pulses that freed them, so a group's clears behind a
-    short plane must not queue behind another group's plane load: the stagger is the smallest
+    Loads are served in the order of the pulses that freed them (a dark pulse's clears go
+    first, once the group's memory may change): the stagger is the smallest
     that keeps every pulse ``sep`` from every other group's (RST_ACTIVE) and every load inside
     its deadline with the loads in queue order; each candidate is then checked by
     :func:`simulate`. Returns (params, frame cycles) if faster than ``beat`` cycles, else None."""
@@ -819,15 +834,17 @@ def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
     best = None
     step = max(2, even(lsb_min // 64))
     for lsb in range(lsb_min, lsb_min + lsb_min // 4, step):
-        pulses, jobs, t = [0], [], 0
+        pulses, jobs, darks, t = [0], [], [], 0
         for j, e in enumerate(exps):
             d = lsb << e
             t += d
             pulses.append(t)
             if d >= p.hide and j != len(exps) - 1:
                 jobs.append(load_g)
+                darks.append(False)
             else:
                 jobs += [clear_g, load_g]
+                darks += [True, False]
                 t += p.dark_gap
                 pulses.append(t)
         pulses = np.array(pulses[:-1])
@@ -851,11 +868,16 @@ def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
             np.tile(np.append(pulses[1:], 1 << 62), G)[None, :] + offsets[None, :] * stag[:, None],
             order, axis=1)
         lengths = np.tile(np.array(jobs), G)[order]
+        dark = np.tile(np.array(darks), G)[order]
         end = np.zeros(len(stag), np.int64)
         fits = np.ones(len(stag), bool)
         for i in range(starts.shape[1]):
-            end = np.maximum(end, starts[:, i] + frozen) + lengths[:, i]
-            fits &= end + margin <= deadlines[:, i]
+            # a dark pulse's clears go before the loads once the memory may change (a row
+            # under way, or another group's clear, first)
+            done = np.maximum(end, starts[:, i] + frozen) + lengths[:, i]
+            cleared = starts[:, i] + frozen + clear_g + 2 * row_cycles(dmd, p.beats)
+            fits &= np.where(dark[:, i], cleared, done + margin) <= deadlines[:, i]
+            end = np.where(dark[:, i], end, done)
         tries = 0
         for s in stag[fits]:
             s = int(s)

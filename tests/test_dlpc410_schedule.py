@@ -197,6 +197,6 @@ def test_phased_pwm_spreads_groups_on_xga(mode):
     plan = schedule.plan(XGA, 200e6, reset_mode=mode)
     p = plan.params
     assert "load queue order" in plan.binds
-    assert 240 < plan.rate_hz < schedule.plan(XGA, 200e6).rate_hz
+    assert plan.rate_hz > 250
     assert p.dark_gap % p.lsb and p.stagger > p.t_rst
     played_exactly(XGA, p)

@@ -20,7 +20,7 @@ from sim.models.net import Model
 from sim.models.slots import SlotPolicy
 from spec import records
 from spec.facts import DMDS, TEST_DMD
-from spec.registers import PlaneOrder, TriggerMode
+from spec.registers import PlaneOrder, ResetMode, TriggerMode
 
 #: The store's refusals, summed into the status reply's ``store_rows_refused``.
 REFUSALS = ("rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot", "rows_no_base")
@@ -391,6 +391,13 @@ def test_cli_configure_says_the_rate_and_sends_the_plan(projector, capsys):
     taken = configured("--trigger", "sync", "--period", "0.0025")
     assert (taken["trigger"], taken["period"]) == (TriggerMode.SYNC, 500_000)
     assert configured("--trigger", "sync")["period"] == 0
+    # the interleaved plane order (its table for 6 planes, the rest after it) and the loose
+    # RST_ACTIVE reading, as the schedule model plans them
+    taken = configured("--order", "INTERLEAVED", "--reset-mode", "SINGLE", "--rst-active", "loose")
+    loose = schedule.plan(TEST_DMD, 200e6, depth=6, reset_mode=ResetMode.SINGLE, strict_rst=False,
+                          order=PlaneOrder.TABLE, order_table=(5, 1, 4, 2, 3, 0, 6, 7)).params
+    assert taken == records.register_wire(loose.registers(TEST_DMD))
+    assert (taken["order"], taken["strict_rst"]) == (PlaneOrder.TABLE, 0)
 
 
 def test_sequencer_record_refuses_what_the_projector_would_drop():

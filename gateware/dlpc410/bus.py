@@ -3,10 +3,12 @@
 The DLPC410 runs at DCLK/2, so idle gaps are even: the bus decides on even cycles only, once the
 row cycle before (and a clear's no-op rows) leaves room for the next on the pins. It makes, in
 this order of priority: a clocking pulse of a group that is due (the lowest such group), if the
-strict RST_ACTIVE reading's pin allows it, else the next load operation of the ready load at the
-head (a row of an occupied block, ``row_period`` after the last row and with a whole row of
-beats buffered; or a clear of an empty block), if that group's memory may change and no loaded
-group's pulse falls due before the operation would end; else nothing. A load whose row data has
+strict RST_ACTIVE reading's pin allows it, else the next clear of the oldest dark pulse's group,
+once that group's memory may change (a dark load needs no data, and its deadline is the shortest
+plane's, so it overtakes the loads queued before it), else the next load operation of the ready
+load at the head (a row of an occupied block, ``row_period`` after the last row and with a whole
+row of beats buffered; or a clear of an empty block), if that group's memory may change; each
+only if no loaded group's pulse falls due before the operation would end; else nothing. A load whose row data has
 not arrived is counted as an underrun (one per row that waits, however long).
 
 The decision is made from registered flags (the planner's, the bus's own) and registered; the
@@ -60,6 +62,9 @@ class Bus(wiring.Component):
         From the planner (registered).
     loads : In(stream.Signature(ready_load))
         Ready loads from the requester, taken when their last operation is applied.
+    darks : In(stream.Signature(ready_load))
+        The clears a dark pulse needs (no block in ``mask``), in the order of the pulses, taken
+        when their last clear is applied.
     beats : In(stream.Signature(bits_per_dclk * beats)); row_ready : In(1)
         Row data, one cycle's beats taken per cycle of a row cycle that loads a row; whether a
         whole row is buffered.
@@ -93,6 +98,7 @@ class Bus(wiring.Component):
             "imminent": In(1),
             "imminent_clear": In(1),
             "loads": In(stream.Signature(ready_load(dmd))),
+            "darks": In(stream.Signature(ready_load(dmd))),
             "beats": In(stream.Signature(dmd.bits_per_dclk * beats)),
             "row_ready": In(1),
             "choice": Out(dmd.blocks),
@@ -148,21 +154,30 @@ class Bus(wiring.Component):
         last_op = Mux(fresh, head.single, l_last)
         m.submodules.pace = pace = Countdown(8, lag=1, flags="settled")
         # (one AND of the flags each: no pulse goes first, the head's group may change, ...)
-        can_load = (free & ~self.flushing & ~self.hold & ~(pin_ok & due.any()) & self.loads.valid
-                    & self.writable.bit_select(head.group, 1))
+        may_op = free & ~self.flushing & ~self.hold & ~(pin_ok & due.any())
+        # ---- a dark pulse's clears first, once its group's memory may change ----
+        dark = self.darks.payload
+        d_fresh = Signal(init=1)               # the dark's first block is next
+        d_block = Signal(bb)
+        cur_dark = Mux(d_fresh, dark.first, d_block)
+        dark_ready = self.darks.valid & self.writable.bit_select(dark.group, 1)
+        do_dark = may_op & dark_ready & ~self.imminent_clear
+        can_load = may_op & ~dark_ready & self.loads.valid & self.writable.bit_select(head.group, 1)
         wants_row = can_load & ~self.imminent & occupied & pace.done
         do_row = wants_row & self.row_ready
-        do_clear = can_load & ~self.imminent_clear & ~occupied
+        do_clear = (can_load & ~self.imminent_clear & ~occupied) | do_dark
 
         # ---- the decision, registered ----
         dec = Signal(data.StructLayout({
-            "pulse": 1, "pulse_group": gb, "row": 1, "clear": 1, "last": 1, "load_group": G, "block": bb,
+            "pulse": 1, "pulse_group": gb, "row": 1, "clear": 1, "dark": 1, "last": 1, "load_group": G, "block": bb,
             "row_at": 11, "fresh": 1, "starved": 1, "block_last": 1, "following": bb, "following_last": 1,
             "following_filled": 1}))
         following = (cur_block + 1)[:bb]
         m.d.sync += [dec.pulse.eq(do_pulse), dec.pulse_group.eq(_lowest(due)),
-                     dec.row.eq(do_row), dec.clear.eq(do_clear), dec.last.eq(last_op),
-                     dec.load_group.eq(1 << head.group), dec.block.eq(cur_block),
+                     dec.row.eq(do_row), dec.clear.eq(do_clear), dec.dark.eq(dark_ready),
+                     dec.last.eq(Mux(dark_ready, cur_dark == dark.last, last_op)),
+                     dec.load_group.eq(1 << Mux(dark_ready, dark.group, head.group)),
+                     dec.block.eq(Mux(dark_ready, cur_dark, cur_block)),
                      dec.row_at.eq(Mux(fresh, head.first_row, row_at)), dec.fresh.eq(fresh),
                      dec.starved.eq(wants_row & ~self.row_ready),
                      # (for the operation after it)
@@ -173,7 +188,13 @@ class Bus(wiring.Component):
         # ---- applied ----
         op = dec.row | dec.clear
         m.d.comb += [pace.load.eq(dec.row), pace.value.eq(regs.row_period)]
-        with m.If(op):
+        with m.If(dec.clear & dec.dark):
+            with m.If(dec.last):
+                m.d.comb += self.darks.ready.eq(1)
+                m.d.sync += d_fresh.eq(1)
+            with m.Else():
+                m.d.sync += [d_fresh.eq(0), d_block.eq(dec.block + 1)]
+        with m.Elif(op):
             with m.If(dec.last):
                 m.d.comb += self.loads.ready.eq(1)
                 m.d.sync += fresh.eq(1)
@@ -192,9 +213,9 @@ class Bus(wiring.Component):
             # block's first row follows a cleared block's
             m.d.sync += row_at.eq(dec.row_at + Mux(dec.row, 1, rpb))
         with m.If(self.flushing):
-            m.d.comb += self.loads.ready.eq(1)
+            m.d.comb += [self.loads.ready.eq(1), self.darks.ready.eq(1)]
         with m.If(self.restart):
-            m.d.sync += fresh.eq(1)
+            m.d.sync += [fresh.eq(1), d_fresh.eq(1)]
 
         # a row counts once however many cycles it waits for its data
         waiting = Signal()

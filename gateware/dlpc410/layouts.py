@@ -5,14 +5,16 @@ are joined by streams; an *event* is a stream that is always ready (it happens, 
 offered), for example a clocking pulse made this cycle.
 """
 
+from amaranth import Const, Mux
 from amaranth.lib import data, stream
 from amaranth.utils import ceil_log2
 
-from ..registers import TIME_BITS
+from ..registers import TIME_BITS, ResetMode
 from ..store.layouts import COUNTER_BITS, SLOT_BITS
 from .interface import BlockMode, RowMode
 
-__all__ = ["group_bits", "block_bits", "load_job", "ready_load", "event", "Command", "Status", "COUNTER_BITS"]
+__all__ = ["group_bits", "block_bits", "group_span", "load_job", "ready_load", "event", "Command", "Status",
+           "COUNTER_BITS"]
 
 
 def group_bits(dmd):
@@ -22,9 +24,21 @@ def group_bits(dmd):
 block_bits = group_bits
 
 
+def group_span(dmd, reset_mode, size_log2, group):
+    """The first and last block of ``group``: every block in global mode, else ``2**size_log2``
+    from ``group << size_log2``, cut at the last block (the DLP9500's 15 blocks)."""
+    bb = block_bits(dmd)
+    first = (group << size_log2)[:bb + 1]
+    end = first | ((Const(1, 4) << size_log2) - 1)
+    is_global = reset_mode == ResetMode.GLOBAL
+    return (Mux(is_global, 0, first)[:bb],
+            Mux(is_global | (end > dmd.blocks - 1), dmd.blocks - 1, end)[:bb])
+
+
 def load_job(dmd):
     """What a group must be loaded with next: display position ``pos`` of the frame in ``slot``
-    (of ``depth`` planes), the stored plane that is (``plane``), or clears (``clear``)."""
+    (of ``depth`` planes), the stored plane that is (``plane``), or a dark pulse's clears
+    (``clear``: they go to the bus apart from the planes, :class:`~.bus.Bus` ``darks``)."""
     return data.StructLayout({"group": group_bits(dmd), "slot": SLOT_BITS, "depth": 4, "pos": 3, "plane": 3,
                               "clear": 1})
 

@@ -9,13 +9,13 @@ While the frame control flushes, jobs are dropped here (through the same slot ac
 request already offered is held until taken (its words are discarded by the row source).
 """
 
-from amaranth import Cat, Const, Module, Mux, Signal
+from amaranth import Cat, Module, Signal
 from amaranth.lib import data, fifo, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from ..registers import Registers, ResetMode, Source
+from ..registers import Registers, Source
 from ..store.layouts import SLOT_BITS, PlaneRequest
-from .layouts import block_bits, load_job, ready_load
+from .layouts import block_bits, group_span, load_job, ready_load
 
 __all__ = ["Requester"]
 
@@ -36,7 +36,7 @@ class Requester(wiring.Component):
     flushing : In(1)
         Drop jobs; end a request once it is taken.
     jobs : In(stream.Signature(load_job))
-        Load jobs in order.
+        Load jobs of planes in order (a dark pulse's clears go to the bus apart).
     occ_slot : Out(SLOT_BITS); occupancy : In(ArrayLayout(8, blocks))
         The occupancy read port (bit k of block b: stored plane k has a bit set in block b), for
         slot ``occ_slot`` as it was one cycle earlier.
@@ -90,17 +90,9 @@ class Requester(wiring.Component):
         head = self.jobs.payload
         plane = Signal(3)
 
-        # the head job's plane, and its group's blocks: all of them in global mode, else
-        # 2**size_log2 from group << size_log2, cut at the last block (the DLP9500's 15 blocks);
-        # registered as the job is taken
-        head_first = Signal(bb)
-        head_last = Signal(bb)
-        g_first = (head.group << self.size_log2)[:bb + 1]
-        g_end = g_first | ((Const(1, 4) << self.size_log2) - 1)
-        with m.If(regs.reset_mode == ResetMode.GLOBAL):
-            m.d.comb += [head_first.eq(0), head_last.eq(dmd.blocks - 1)]
-        with m.Else():
-            m.d.comb += [head_first.eq(g_first), head_last.eq(Mux(g_end > dmd.blocks - 1, dmd.blocks - 1, g_end))]
+        # the head job's plane, and its group's blocks, registered as the job is taken
+        head_first, head_last = Signal(bb), Signal(bb)
+        m.d.comb += Cat(head_first, head_last).eq(Cat(*group_span(dmd, regs.reset_mode, self.size_log2, head.group)))
         span_first, span_last = Signal(bb), Signal(bb)
 
         m.d.comb += [
@@ -131,7 +123,7 @@ class Requester(wiring.Component):
         with m.FSM(name="requester") as fsm:
             with m.State("IDLE"):
                 # the last group's first load from a new slot: no group reads the old one again
-                leaves = (head.group == last_group) & ~head.clear & seen_slot & (head.slot != last_slot)
+                leaves = (head.group == last_group) & seen_slot & (head.slot != last_slot)
                 m.d.comb += self.jobs.ready.eq(room & ~releasing)
                 with m.If(self.jobs.valid & self.jobs.ready & leaves):
                     m.d.sync += [releasing.eq(1), released.eq(last_slot)]
@@ -139,7 +131,7 @@ class Requester(wiring.Component):
                 with m.If(self.jobs.valid & self.jobs.ready):
                     m.d.sync += [entry.eq(head), span_first.eq(head_first), span_last.eq(head_last),
                                  plane.eq(head.plane)]
-                    with m.If((head.group == last_group) & ~head.clear):
+                    with m.If(head.group == last_group):
                         m.d.sync += [last_slot.eq(head.slot), seen_slot.eq(1)]
                     with m.If(~flushing):
                         m.next = "LOOK"
@@ -156,10 +148,10 @@ class Requester(wiring.Component):
                     after_first = (span_first <= b) if b < (1 << bb) - 1 else 1
                     before_last = (span_last >= b) if b else 1
                     return after_first & before_last
-                looked = Cat(in_span(b) & ~entry.clear & occupied[b] for b in range(dmd.blocks))
+                looked = Cat(in_span(b) & occupied[b] for b in range(dmd.blocks))
                 m.d.sync += [mask.eq(looked), block.eq(span_first), last.eq(span_last),
                              first_row.eq(span_first * rpb), block_row.eq(span_first * rpb),
-                             first_occupied.eq(~entry.clear & occupied.bit_select(span_first, 1)),
+                             first_occupied.eq(occupied.bit_select(span_first, 1)),
                              at_last.eq(span_first == span_last), passed.eq(0)]
                 m.next = "PUSH"
                 with m.If(flushing):

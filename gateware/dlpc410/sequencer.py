@@ -8,15 +8,18 @@ first plane preloaded so that a trigger becomes a pulse a few cycles later.
 Its parts, joined by streams::
 
     frames --> Planner --jobs--> queue --> Requester --requests--> (store) --words--> RowSource
-                 ^  ^                         |                                         |
-                 |  +---- FrameControl        +--loads--> queue --> Bus <--beats--------+
+                 ^  ^   |                     |                                         |
+                 |  |   |                     +--loads--> queue --> Bus <--beats--------+
+                 |  |   +--dark jobs--------------------> queue --> Bus
+                 |  +---- FrameControl
                  +-------- pulse, loaded ------------------------- Bus --> command pins
 
 * :class:`~.planner.Planner`: every group's timeline; after a pulse, the group's next load job;
 * :class:`~.control.FrameControl`: start, reload on a newer frame, obey or count triggers;
 * :class:`~.requester.Requester`: load jobs to row requests, with the occupancy map;
 * :class:`~.row_source.RowSource`: the store's words as beats, or the on-chip pattern source;
-* :class:`~.bus.Bus`: every even free cycle, a due pulse, else the next row or clear, else nothing;
+* :class:`~.bus.Bus`: every even free cycle, a due pulse, else a dark pulse's next clear, else the
+  next row or clear, else nothing;
 * :class:`~.camera.CameraTrigger`, :class:`~.init.Init`, :class:`~.trigger.Trigger`.
 """
 
@@ -34,7 +37,7 @@ from .bus import Bus
 from .camera import CameraTrigger
 from .control import FrameControl
 from .init import TRAINING_EDGES, Init
-from .layouts import Status, load_job, ready_load
+from .layouts import Status, group_span, load_job, ready_load
 from .period_watch import PeriodWatch
 from .planner import Planner
 from .requester import Requester
@@ -152,6 +155,7 @@ class Sequencer(wiring.Component):
         m.submodules.jobs = jobs = Queue(load_job(dmd), depth=G + 1)
         m.submodules.requester = requester = Requester(dmd)
         m.submodules.loads = loads = Queue(ready_load(dmd), depth=G + 1)
+        m.submodules.darks = darks = Queue(ready_load(dmd), depth=G + 1)
         m.submodules.row_source = source = RowSource(dmd, beats=beats, store_words=self._store_words)
         m.submodules.bus = bus = Bus(dmd, beats=beats)
         m.submodules.camera = camera = CameraTrigger()
@@ -209,8 +213,14 @@ class Sequencer(wiring.Component):
 
         # ---- load jobs -> requester -> ready loads; row data ----
         # the job queue always has room: one job per group in flight, first planes only once
-        # the queue is empty
-        m.d.comb += [jobs.w_stream.valid.eq(planner.jobs.valid), jobs.w_stream.payload.eq(planner.jobs.payload)]
+        # the queue is empty. A dark pulse's clears need no data: they go to the bus apart
+        job = planner.jobs.payload
+        m.d.comb += [jobs.w_stream.valid.eq(planner.jobs.valid & ~job.clear), jobs.w_stream.payload.eq(job),
+                     darks.w_stream.valid.eq(planner.jobs.valid & job.clear)]
+        dark = darks.w_stream.payload
+        dark_first, dark_last = group_span(dmd, regs.reset_mode, size_log2, job.group)
+        m.d.comb += [dark.group.eq(job.group), dark.first.eq(dark_first), dark.last.eq(dark_last),
+                     dark.single.eq(dark_first == dark_last)]
         wiring.connect(m, jobs.r_stream, requester.jobs)
         m.d.comb += [requester.size_log2.eq(size_log2), requester.flushing.eq(control.flushing),
                      self.occ_slot.eq(requester.occ_slot), requester.occupancy.eq(self.occupancy)]
@@ -225,10 +235,11 @@ class Sequencer(wiring.Component):
         ]
         # (registered: the frame control's flush and restart wait on it)
         m.d.sync += control.drained.eq(requester.idle & ~planner.job_due & (jobs.level == 0) & (loads.level == 0)
-                                       & source.drained)
+                                       & (darks.level == 0) & source.drained)
 
         # ---- the bus ----
         wiring.connect(m, loads.r_stream, bus.loads)
+        wiring.connect(m, darks.r_stream, bus.darks)
         wiring.connect(m, source.beats, bus.beats)
         m.d.comb += [
             bus.even.eq(~time_base.count[0]),
