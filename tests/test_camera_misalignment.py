@@ -21,3 +21,13 @@ def test_the_jump_at_128_on_the_gateware(test_name):
     assert lag[128] - lag[127] < -20
     # leading: the frame's end is lost (its low planes); 128 has none there
     assert lead[127] < -10 and lead[128] - lead[127] > 10
+
+
+@pytest.mark.verilog
+def test_the_interleaved_order_leads_with_its_msb(test_name):
+    """The interleaved order (7 1 6 2 5 3 4 0) on the gateware: aligned, every level exact; its
+    most significant plane comes first, so a lagging window loses the MSB's share from every
+    level of 128 and up, as with MSB first."""
+    curves = misalignment(PlaneOrder.TABLE, shifts=(0, 10), name=test_name)
+    assert np.abs(curves[0]).max() == 0
+    assert curves[10][128] - curves[10][127] < -20

@@ -9,7 +9,9 @@ DLPC410 model, the light from the camera model; the error of each grey level is 
 sees less the level, in LSB. With MSB first the most significant plane fills the first half of
 the frame, so a lagging window loses up to 128 LSB from every level of 128 and up while the
 levels below lose only their low planes: the error jumps at 128. With LSB first the jump moves to
-a leading window. ``build/camera_misalignment.csv`` and ``.png``.
+a leading window. The interleaved order (``7 1 6 2 5 3 4 0``, :func:`spec.plan_search.interleaved`,
+which the plan finder picks for phased plans) is measured beside them.
+``build/camera_misalignment.csv`` and ``.png``.
 """
 
 import numpy as np
@@ -18,11 +20,14 @@ from sim.bench.tables import label, pyplot, save_figure, write_table
 from sim.models.camera import Camera, to_lsb
 from sim.seq_rig import run_rig
 from sim.tb.seq_sim import CAMERA_DELAY, CAMERA_RAMP
-from spec import schedule
+from spec import plan_search, schedule
 from spec.facts import TEST_DMD
 from spec.registers import PlaneOrder, TriggerMode
 
-__all__ = ["misalignment", "run", "SHIFTS_PCT"]
+__all__ = ["misalignment", "run", "SHIFTS_PCT", "ORDERS"]
+
+#: The plane orders measured, by name (``interleaved``: ``PlaneOrder.TABLE`` with its table).
+ORDERS = {"msb_first": PlaneOrder.MSB_FIRST, "lsb_first": PlaneOrder.LSB_FIRST, "interleaved": PlaneOrder.TABLE}
 
 #: Window start minus the ramp frame's first pulse, in % of the frame period (- leads, + lags).
 SHIFTS_PCT = tuple(sorted({*range(-100, 101, 5), -1, 1}))
@@ -32,9 +37,10 @@ SHOWN_PCT = (-50, -10, -1, 1, 10, 50)
 
 def misalignment(order, shifts=SHIFTS_PCT, *, name=None):
     """Per shift (% of a frame), the mean error (LSB) of each grey level 0..255, for the plane
-    ``order``: ``{shift: array of 256}``."""
+    ``order`` (``TABLE``: the interleaved order): ``{shift: array of 256}``."""
     dmd = TEST_DMD
-    plan = schedule.plan(dmd, 200e6, depth=8, order=order, t_rst_s=20 / 200e6, t_settle_s=30 / 200e6)
+    plan = schedule.plan(dmd, 200e6, depth=8, **plan_search.order_kwargs(order, 8), t_rst_s=20 / 200e6,
+                         t_settle_s=30 / 200e6)
     p = plan.params
     p.trigger, p.trigger_hold, p.period = TriggerMode.PERIODIC, True, plan.frame_cycles
     # every grey level 0..255 on the 128 columns: odd rows hold the upper half
@@ -63,21 +69,21 @@ def _write(curves):
                 [[order, pct, *[f"{e:.3f}" for e in errors]]
                  for order, by_shift in curves.items() for pct, errors in by_shift.items()])
     plt = pyplot()
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4))
+    fig, axes = plt.subplots(1, len(curves) + 1, figsize=(5 * (len(curves) + 1), 4))
     for k, (order, by_shift) in enumerate(curves.items()):
         for pct in (p for p in SHOWN_PCT if abs(p) >= 10):
             axes[k].plot(range(256), by_shift[pct], label=f"{pct:+d} %")
         axes[k].axvline(128, color="grey", alpha=0.3)
         label(axes[k], "grey level", "camera error (LSB)", f"{order}: error against grey level",
               legend_title="window start (% of a frame)")
-        axes[2].plot(list(by_shift), [np.abs(e).max() for e in by_shift.values()], "o-", label=order)
-    label(axes[2], "window start - frame start (% of a frame; - leads, + lags)", "max |error| (LSB)",
+        axes[-1].plot(list(by_shift), [np.abs(e).max() for e in by_shift.values()], "o-", label=order)
+    label(axes[-1], "window start - frame start (% of a frame; - leads, + lags)", "max |error| (LSB)",
           "largest error against misalignment")
     save_figure(plt, fig, "camera_misalignment")
 
 
 def run():
-    curves = {order.name.lower(): misalignment(order) for order in (PlaneOrder.MSB_FIRST, PlaneOrder.LSB_FIRST)}
+    curves = {name: misalignment(order, name=f"camera_{name}") for name, order in ORDERS.items()}
     _write(curves)
     figures = {}
     for order, by_shift in curves.items():
@@ -87,11 +93,12 @@ def run():
             errors = by_shift[pct]
             figures[f"cam.{when}_error_lsb_max_{order}"] = (float(np.abs(errors).max()), "LSB")
             figures[f"cam.{when}_jump_at_128_lsb_{order}"] = (float(errors[128] - errors[127]), "LSB")
-    # the plane order with the smaller worst error a 1 % misalignment either way leaves:
-    # 0 MSB first, 1 LSB first
+    # the plane order with the smallest worst error a 1 % misalignment either way leaves:
+    # 0 MSB first, 1 LSB first, 2 interleaved
     worst = {order: max(figures[f"cam.{w}_1pct_error_lsb_max_{order}"][0] for w in ("lag", "lead"))
              for order in curves}
-    figures["cam.best_order_1pct"] = (list(curves).index(min(worst, key=worst.get)), "0 msb_first, 1 lsb_first")
+    figures["cam.best_order_1pct"] = (list(curves).index(min(worst, key=worst.get)),
+                                      "0 msb_first, 1 lsb_first, 2 interleaved")
     return figures
 
 
