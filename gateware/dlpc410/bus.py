@@ -8,8 +8,8 @@ once that group's memory may change (a dark load needs no data, and its deadline
 plane's, so it overtakes the loads queued before it), else the next load operation of the ready
 load at the head (a row of an occupied block, ``row_period`` after the last row and with a whole
 row of beats buffered; or a clear of an empty block), if that group's memory may change; each
-only if no loaded group's pulse falls due before the operation would end; else nothing. A load whose row data has
-not arrived is counted as an underrun (one per row that waits, however long).
+only if no loaded group's pulse falls due before the operation would end; else nothing. A load
+whose row data has not arrived is counted as an underrun (one per row that waits, however long).
 
 The decision is made from registered flags (the planner's, the bus's own) and registered; the
 cycle after, it is applied: the command registers (the pins show it :data:`DECISION_TO_PINS`
