@@ -17,7 +17,7 @@ import numpy as np
 
 from spec import plan_search, schedule
 from spec.facts import DMDS, SETTLE_READINGS
-from spec.registers import PlaneOrder, ResetMode, TriggerMode
+from spec.registers import ResetMode, TriggerMode
 
 from .client import DEFAULT_PORT, DELTA_ROWS, Client, ClientError, MasterClient, period_fault
 
@@ -73,9 +73,8 @@ def _plan(args):
             print("a phased plan: its loads have little slack for a store slower than the schedule model's "
                   "(docs/dlpc410_model.md); check the status reply's late pulses on the board")
     else:
-        order = PlaneOrder.TABLE if args.order == "INTERLEAVED" else PlaneOrder[args.order]
         plan = schedule.plan(dmd, args.dclk, reset_mode=ResetMode[args.reset_mode],
-                             **plan_search.order_kwargs(order, args.depth), **common)
+                             **plan_search.order_kwargs(plan_search.ORDER_NAMES[args.order], args.depth), **common)
     trigger = TriggerMode[args.trigger.upper()]
     given = round(args.period * schedule.FABRIC_HZ)
     if trigger == TriggerMode.PERIODIC:
@@ -165,7 +164,7 @@ def main(argv=None):
                            help="search every reset mode, plane order and hide threshold for the fastest legal "
                                 "plan (spec.plan_search; about two minutes on the DLP7000) instead of "
                                 "--reset-mode and --order")
-    configure.add_argument("--order", default="MSB_FIRST", choices=["MSB_FIRST", "LSB_FIRST", "INTERLEAVED"],
+    configure.add_argument("--order", default="MSB_FIRST", choices=list(plan_search.ORDER_NAMES),
                            help="plane order; INTERLEAVED: each short plane behind a long one (7 1 6 2 5 3 4 0)")
     configure.add_argument("--anchor", type=int, default=0, choices=range(8),
                            help="the position in the plane order a frame starts at (modulo its depth), "

@@ -23,10 +23,17 @@ from dataclasses import dataclass, replace
 from .registers import PlaneOrder, ResetMode
 from .schedule import Frame, Plan, exponents, frame_period, on_time, plan
 
-__all__ = ["Candidate", "Found", "find", "interleaved", "order_kwargs", "ORDERS"]
+__all__ = ["Candidate", "Found", "find", "interleaved", "order_kwargs", "order_name", "ORDERS", "ORDER_NAMES"]
 
-#: The plane orders tried (``TABLE``: :func:`interleaved`).
-ORDERS = (PlaneOrder.MSB_FIRST, PlaneOrder.LSB_FIRST, PlaneOrder.TABLE)
+#: The plane orders tried, by name (``INTERLEAVED``: ``TABLE`` with :func:`interleaved`).
+ORDER_NAMES = {"MSB_FIRST": PlaneOrder.MSB_FIRST, "LSB_FIRST": PlaneOrder.LSB_FIRST,
+               "INTERLEAVED": PlaneOrder.TABLE}
+ORDERS = tuple(ORDER_NAMES.values())
+
+
+def order_name(order):
+    """The name of one of :data:`ORDERS`."""
+    return next(name for name, o in ORDER_NAMES.items() if o == order)
 
 
 def interleaved(depth):
@@ -67,7 +74,7 @@ class Candidate:
 
     @property
     def order_name(self):
-        return "INTERLEAVED" if self.order == PlaneOrder.TABLE else self.order.name
+        return order_name(self.order)
 
     def describe(self):
         head = f"{self.reset_mode.name:6} {self.order_name:11} hide {self.hide:>7}"

@@ -365,22 +365,20 @@ class _Model:
     def enqueue(self, g, fi, j):
         """Queue the load of frame ``fi``'s display position ``j`` (None: clears) for group g."""
         dmd, frame = self.dmd, self.res.shown[fi]
-        ops = []
+        self.st[g].loaded_at = None
         if j is None:
             # a dark pulse's clears: queued apart, served before any load once the group's
             # memory may change (they need no data, and their window is the shortest plane's)
             self.darks.append([g, [("clear", b) for b in self.grp[g]], 0])
-            self.st[g].loaded_at = None
             return
+        ops = []
+        plane = frame.stored_plane(self.exps_of(fi)[j])
         for b in self.grp[g]:
-            if j is not None:
-                plane = frame.stored_plane(self.exps_of(fi)[j])
-                if self.p.source == Source.PRNG or frame.occupied(plane, b):
-                    ops += [("row", r) for r in range(b * dmd.rows_per_block, (b + 1) * dmd.rows_per_block)]
-                    continue
-            ops.append(("clear", b))
+            if self.p.source == Source.PRNG or frame.occupied(plane, b):
+                ops += [("row", r) for r in range(b * dmd.rows_per_block, (b + 1) * dmd.rows_per_block)]
+            else:
+                ops.append(("clear", b))
         self.queue.append([g, ops, 0])
-        self.st[g].loaded_at = None
 
     def next_frame_for(self, g):
         if g == 0:

@@ -28,7 +28,7 @@ from ..countdown import Countdown
 from ..counter import Counter
 from ..registers import Registers, ResetMode
 from .interface import BlockMode, RowMode
-from .layouts import COUNTER_BITS, Command, group_bits, ready_load
+from .layouts import COUNTER_BITS, Command, dark_load, group_bits, ready_load
 
 __all__ = ["Bus", "DECISION_TO_PINS"]
 
@@ -62,9 +62,9 @@ class Bus(wiring.Component):
         From the planner (registered).
     loads : In(stream.Signature(ready_load))
         Ready loads from the requester, taken when their last operation is applied.
-    darks : In(stream.Signature(ready_load))
-        The clears a dark pulse needs (no block in ``mask``), in the order of the pulses, taken
-        when their last clear is applied.
+    darks : In(stream.Signature(dark_load))
+        The clears a dark pulse needs, in the order of the pulses, taken when their last clear is
+        applied.
     beats : In(stream.Signature(bits_per_dclk * beats)); row_ready : In(1)
         Row data, one cycle's beats taken per cycle of a row cycle that loads a row; whether a
         whole row is buffered.
@@ -98,7 +98,7 @@ class Bus(wiring.Component):
             "imminent": In(1),
             "imminent_clear": In(1),
             "loads": In(stream.Signature(ready_load(dmd))),
-            "darks": In(stream.Signature(ready_load(dmd))),
+            "darks": In(stream.Signature(dark_load(dmd))),
             "beats": In(stream.Signature(dmd.bits_per_dclk * beats)),
             "row_ready": In(1),
             "choice": Out(dmd.blocks),

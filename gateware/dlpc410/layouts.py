@@ -13,8 +13,8 @@ from ..registers import TIME_BITS, ResetMode
 from ..store.layouts import COUNTER_BITS, SLOT_BITS
 from .interface import BlockMode, RowMode
 
-__all__ = ["group_bits", "block_bits", "group_span", "load_job", "ready_load", "event", "Command", "Status",
-           "COUNTER_BITS"]
+__all__ = ["group_bits", "block_bits", "group_span", "load_job", "ready_load", "dark_load", "event", "Command",
+           "Status", "COUNTER_BITS"]
 
 
 def group_bits(dmd):
@@ -51,6 +51,11 @@ def ready_load(dmd):
     return data.StructLayout({"group": group_bits(dmd), "mask": dmd.blocks,
                               "first": block_bits(dmd), "last": block_bits(dmd), "first_row": 11,
                               "first_occupied": 1, "single": 1})
+
+
+def dark_load(dmd):
+    """A dark pulse's clears: every block ``first`` .. ``last`` of ``group``."""
+    return data.StructLayout({"group": group_bits(dmd), "first": block_bits(dmd), "last": block_bits(dmd)})
 
 
 def event(shape):

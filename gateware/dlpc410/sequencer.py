@@ -37,7 +37,7 @@ from .bus import Bus
 from .camera import CameraTrigger
 from .control import FrameControl
 from .init import TRAINING_EDGES, Init
-from .layouts import Status, group_span, load_job, ready_load
+from .layouts import Status, dark_load, group_span, load_job, ready_load
 from .period_watch import PeriodWatch
 from .planner import Planner
 from .requester import Requester
@@ -155,7 +155,7 @@ class Sequencer(wiring.Component):
         m.submodules.jobs = jobs = Queue(load_job(dmd), depth=G + 1)
         m.submodules.requester = requester = Requester(dmd)
         m.submodules.loads = loads = Queue(ready_load(dmd), depth=G + 1)
-        m.submodules.darks = darks = Queue(ready_load(dmd), depth=G + 1)
+        m.submodules.darks = darks = Queue(dark_load(dmd), depth=G + 1)
         m.submodules.row_source = source = RowSource(dmd, beats=beats, store_words=self._store_words)
         m.submodules.bus = bus = Bus(dmd, beats=beats)
         m.submodules.camera = camera = CameraTrigger()
@@ -212,15 +212,7 @@ class Sequencer(wiring.Component):
             wiring.connect(m, getattr(control, name), getattr(planner, name))
 
         # ---- load jobs -> requester -> ready loads; row data ----
-        # the job queue always has room: one job per group in flight, first planes only once
-        # the queue is empty. A dark pulse's clears need no data: they go to the bus apart
-        job = planner.jobs.payload
-        m.d.comb += [jobs.w_stream.valid.eq(planner.jobs.valid & ~job.clear), jobs.w_stream.payload.eq(job),
-                     darks.w_stream.valid.eq(planner.jobs.valid & job.clear)]
-        dark = darks.w_stream.payload
-        dark_first, dark_last = group_span(dmd, regs.reset_mode, size_log2, job.group)
-        m.d.comb += [dark.group.eq(job.group), dark.first.eq(dark_first), dark.last.eq(dark_last),
-                     dark.single.eq(dark_first == dark_last)]
+        self._split_jobs(m, planner.jobs, jobs.w_stream, darks.w_stream, size_log2)
         wiring.connect(m, jobs.r_stream, requester.jobs)
         m.d.comb += [requester.size_log2.eq(size_log2), requester.flushing.eq(control.flushing),
                      self.occ_slot.eq(requester.occ_slot), requester.occupancy.eq(self.occupancy)]
@@ -277,8 +269,25 @@ class Sequencer(wiring.Component):
             self.status.underruns.eq(bus.underruns),
         ]
 
-        # ---- pins ----
-        pins = self.pins
+        self._drive_pins(m, init, bus)
+        return m
+
+    def _split_jobs(self, m, jobs, planes, darks, size_log2):
+        """The planner's ``jobs`` to the plane jobs' queue (``planes``, the requester's) and a dark
+        pulse's clears to their own (``darks``, the bus's: they need no data), with the group's
+        blocks. The queues always have room: one job per group in flight, first planes only once
+        the queue is empty."""
+        job = jobs.payload
+        dark = darks.payload
+        first, last = group_span(self._dmd, self.regs.reset_mode, size_log2, job.group)
+        m.d.comb += [planes.valid.eq(jobs.valid & ~job.clear), planes.payload.eq(job),
+                     darks.valid.eq(jobs.valid & job.clear),
+                     dark.group.eq(job.group), dark.first.eq(first), dark.last.eq(last)]
+
+    def _drive_pins(self, m, init, bus):
+        """The DLPC410's pins: the static ones from the registers, then the training pattern while
+        the controller initialises, else the bus's row cycles."""
+        dmd, regs, beats, pins = self._dmd, self.regs, self._beats, self.pins
         edges = 2 * beats
         m.d.comb += [pins.arstz.eq(1), pins.wdt_enblz.eq(1), pins.comp_data.eq(0),
                      pins.ns_flip.eq(regs.ns_flip), pins.pwr_float.eq(regs.park)]
@@ -300,4 +309,3 @@ class Sequencer(wiring.Component):
             m.d.comb += [pins.dvalid.eq(bus.dvalid.replicate(edges)), pins.rowmd.eq(cmd.rowmd),
                          pins.rowad.eq(cmd.rowad), pins.blkmd.eq(cmd.blkmd), pins.blkad.eq(cmd.blkad),
                          pins.rst2blkz.eq(cmd.rst2blkz)]
-        return m

@@ -22,12 +22,9 @@ from sim.seq_rig import run_rig
 from sim.tb.seq_sim import CAMERA_DELAY, CAMERA_RAMP
 from spec import plan_search, schedule
 from spec.facts import TEST_DMD
-from spec.registers import PlaneOrder, TriggerMode
+from spec.registers import TriggerMode
 
-__all__ = ["misalignment", "run", "SHIFTS_PCT", "ORDERS"]
-
-#: The plane orders measured, by name (``interleaved``: ``PlaneOrder.TABLE`` with its table).
-ORDERS = {"msb_first": PlaneOrder.MSB_FIRST, "lsb_first": PlaneOrder.LSB_FIRST, "interleaved": PlaneOrder.TABLE}
+__all__ = ["misalignment", "run", "SHIFTS_PCT"]
 
 #: Window start minus the ramp frame's first pulse, in % of the frame period (- leads, + lags).
 SHIFTS_PCT = tuple(sorted({*range(-100, 101, 5), -1, 1}))
@@ -83,7 +80,8 @@ def _write(curves):
 
 
 def run():
-    curves = {name: misalignment(order, name=f"camera_{name}") for name, order in ORDERS.items()}
+    curves = {name.lower(): misalignment(order, name=f"camera_{name.lower()}")
+              for name, order in plan_search.ORDER_NAMES.items()}
     _write(curves)
     figures = {}
     for order, by_shift in curves.items():
