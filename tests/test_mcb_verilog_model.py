@@ -34,3 +34,8 @@ def test_rule_breaks_agree_with_python_model(case):
                          ids="-".join)
 def test_calibration_loss_agrees_with_python_model(case):
     run("calibration_loss", plusargs=mcb_client.loss_plusargs(), case=list(case))
+
+
+@pytest.mark.verilog
+def test_read_after_idle_agrees_with_python_model():
+    run("read_after_idle")

@@ -153,7 +153,7 @@ module mcb_model #(
         // the command being executed
         reg busy, writing;
         integer words_left, addr, owed;
-        real now, next_word_at;
+        real now, next_word_at, refresh_end;
         reg [31:0] cycle;
         reg calib, bad_write, saw_loss;
         reg [63:0] word;
@@ -253,9 +253,14 @@ module mcb_model #(
             end
             // -- the controller side
             if (!busy && c_n != 0 && cycle >= c_time[c_head] + CMD_WAIT) begin
+                // each refresh due by the start runs at its time, or once the memory is free:
+                // an idle memory has done its refreshes by now (as the Python model's), they do
+                // not pile up on the next command
                 next_word_at = free_at > now ? free_at : now;
                 while (refresh_at <= next_word_at) begin
-                    next_word_at = next_word_at + REFRESH_NS;
+                    refresh_end = (refresh_at > free_at ? refresh_at : free_at) + REFRESH_NS;
+                    free_at = refresh_end;
+                    if (next_word_at < refresh_end) next_word_at = refresh_end;
                     refresh_at = refresh_at + REFRESH_INTERVAL_NS;
                 end
                 if (stall_permille != 0) begin

@@ -15,7 +15,7 @@ from sim.models.mcb import FIFO_DEPTH, READ, WRITE, McbError, McbModel, McbTimin
 
 __all__ = ["Client", "traffic", "writes", "reads", "python_reads", "python_fault", "CASES", "FAULTS",
            "PERIODS_S", "WIDTHS", "LossClient", "LOSS_CASES", "LOSS_AT_NS", "LOSS_NS", "loss_plusargs",
-           "python_loss"]
+           "python_loss", "IDLE_S", "read", "python_read_after_idle"]
 
 #: ``mcb_model.v`` fault codes -> the Python model's error kinds.
 FAULTS = {1: "before_calib", 2: "cmd_full", 3: "misaligned", 4: "out_of_range", 5: "data_missing",
@@ -137,25 +137,50 @@ def python_fault(script, port):
     return None
 
 
+#: How long the memory idles before :func:`python_read_after_idle`'s read: 256 refresh intervals.
+IDLE_S = 256 * McbTiming().refresh_interval_s
+
+
+def python_read_after_idle(port=1, idle_s=IDLE_S):
+    """Edges of ``port`` on the Python model from a one-word read (its first edge after the
+    memory idled ``idle_s`` from calibration) to the edge after which its word is in the read
+    FIFO. Refreshes fall due while the memory idles and are done then: the read waits for one at
+    most."""
+    model = _model()
+    port_model, period = model.ports[port], PERIODS_S[port]
+    out, cycle = port_model.outputs, 0
+    while not out["calib_done"]:
+        cycle += 1
+        out = port_model.clock(cycle * period)
+    start = cycle * period + idle_s
+    out = port_model.clock(start, **read(0))
+    for edges in range(1, 10000):
+        if not out["rd_empty"]:
+            return edges
+        out = port_model.clock(start + edges * period)
+    raise AssertionError("the read after the idle time never came")
+
+
 def _after_calib(*cycles):
     return [{}] * 210 + list(cycles)
 
 
-def _read(address, words=1):
+def read(address, words=1):
+    """The inputs of a read command of ``words`` words from byte ``address``."""
     return {"cmd_en": 1, "cmd_instr": READ, "cmd_bl": words - 1, "cmd_byte_addr": address}
 
 
 #: Scripts (per-cycle inputs of one port of ``width`` bits) that break one rule each.
 CASES = {
-    "before_calib": lambda width: [_read(0)],
+    "before_calib": lambda width: [read(0)],
     "rd_empty": lambda width: _after_calib({"rd_en": 1}),
-    "misaligned": lambda width: _after_calib(_read(width // 16)),          # half a port word
-    "out_of_range": lambda width: _after_calib(_read(WORDS * 8 - width // 8, 2)),
+    "misaligned": lambda width: _after_calib(read(width // 16)),          # half a port word
+    "out_of_range": lambda width: _after_calib(read(WORDS * 8 - width // 8, 2)),
     "data_missing": lambda width: _after_calib({"wr_en": 1, "wr_data": 1}, {"wr_en": 1, "wr_data": 2},
                                                {"cmd_en": 1, "cmd_instr": WRITE, "cmd_bl": 2, "cmd_byte_addr": 0}),
     "wr_full": lambda width: _after_calib(*[{"wr_en": 1, "wr_data": i} for i in range(FIFO_DEPTH + 1)]),
-    "cmd_full": lambda width: _after_calib(*[_read(64 * width // 8 * i, 64) for i in range(8)]),
-    "overflow": lambda width: _after_calib(_read(0, 64), _read(64 * width // 8, 64)),
+    "cmd_full": lambda width: _after_calib(*[read(64 * width // 8 * i, 64) for i in range(8)]),
+    "overflow": lambda width: _after_calib(read(0, 64), read(64 * width // 8, 64)),
 }
 
 
@@ -207,7 +232,7 @@ class LossClient:
         return (yield {"cmd_en": 1, "cmd_instr": WRITE, "cmd_bl": len(words) - 1, "cmd_byte_addr": self.address})
 
     def _read(self, words):
-        out = yield _read(self.address, words)
+        out = yield read(self.address, words)
         got = []
         while len(got) < words:
             if out["rd_empty"]:
@@ -225,14 +250,14 @@ class LossClient:
         while not (out["cmd_empty"] and out["wr_empty"]):
             out = yield {}
         # words left in the FIFOs for the loss to take
-        out = yield _read(self.address, 2)
+        out = yield read(self.address, 2)
         for _ in range(3):
             out = yield {"wr_en": 1, "wr_data": self.stale}
         while out["calib_done"]:
             self.before = {name: out[name] for name in FIFO_OUTPUTS}
             out = yield {}
         if self.case == "before_calib":
-            out = yield _read(self.address)
+            out = yield read(self.address)
         while not out["calib_done"]:
             out = yield {}
         self.after = {name: out[name] for name in FIFO_OUTPUTS}

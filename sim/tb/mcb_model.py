@@ -138,3 +138,26 @@ async def calibration_loss(dut):
             size = widths[port] // 8
             garbage = [model.read_word(client.address + i * size, size) for i in range(2)]
             assert client.read == garbage, f"port {port}: read {client.read}, the Python model holds {garbage}"
+
+
+@cocotb.test()
+async def read_after_idle(dut):
+    """A read on port 1 after the memory idled for hundreds of refresh intervals: its word comes
+    after as many edges as on the Python model (the refreshes fell due while the memory idled and
+    were done then; they do not pile up on the next command)."""
+    ports = await start(dut)
+    await run_ports(dut, ports, [None, None], 1000, until=lambda: ports.sample(1)["calib_done"])
+    await Timer(round(mcb_client.IDLE_S * 1e9), "ns")        # no edge: the memory idles
+    seen = {"edges": 0, "word": False}
+
+    def step(out):
+        if seen["edges"]:
+            seen["word"] = seen["word"] or not out["rd_empty"]
+        seen["edges"] += not seen["word"]
+        return mcb_client.read(0) if seen["edges"] == 1 else None
+
+    await run_ports(dut, ports, [None, step], 20000, until=lambda: seen["word"])
+    want = mcb_client.python_read_after_idle()
+    assert seen["word"], "the read after the idle time never came"
+    assert seen["edges"] == want, f"{seen['edges']} edges to the word, the Python model {want}"
+    assert ports.fault(1) is None
