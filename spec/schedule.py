@@ -72,7 +72,8 @@ from .registers import MIN_SETTLE, PlaneOrder, ResetMode, Source, TriggerMode, g
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate", "FABRIC_HZ",
            "beats_at", "row_cycles", "row_rate_words",
            "plan", "bound", "paper_eq_rate_hz", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS",
-           "flush_rows", "PAPER_SETTLE_CYCLES", "MIN_SETTLE", "RST_MARGIN", "DECISION_TO_PINS", "PACE_LAG",
+           "flush_rows", "PAPER_SETTLE_CYCLES", "MIN_SETTLE", "RST_MARGIN",
+           "FALL_LATENCY", "DECISION_TO_PINS", "PACE_LAG",
            "even", "ready_cycle", "reload_bound", "reload_cycles", "on_time", "frame_period"]
 
 #: The ``dmd`` domain's clock: every cycle count of the model and the sequencer is in its cycles.
@@ -132,10 +133,14 @@ PAPER_SETTLE_CYCLES = MIN_SETTLE
 #: command registers.
 DECISION_TO_PINS = 2
 
+#: Cycles from RST_ACTIVE falling at the pin to its fall in the sequencer (a two-flip-flop
+#: synchroniser).
+FALL_LATENCY = 2
+
 #: Cycles added to the RST_ACTIVE time: the command leaves :data:`DECISION_TO_PINS` cycles after
-#: its decision, RST_ACTIVE rises the cycle after, and the sequencer sees it through a
-#: two-flip-flop synchroniser; ``t_rst`` must cover the pin's high time plus this.
-RST_MARGIN = DECISION_TO_PINS + 3
+#: its decision, RST_ACTIVE rises the cycle after, and the sequencer sees it through its
+#: synchroniser; ``t_rst`` must cover the pin's high time plus this.
+RST_MARGIN = DECISION_TO_PINS + 1 + FALL_LATENCY
 
 #: A trigger's pace reaches the frame control's newer-frame guard this many cycles after the
 #: trigger (the guard's thresholds, the interval plus an eighth and the interval less
@@ -737,9 +742,9 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     ``trigger_hold``: a trigger that comes too early is held until every group is ready, rather
     than counted as an overrun.
     ``t_rst_cycles``: the controller's own RST_ACTIVE as the projector measured it (the status
-    reply's ``rst_active_cycles_max``, from the pulse's decision to the fall: the synchroniser's
-    margin included), taken as ``t_rst`` instead of the facts table's time plus
-    :data:`RST_MARGIN`.
+    reply's ``rst_active_cycles_max``, from the pulse's decision to the fall at the pin), plus
+    the synchroniser's :data:`FALL_LATENCY` (the strict reading's pin check sees the fall that
+    much later), taken as ``t_rst`` instead of the facts table's time plus :data:`RST_MARGIN`.
     ``reading``: a key of :data:`spec.facts.SETTLE_READINGS`. TI's (default) freezes a pulsed
     group's memory for ``t_rst + t_settle``; the four-DMD paper's frees it once RST_ACTIVE falls
     (``t_settle`` register :data:`PAPER_SETTLE_CYCLES`) and keeps the group's pulses ``t_settle``
@@ -747,7 +752,7 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     """
     beats = beats_at(dclk_hz)
     R = row_cycles(dmd, beats)
-    t_rst = even(t_rst_cycles) if t_rst_cycles is not None else \
+    t_rst = even(t_rst_cycles + FALL_LATENCY) if t_rst_cycles is not None else \
         even(_cycles(TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s) + RST_MARGIN)
     t_settle = _cycles(TIMING["t_settle"].value if t_settle_s is None else t_settle_s)
     t_flip = 0

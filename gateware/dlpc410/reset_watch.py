@@ -15,8 +15,9 @@ pulse cannot pass for the pulse's own reset and end its wait early. With the loo
 longer tells when the earlier group's reset ended, and that group falls back on the planned time.
 
 The longest RST_ACTIVE seen with the strict reading (from a pulse's decision to the fall, dated
-as above) is the ``t_rst`` a plan for this controller needs: it is reported, so that the host can
-plan with the controller's own time instead of the facts table's.
+as above) is reported, so that the host can plan with the controller's own time instead of the
+facts table's (:func:`spec.schedule.plan` adds the synchroniser's :data:`FALL_LATENCY`: the strict
+reading's pin check sees the fall that much later).
 
 Every time is a countdown (:mod:`gateware.countdown`) and the fault time is a chain of them
 (``t_rst`` to the planned fall, ``t_rst + t_settle`` more), so no sum is formed.
@@ -26,7 +27,7 @@ from amaranth import Cat, Module, Signal
 from amaranth.lib import enum, wiring
 from amaranth.lib.wiring import In, Out
 
-from spec.schedule import DECISION_TO_PINS
+from spec.schedule import DECISION_TO_PINS, FALL_LATENCY
 
 from ..countdown import Countdown
 from ..counter import Counter
@@ -35,9 +36,8 @@ from .layouts import COUNTER_BITS
 
 __all__ = ["ResetWatch", "FALL_LATENCY", "BLIND"]
 
-#: Cycles from RST_ACTIVE falling at the pin to its fall at ``rst_active`` (the two-flip-flop
-#: synchroniser): the fall is dated this much earlier, never later than it was.
-FALL_LATENCY = 2
+# (:data:`FALL_LATENCY`: cycles from RST_ACTIVE falling at the pin to its fall at
+# ``rst_active``; the fall is dated this much earlier, never later than it was)
 #: Cycles after a pulse is applied (a cycle after its decision) in which ``rst_active`` still
 #: shows the pin from before the pulse reached it.
 BLIND = DECISION_TO_PINS - 1 + FALL_LATENCY
