@@ -69,9 +69,6 @@ def _plan(args):
               f"settle reading and the {args.rst_active} RST_ACTIVE reading\n{found.table()}\n"
               f"fastest: {found.binds}")
         plan = found.plan
-        if plan.params.reset_mode != ResetMode.GLOBAL:
-            print("a phased plan: its loads have little slack for a store slower than the schedule model's "
-                  "(docs/dlpc410_model.md); check the status reply's late pulses on the board")
     else:
         plan = schedule.plan(dmd, args.dclk, reset_mode=ResetMode[args.reset_mode],
                              **plan_search.order_kwargs(plan_search.ORDER_NAMES[args.order], args.depth), **common)

@@ -136,8 +136,9 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=False, dmd="dlp70
     agree = ("frame starts equal the schedule model's" if r["compared_with_model"]
              else "the sequencer waits for late rows: not compared with the schedule model")
     print(f"frame period back to back, measured on the pins: {measured} cycles = {xga.DMD_HZ / measured:.1f} Hz "
-          f"({agree}; periods {periods}); schedule model (global reset, MSB "
-          f"first, LSB {r['lsb_cycles']} cycles, rows every {r['row_period']} cycles, t_rst {r['t_rst_cycles']} "
+          f"({agree}; periods {periods}); schedule model (the plan finder's: {r['reset_mode']} reset, "
+          f"{r['order']}, LSB {r['lsb_cycles']} cycles, stagger {r['stagger_cycles']}, "
+          f"rows every {r['row_period']} cycles, t_rst {r['t_rst_cycles']} "
           f"cycles{' as measured' if r['t_rst_measured'] else ''}): {r['period_cycles']} "
           f"cycles = {r['rate_hz']:.1f} Hz")
     spans = sorted({f["span_cycles"] for f in shown})

@@ -29,10 +29,12 @@ the window closes :data:`WINDOW_AFTER_US` after the frame's first clocking pulse
 
 Timing: DCLK 400 MHz (two beats per 200 MHz ``dmd`` cycle) by default, or 200 MHz; RST_ACTIVE and
 settle from the facts table (no scaling); only the DLPC410's initialisation (220 ms) is shortened,
-to ``INIT_CYCLES``. The schedule comes from :func:`spec.schedule.plan` with the read bandwidth
-the memory model gives the plane reader.
+to ``INIT_CYCLES``. The schedule is the plan finder's choice (:func:`spec.plan_search.find`) for
+the read bandwidth the memory model gives the plane reader.
 """
 
+import fcntl
+import hashlib
 import json
 import time
 from pathlib import Path
@@ -45,14 +47,15 @@ from scapy.packet import Raw
 from host import codec
 from sim.fast_top import PLUSARGS, SOURCES, WINDOW_SOURCES, FastSystem, pin_layout, read_rate
 from sim.harness import cocotb_run
-from sim.harness.paths import build_dir
+from sim.harness.paths import ROOT, build_dir
 from sim.models import bitplane, gmii, trace
 from sim.models.camera import Camera, to_lsb
 from sim.models.dlpc410 import Dlpc410
 from sim.models.mcb import McbTiming
 from sim.scene import default_scene
-from spec import records, schedule
+from spec import plan_search, records, schedule
 from spec.facts import DMDS, TIMING
+from spec.registers import PlaneOrder, ResetMode
 
 __all__ = ["run", "plan", "DMD", "DMD_HZ", "DCLK_HZ"]
 
@@ -83,11 +86,28 @@ WINDOW_AFTER_US = 5
 
 
 def plan(dclk_hz=DCLK_HZ, t_rst_cycles=None, dmd=DMD):
-    """The schedule for the run: global reset, MSB first, rows paced to the read bandwidth the
-    memory leaves the plane reader, early triggers held; ``t_rst_cycles``: the controller's
-    RST_ACTIVE as the projector measured it (default: the facts table's)."""
-    return schedule.plan(dmd, dclk_hz, depth=8, words_per_cycle=read_rate(McbTiming(), DMD_HZ),
-                         trigger_hold=True, t_rst_cycles=t_rst_cycles)
+    """The schedule for the run, as a user plans it (``python -m host configure --best``): the
+    plan finder's fastest legal plan (every reset mode, plane order and hide threshold) for rows
+    paced to the read bandwidth the memory leaves the plane reader, early triggers held;
+    ``t_rst_cycles``: the controller's RST_ACTIVE as the projector measured it (default: the
+    facts table's). The finder's choice is kept in the build directory, keyed by the arguments
+    and the planner's source, so that later runs plan only that one choice."""
+    kwargs = {"depth": 8, "words_per_cycle": read_rate(McbTiming(), DMD_HZ), "trigger_hold": True,
+              "t_rst_cycles": t_rst_cycles}
+    source = b"".join(path.read_bytes() for path in sorted((ROOT / "spec").glob("*.py")))
+    key = hashlib.sha256(json.dumps([dmd.name, dclk_hz, kwargs]).encode() + source).hexdigest()[:16]
+    path = build_dir("plans") / f"{key}.json"
+    with open(path.with_suffix(".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)          # (test workers that plan at once search once)
+        if path.exists():
+            choice = json.loads(path.read_text())
+            found = plan_search.candidate(dmd, dclk_hz, ResetMode[choice["reset_mode"]],
+                                          PlaneOrder[choice["order"]], choice["hide"], **kwargs)
+        else:
+            found = plan_search.find(dmd, dclk_hz, **kwargs).best
+            path.write_text(json.dumps({"reset_mode": found.reset_mode.name, "order": found.order.name,
+                                        "hide": found.hide}))
+    return found.plan
 
 
 def calibrate(key, dclk_hz=DCLK_HZ, faults=None, log=print, dmd=DMD):
@@ -335,6 +355,9 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
         "model_span_cycles": _model_span(dmd, the_plan),
         "lsb_cycles": lsb,
         "row_period": the_plan.params.row_period,
+        "reset_mode": p.reset_mode.name.lower(),
+        "order": plan_search.order_name(p.order).lower().replace("_", " "),
+        "stagger_cycles": p.stagger,
         "pulse_to_mirror_cycles": round(TIMING["t_pulse_to_mirror"].value * DMD_HZ),
         "back_to_back_model": want,
         "compared_with_model": compared,

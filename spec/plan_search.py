@@ -23,7 +23,8 @@ from dataclasses import dataclass, replace
 from .registers import PlaneOrder, ResetMode
 from .schedule import Frame, Plan, exponents, frame_period, on_time, plan
 
-__all__ = ["Candidate", "Found", "find", "interleaved", "order_kwargs", "order_name", "ORDERS", "ORDER_NAMES"]
+__all__ = ["Candidate", "Found", "candidate", "find", "interleaved", "order_kwargs", "order_name", "ORDERS",
+           "ORDER_NAMES"]
 
 #: The plane orders tried, by name (``INTERLEAVED``: ``TABLE`` with :func:`interleaved`).
 ORDER_NAMES = {"MSB_FIRST": PlaneOrder.MSB_FIRST, "LSB_FIRST": PlaneOrder.LSB_FIRST,
@@ -130,6 +131,15 @@ def _candidates(dmd, dclk_hz, depth, mode, order, hides, plan_kwargs):
                          binds=base.binds + " (hide raised: more planes end dark)")
         out.append(Candidate(ResetMode(mode), order, hide, higher))
     return out
+
+
+def candidate(dmd, dclk_hz, mode, order, hide, *, depth=8, **plan_kwargs):
+    """The candidate :func:`find` makes of one reset mode, plane order and hide threshold (a
+    choice found before, planned again without the search)."""
+    for c in _candidates(dmd, dclk_hz, depth, mode, order, True, plan_kwargs):
+        if c.hide == hide:
+            return c
+    raise ValueError(f"no candidate with hide {hide} for {ResetMode(mode).name}, {order_name(order)}")
 
 
 def find(dmd, dclk_hz, *, depth=8, modes=tuple(ResetMode), orders=ORDERS, hides=True, workers=None,
