@@ -5,8 +5,9 @@ may take it: while it rests (:attr:`gateware.dlpc410.sequencer.Sequencer.at_rest
 first frame, or every group loaded and waiting for a trigger). Frames may play for a long time
 (a chained run rests only when disarmed), so sets wait in a mailbox in ``sync`` where the newest replaces an
 older one not yet sent; from there they cross through a small :class:`amaranth.lib.fifo.AsyncFIFO`
-(every bit of a set crosses together) and the sequencer side takes the next one when it rests,
-telling the sequencer to load its first plane again under the new registers.
+(every bit of a set crosses together) into a register on the sequencer side, which applies it
+when the sequencer rests, telling the sequencer to load its first plane again under the new
+registers.
 """
 
 from amaranth import DomainRenamer, Module, Signal
@@ -73,10 +74,15 @@ class RegisterCrossing(wiring.Component):
         with m.Elif(into.ready):
             m.d.sync += full.eq(0)
 
-        # ---- dmd: applied whole, while the sequencer rests ----
+        # ---- dmd: taken into a register as it arrives, applied whole while the sequencer rests
+        # (the FIFO's read side does not wait on the sequencer's decisions) ----
+        held, holding = Signal(Registers), Signal()
+        m.d.comb += out.ready.eq(~holding)
+        with m.If(out.valid & ~holding):
+            m.d.dmd += [held.eq(out.payload), holding.eq(1)]
         m.submodules.applied = applied = DomainRenamer({"sync": "dmd"})(Counter(len(self.applied)))
-        m.d.comb += [self.applied.eq(applied.count), applied.inc.eq(out.valid & self.at_rest)]
-        with m.If(out.valid & self.at_rest):
-            m.d.comb += [out.ready.eq(1), self.reload.eq(1)]
-            m.d.dmd += self.regs.eq(out.payload)
+        m.d.comb += [self.applied.eq(applied.count), applied.inc.eq(holding & self.at_rest)]
+        with m.If(holding & self.at_rest):
+            m.d.comb += self.reload.eq(1)
+            m.d.dmd += [self.regs.eq(held), holding.eq(0)]
         return m
