@@ -20,6 +20,9 @@ def main(argv=None):
     timing.add_argument("--block", default=None, help="one block of flow.blocks instead of the core")
     timing.add_argument("--over", action="append", default=[], metavar="DOMAIN",
                         help="list every register a path over the budget ends at, in this domain (repeatable)")
+    timing.add_argument("--path", action="append", default=[], metavar="REGISTER",
+                        help="the deepest path to the register named like this, cell by cell, with the named "
+                             "signals each cell reads (repeatable)")
     formal = sub.add_parser("formal", help="prove or check every formal property (SymbiYosys)")
     formal.add_argument("--quick", action="store_true", help="BMC to the test suite's depths, no proofs")
     formal.add_argument("--only", action="append", help="only this block (repeatable)")
@@ -51,7 +54,7 @@ def main(argv=None):
         return run(blocks=args.block, jobs=args.jobs)
     if args.command == "timing":
         from flow.timing import main as run
-        return run(block=args.block, over=args.over)
+        return run(block=args.block, over=args.over, path=args.path)
     if args.command == "formal":
         from flow.formal import main as run
         return run(quick=args.quick, only=args.only)

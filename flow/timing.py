@@ -16,14 +16,16 @@ level from its read address to its output. A path belongs to the clock domain of
 ends at. The budget for 200 MHz on a -3 Spartan-6 that the ``dmd`` domain
 is pipelined to: at most 4 LUT levels and one carry chain of at most 16 bits on any path.
 
-``python -m flow timing`` prints the figures and the deepest paths of the projector's core.
+``python -m flow timing`` prints the figures and the deepest paths of the projector's core;
+``--path NAME`` also prints the deepest path to a register, cell by cell, with the named nets
+each cell reads (the LUTs' own names are the mapper's), to read it against the source.
 """
 
 import json
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["Depth", "analyse", "netlist", "report", "figures", "BUDGET", "main"]
+__all__ = ["Depth", "analyse", "deepest_path", "netlist", "report", "figures", "BUDGET", "main"]
 
 #: The ``dmd`` domain's budget: LUT levels, carry bits, carry chains per path.
 BUDGET = {"lut_levels_max": 4, "carry_max": 16, "carry_chains_max": 1}
@@ -66,6 +68,7 @@ class Depth:
     chains: int = 0
     run: int = 0
     start: str = ""
+    via: int | None = None      # the input net of the deepest LUT path's last cell
 
 
 def netlist(verilog, top, *, workdir):
@@ -91,10 +94,8 @@ def _sequential(kind):
     return kind.startswith(_SEQUENTIAL_PREFIXES)
 
 
-def analyse(module, *, keep=5):
-    """Per clock domain (named after the net on the clock pins): ``{"lut_levels_max",
-    "carry_max", "carry_chains_max", "paths"}``, ``paths`` the ``keep`` deepest, deepest first, as
-    ``(luts, carry bits, chains, start, end)``."""
+def _depths(module):
+    """Every net's :class:`Depth`, with the netlist's names, cells and drivers."""
     names = {}
     for name, net in module["netnames"].items():
         for bit in net["bits"]:
@@ -167,12 +168,14 @@ def analyse(module, *, keep=5):
             for out_pin, addr in reads(cell).items():
                 ds = [of(b) for b in addr]
                 deepest = max(ds, key=lambda d: d.luts, default=Depth(start=cname))
+                via = max(addr, key=lambda b: of(b).luts, default=None)
                 settle(cell["connections"][out_pin],
                        Depth(deepest.luts + 1, max((d.carry for d in ds), default=0),
-                             max((d.chains for d in ds), default=0), 0, deepest.start))
+                             max((d.chains for d in ds), default=0), 0, deepest.start, via))
             continue
         ins = [(pin, of(bit)) for pin, bit in inputs(cell)]
         deepest = max((d for _, d in ins), key=lambda d: d.luts, default=Depth(start=cname))
+        via = max((bit for _, bit in inputs(cell) if isinstance(bit, int)), key=lambda b: of(b).luts, default=None)
         luts = deepest.luts + (1 if kind in _LUTS else _DSP_LEVELS if kind == "DSP48A1" else 0)
         carry = max((d.carry for _, d in ins), default=0)
         chains = max((d.chains for _, d in ins), default=0)
@@ -183,31 +186,42 @@ def analyse(module, *, keep=5):
             carry = max(carry, run)
             chains = max([d.chains + 1 for pin, d in ins if pin != "CI"]
                          + [d.chains + (0 if d.run else 1) for pin, d in ins if pin == "CI"])
-        out = Depth(luts, carry, chains, run, deepest.start)
+        out = Depth(luts, carry, chains, run, deepest.start, via)
         for pin, direction in cell["port_directions"].items():
             if direction == "output":
                 settle(cell["connections"][pin], out)
+    return of, names, cells, drivers, inputs
 
-    domains = {}
+
+def _ends(cells, names, inputs, of):
+    """Each path's end: ``(clock net, end name, input pin, its Depth)``, a path ending at a
+    flip-flop, block RAM, DSP or shift register input, or at a LUT-RAM's write side (its
+    read-only addresses not: those paths go on through the read)."""
     for cname, cell in cells.items():
-        # a path ends at a flip-flop, block RAM, DSP or shift register input, and at a LUT-RAM's
-        # write side (its read-only addresses not: those paths go on through the read)
         if not (_sequential(cell["type"]) or cell["type"] in _LUTRAM_READS):
             continue
         read_only = _LUTRAM_READ_ONLY.get(cell["type"], set())
         clocks = [cell["connections"][p][0] for p in _CLOCK_PINS if p in cell["connections"]]
-        domain = names.get(clocks[0], "?") if clocks else "?"
-        entry = domains.setdefault(domain, {"lut_levels_max": 0, "carry_max": 0, "carry_chains_max": 0,
-                                            "paths": []})
         end = names.get(cell["connections"].get("Q", [None])[0], cname)
         for pin, bit in inputs(cell):
-            if pin.rstrip("0123456789") in read_only:
-                continue
-            d = of(bit)
-            entry["lut_levels_max"] = max(entry["lut_levels_max"], d.luts)
-            entry["carry_max"] = max(entry["carry_max"], d.carry)
-            entry["carry_chains_max"] = max(entry["carry_chains_max"], d.chains)
-            entry["paths"].append((d.luts, d.carry, d.chains, d.start, end))
+            if pin.rstrip("0123456789") not in read_only:
+                yield (clocks[0] if clocks else None), end, bit, of(bit)
+
+
+def analyse(module, *, keep=5):
+    """Per clock domain (named after the net on the clock pins): ``{"lut_levels_max",
+    "carry_max", "carry_chains_max", "paths"}``, ``paths`` the ``keep`` deepest, deepest first, as
+    ``(luts, carry bits, chains, start, end)``."""
+    of, names, cells, _drivers, inputs = _depths(module)
+    domains = {}
+    for clock, end, _bit, d in _ends(cells, names, inputs, of):
+        domain = names.get(clock, "?") if clock is not None else "?"
+        entry = domains.setdefault(domain, {"lut_levels_max": 0, "carry_max": 0, "carry_chains_max": 0,
+                                            "paths": []})
+        entry["lut_levels_max"] = max(entry["lut_levels_max"], d.luts)
+        entry["carry_max"] = max(entry["carry_max"], d.carry)
+        entry["carry_chains_max"] = max(entry["carry_chains_max"], d.chains)
+        entry["paths"].append((d.luts, d.carry, d.chains, d.start, end))
     for entry in domains.values():
         entry["over"] = over_budget(entry["paths"])
         seen, paths = set(), []
@@ -219,6 +233,33 @@ def analyse(module, *, keep=5):
                 break
         entry["paths"] = paths
     return domains
+
+
+def deepest_path(module, end):
+    """The deepest path ending at a register whose name contains ``end``: ``(end name, steps)``,
+    each step a combinational cell from the start on, as ``(LUT levels so far, cell type, the
+    named nets it reads)`` (Yosys' own ``$`` nets left out: they name nothing in the source), so
+    that a path through LUTs whose names the mapping lost can be read against the source."""
+    of, names, cells, drivers, inputs = _depths(module)
+    bit_names = {}
+    for name, net in module["netnames"].items():
+        if name.startswith("$"):
+            continue
+        for index, bit in enumerate(net["bits"]):
+            if isinstance(bit, int) and (bit not in bit_names or len(name) < len(bit_names[bit])):
+                bit_names[bit] = f"{name}[{index}]" if len(net["bits"]) > 1 else name
+    found = [(d.luts, name, bit) for _clock, name, bit, d in _ends(cells, names, inputs, of) if end in name]
+    if not found:
+        raise ValueError(f"no register named like {end!r}")
+    _luts, name, bit = max(found, key=lambda f: f[0])
+    steps = []
+    while isinstance(bit, int) and bit in drivers and not _sequential(cells[drivers[bit]]["type"]):
+        cell = cells[drivers[bit]]
+        read = sorted({bit_names[b] for _pin, b in inputs(cell) if b in bit_names})
+        steps.append((of(bit).luts, cell["type"], read))
+        bit = of(bit).via
+    start = bit_names.get(bit, names.get(bit, "input")) if isinstance(bit, int) else "constant"
+    return name, [(0, "start", [start])] + steps[::-1]
 
 
 def _within(path):
@@ -248,15 +289,19 @@ def _domain_of(net):
     return "sync" if net == "clk" else net[:-len("_clk")] if net.endswith("_clk") else net
 
 
-def report(component=None, *, name="projector", workdir="build/timing"):
-    """Synthesise the projector's core (or ``component``) and analyse it: ``{domain: ...}``."""
+def report(component=None, *, name="projector", workdir="build/timing", keep_netlist=False):
+    """Synthesise the projector's core (or ``component``) and analyse it: ``{domain: ...}``
+    (and the netlist under ``None`` with ``keep_netlist``)."""
     from amaranth.back import verilog
     if component is None:
         from flow.blocks import core
         component = core()
     text = verilog.convert(component, name=name, emit_src=False, strip_internal_attrs=True)
-    result = analyse(netlist(text, name, workdir=workdir))
-    return {_domain_of(domain): entry for domain, entry in result.items()}
+    module = netlist(text, name, workdir=workdir)
+    out = {_domain_of(domain): entry for domain, entry in analyse(module).items()}
+    if keep_netlist:
+        out[None] = module
+    return out
 
 
 def figures(result):
@@ -285,12 +330,19 @@ def print_report(result, *, over=()):
                 print(f"    {luts:3d} LUT {carry:3d} bits {chains} chain(s) {count:5d} path(s): {name} <- {start}")
 
 
-def main(*, block=None, over=()):
-    """``block``: one block of :data:`flow.blocks.BLOCKS` instead of the projector's core."""
+def main(*, block=None, over=(), path=()):
+    """``block``: one block of :data:`flow.blocks.BLOCKS` instead of the projector's core;
+    ``path``: print the deepest path to each register named like these, step by step."""
     if block is None:
-        result = report()
+        result = report(keep_netlist=bool(path))
     else:
         from flow.blocks import BLOCKS
-        result = report(BLOCKS[block](), name=block, workdir=f"build/timing/{block}")
+        result = report(BLOCKS[block](), name=block, workdir=f"build/timing/{block}", keep_netlist=bool(path))
+    netlist_ = result.pop(None, None)
     print_report(result, over=over)
+    for end in path:
+        name, steps = deepest_path(netlist_, end)
+        print(f"deepest path to {name}: {steps[-1][0]} LUT levels")
+        for luts, kind, read in steps:
+            print(f"  {luts:3d} {kind:8} {', '.join(read)}")
     return 0
