@@ -71,7 +71,8 @@ class FrameControl(wiring.Component):
         No frame plays and no load is under way: before the first frame, or every group loaded
         and waiting for a trigger (as registered the cycle before, less this cycle's decisions).
     offer : In(:class:`~gateware.dlpc410.frame_offer.Offer`)
-        The frame the store offers.
+        The frame the store offers (``valid`` unless group 0's take answers it now; a start or
+        retake applied now is counted in here).
     playing, ended : In(1)
         From the planner.
     drained : In(1)
@@ -201,9 +202,14 @@ class FrameControl(wiring.Component):
         # trigger is obeyed before every group is loaded again), and the settle times of the last
         # pulses still hold. With ``reload`` at rest, the same frame is loaded again under new
         # registers.
-        newer = ~use_prng & ~regs.chain & self.offer.valid & (~self.offer.sequence | ended)
+        # (the offer is ``valid`` unless group 0's take answers it now; a start, restart or newer
+        # frame's take applied now answers it too, and ends a sequence's ``ended``: neither is
+        # counted in here, off the loop from the decisions applied to the next, as no frame is
+        # taken or trigger obeyed then: a start or restart leaves ``run`` low, every take leaves
+        # ``all_ready`` low, and a newer frame's take is masked below)
+        newer = ~use_prng & ~regs.chain & self.offer.valid & (~self.offer.sequence | self.ended)
         fits = self._fits(m)
-        takes = run & ((~playing & newer & fits) | (all_ready & self.reload))
+        takes = run & ~(did.take & did.newer) & ((~playing & newer & fits) | (all_ready & self.reload))
         starts = fsm.ongoing("WAIT") & self.initialised & (self.offer.valid | use_prng) & ~did.start
         # a trigger is obeyed when every group is ready; one that comes sooner is held (with
         # ``trigger_hold``) and obeyed on the first cycle they are, before any new one (every

@@ -43,6 +43,8 @@ class FrameOffer(wiring.Component):
     offer : Out(Offer)
         The frame offered, as the store offered it the cycle before; not ``valid`` while a take
         is answered.
+    held : Out(1)
+        The frame offered is valid, takes answered now not counted in (registered).
     bad_frames : Out(COUNTER_BITS)
         Frames dropped for their bit depth.
     """
@@ -50,6 +52,7 @@ class FrameOffer(wiring.Component):
     frames: In(stream.Signature(FrameInfo))
     answered: In(1)
     offer: Out(Offer)
+    held: Out(1)
     bad_frames: Out(COUNTER_BITS)
 
     def elaborate(self, platform):
@@ -62,7 +65,7 @@ class FrameOffer(wiring.Component):
                      held.slot.eq(frames.payload.slot), held.depth.eq(depth),
                      held.sequence.eq(frames.payload.sequence),
                      held.showing.eq(frames.payload.showing), held.low_plane.eq(frames.payload.low_plane)]
-        m.d.comb += [self.offer.eq(held), self.offer.valid.eq(held.valid & ~answered),
+        m.d.comb += [self.offer.eq(held), self.offer.valid.eq(held.valid & ~answered), self.held.eq(held.valid),
                      frames.ready.eq(answered | (frames.valid & ~ok))]
         m.submodules.bad = bad = Counter(COUNTER_BITS)
         bad_seen = Signal()                    # (counted a cycle later)

@@ -64,7 +64,9 @@ class Planner(wiring.Component):
         A frame taken is answered (``ready``) the cycle after it was taken.
     offer : Out(Offer)
         The frame offered, as the store offered it the cycle before
-        (:data:`spec.schedule.OFFER_LAG`), for the frame control.
+        (:data:`spec.schedule.OFFER_LAG`), for the frame control: ``valid`` unless group 0's take
+        of it is answered now (a start or retake the frame control applies now is its own to
+        count in).
     choice : In(blocks)
         The bus's decision this cycle: bit g, a pulse of group g (one bit at most).
     pulsing : In(1)
@@ -203,14 +205,15 @@ class Planner(wiring.Component):
         taking = Signal()                      # group 0 took the offered frame last cycle
         m.d.comb += [offers.answered.eq(taking | (self.start.valid & self.start.payload.take)
                                         | (self.retake.valid & self.retake.payload.newer)),
-                     self.offer.eq(offers.offer), self.bad_frames.eq(offers.bad_frames),
+                     self.offer.eq(offers.offer), self.offer.valid.eq(offers.held & ~taking),
+                     self.bad_frames.eq(offers.bad_frames),
                      frames.offered.slot.eq(offers.offer.slot), frames.offered.depth.eq(offers.offer.depth),
                      frames.offered.low_plane.eq(offers.offer.low_plane),
                      frames.offered.showing.eq(offers.offer.showing)]
 
         # ---- the decision: what the pulse the bus chooses does (registered) ----
         P = self.choice
-        usable = self.offer.valid & ~use_prng
+        usable = offers.offer.valid & ~use_prng
         hidden, final, takes_offered = self._outcomes(m, info, frames, dark, usable)
         # the reset mode's last group (its groups are 0 .. n - 1)
         last_group = Cat(active[g] & (~active[g + 1] if g + 1 < G else 1) for g in range(G))
