@@ -168,7 +168,7 @@ def _depths(module):
             for out_pin, addr in reads(cell).items():
                 ds = [of(b) for b in addr]
                 deepest = max(ds, key=lambda d: d.luts, default=Depth(start=cname))
-                via = max(addr, key=lambda b: of(b).luts, default=None)
+                via = addr[ds.index(deepest)] if ds else None
                 settle(cell["connections"][out_pin],
                        Depth(deepest.luts + 1, max((d.carry for d in ds), default=0),
                              max((d.chains for d in ds), default=0), 0, deepest.start, via))
@@ -289,19 +289,23 @@ def _domain_of(net):
     return "sync" if net == "clk" else net[:-len("_clk")] if net.endswith("_clk") else net
 
 
-def report(component=None, *, name="projector", workdir="build/timing", keep_netlist=False):
-    """Synthesise the projector's core (or ``component``) and analyse it: ``{domain: ...}``
-    (and the netlist under ``None`` with ``keep_netlist``)."""
+def _synthesise(component=None, *, name="projector", workdir="build/timing"):
+    """The flattened netlist of the projector's core (or ``component``)."""
     from amaranth.back import verilog
     if component is None:
         from flow.blocks import core
         component = core()
     text = verilog.convert(component, name=name, emit_src=False, strip_internal_attrs=True)
-    module = netlist(text, name, workdir=workdir)
-    out = {_domain_of(domain): entry for domain, entry in analyse(module).items()}
-    if keep_netlist:
-        out[None] = module
-    return out
+    return netlist(text, name, workdir=workdir)
+
+
+def _by_domain(module):
+    return {_domain_of(domain): entry for domain, entry in analyse(module).items()}
+
+
+def report(component=None, *, name="projector", workdir="build/timing"):
+    """Synthesise the projector's core (or ``component``) and analyse it: ``{domain: ...}``."""
+    return _by_domain(_synthesise(component, name=name, workdir=workdir))
 
 
 def figures(result):
@@ -334,14 +338,13 @@ def main(*, block=None, over=(), path=()):
     """``block``: one block of :data:`flow.blocks.BLOCKS` instead of the projector's core;
     ``path``: print the deepest path to each register named like these, step by step."""
     if block is None:
-        result = report(keep_netlist=bool(path))
+        module = _synthesise()
     else:
         from flow.blocks import BLOCKS
-        result = report(BLOCKS[block](), name=block, workdir=f"build/timing/{block}", keep_netlist=bool(path))
-    netlist_ = result.pop(None, None)
-    print_report(result, over=over)
+        module = _synthesise(BLOCKS[block](), name=block, workdir=f"build/timing/{block}")
+    print_report(_by_domain(module), over=over)
     for end in path:
-        name, steps = deepest_path(netlist_, end)
+        name, steps = deepest_path(module, end)
         print(f"deepest path to {name}: {steps[-1][0]} LUT levels")
         for luts, kind, read in steps:
             print(f"  {luts:3d} {kind:8} {', '.join(read)}")

@@ -1,6 +1,6 @@
 """The logic-depth analysis (:mod:`flow.timing`) on a small design whose paths are known: a
-register fed through a chain of XORs of registers (each level a LUT), and the deepest path to it
-read back cell by cell with the registers each cell reads."""
+register fed by the parity of 64 registers (a tree of LUTs), and the deepest path to it read back
+cell by cell with the registers each cell reads."""
 
 from amaranth import Module, Signal
 from amaranth.back import verilog

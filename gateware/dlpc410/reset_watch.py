@@ -34,10 +34,8 @@ from ..counter import Counter
 from ..registers import Registers
 from .layouts import COUNTER_BITS
 
-__all__ = ["ResetWatch", "FALL_LATENCY", "BLIND"]
+__all__ = ["ResetWatch", "BLIND"]
 
-# (:data:`FALL_LATENCY`: cycles from RST_ACTIVE falling at the pin to its fall at
-# ``rst_active``; the fall is dated this much earlier, never later than it was)
 #: Cycles after a pulse is applied (a cycle after its decision) in which ``rst_active`` still
 #: shows the pin from before the pulse reached it.
 BLIND = DECISION_TO_PINS - 1 + FALL_LATENCY
