@@ -13,8 +13,9 @@ whose row data has not arrived is counted as an underrun (one per row that waits
 
 The decision is made from registered flags (the planner's, the bus's own) and registered; the
 cycle after, it is applied: the command registers (the pins show it :data:`DECISION_TO_PINS`
-cycles after the decision), the pulse event, the load's progress. A load's last operation ends
-the group's load on the cycle before the next decision may be made.
+cycles after the decision), the pulse event, the load's progress. (The operation is registered
+as chosen without the pulses, and a pulse decided with it takes its place as it is applied.) A
+load's last operation ends the group's load on the cycle before the next decision may be made.
 """
 
 from amaranth import Array, Cat, Const, Module, Mux, Signal
@@ -153,8 +154,10 @@ class Bus(wiring.Component):
         occupied = Mux(fresh, head.first_occupied, l_occupied)
         last_op = Mux(fresh, head.single, l_last)
         m.submodules.pace = pace = Countdown(8, lag=1, flags="settled")
-        # (one AND of the flags each: no pulse goes first, the head's group may change, ...)
-        may_op = free & ~self.flushing & ~self.hold & ~(pin_ok & due.any())
+        # (one AND of the flags each: the head's group may change, ...; chosen as if no pulse
+        # were due, the pulse's priority applied from the registered decision, so that the due
+        # flags' priority is not in series with the operation's conditions)
+        may_op = free & ~self.flushing & ~self.hold
         # ---- a dark pulse's clears first, once its group's memory may change ----
         dark = self.darks.payload
         d_fresh = Signal(init=1)               # the dark's first block is next
@@ -186,9 +189,13 @@ class Bus(wiring.Component):
                      dec.following_filled.eq(head.mask.bit_select(following, 1))]
 
         # ---- applied ----
-        op = dec.row | dec.clear
-        m.d.comb += [pace.load.eq(dec.row), pace.value.eq(regs.row_period)]
-        with m.If(dec.clear & dec.dark):
+        # (a pulse goes first: the operation was chosen as if none were due)
+        row, clear, starved = Signal(), Signal(), Signal()
+        m.d.comb += [row.eq(dec.row & ~dec.pulse), clear.eq(dec.clear & ~dec.pulse),
+                     starved.eq(dec.starved & ~dec.pulse)]
+        op = row | clear
+        m.d.comb += [pace.load.eq(row), pace.value.eq(regs.row_period)]
+        with m.If(clear & dec.dark):
             with m.If(dec.last):
                 m.d.comb += self.darks.ready.eq(1)
                 m.d.sync += d_fresh.eq(1)
@@ -200,18 +207,18 @@ class Bus(wiring.Component):
                 m.d.sync += fresh.eq(1)
             with m.Else():
                 m.d.sync += fresh.eq(0)
-                row = Mux(dec.fresh, 0, l_row)
-                with m.If(dec.row & (row != rpb - 1)):
+                at_row = Mux(dec.fresh, 0, l_row)
+                with m.If(row & (at_row != rpb - 1)):
                     # the block's next row
-                    m.d.sync += [l_block.eq(dec.block), l_row.eq(row + 1), l_occupied.eq(1),
-                                 l_last.eq(dec.block_last & (row == rpb - 2))]
+                    m.d.sync += [l_block.eq(dec.block), l_row.eq(at_row + 1), l_occupied.eq(1),
+                                 l_last.eq(dec.block_last & (at_row == rpb - 2))]
                 with m.Else():
                     # the next block: its rows, or a clear
                     m.d.sync += [l_block.eq(dec.following), l_row.eq(0), l_occupied.eq(dec.following_filled),
                                  l_last.eq(dec.following_last & (~dec.following_filled | (rpb == 1)))]
             # rows are numbered block after block: the next row follows this one, or the next
             # block's first row follows a cleared block's
-            m.d.sync += row_at.eq(dec.row_at + Mux(dec.row, 1, rpb))
+            m.d.sync += row_at.eq(dec.row_at + Mux(row, 1, rpb))
         with m.If(self.flushing):
             m.d.comb += [self.loads.ready.eq(1), self.darks.ready.eq(1)]
         with m.If(self.restart):
@@ -219,16 +226,16 @@ class Bus(wiring.Component):
 
         # a row counts once however many cycles it waits for its data
         waiting = Signal()
-        with m.If(dec.starved):
+        with m.If(starved):
             m.d.sync += waiting.eq(1)
-        with m.If(dec.row):
+        with m.If(row):
             m.d.sync += waiting.eq(0)
         m.submodules.underruns = underruns = Counter(COUNTER_BITS)
-        m.d.comb += [underruns.inc.eq(dec.starved & ~waiting), self.underruns.eq(underruns.count)]
+        m.d.comb += [underruns.inc.eq(starved & ~waiting), self.underruns.eq(underruns.count)]
 
         # the group's load ends on the cycle before its last operation leaves room for the next
         # decision: a two-cycle operation's now, a longer one's registered the cycle before
-        length_two = Mux(dec.clear, clear_cycles == 2, R == 2)
+        length_two = Mux(clear, clear_cycles == 2, R == 2)
         finishing = Signal(G)                  # this group's load ends at ``remain == 1``
         ends = Signal(G)                       # the load of this group ends next cycle
         with m.If(op & dec.last & ~length_two):
@@ -242,35 +249,36 @@ class Bus(wiring.Component):
         m.d.comb += self.loaded.eq(ends | Mux(op & dec.last & length_two, dec.load_group, 0))
 
         # ---- the command registers ----
-        self._command_registers(m, dec, op, remain=remain, spent=spent)
+        self._command_registers(m, dec, row, clear, remain=remain, spent=spent)
         return m
 
-    def _command_registers(self, m, dec, op, *, remain, spent):
-        """The pins of the decision ``dec`` (``op``: it loads a row or clears a block), from the
-        cycle after it: the command held through its row cycles (a clear's no-op rows after it),
-        DVALID, the row's beats; and ``remain``, the cycles until the next decision may be made
-        (``spent``: none)."""
+    def _command_registers(self, m, dec, row, clear, *, remain, spent):
+        """The pins of the decision ``dec`` (``row``, ``clear``: it loads a row, clears a block),
+        from the cycle after it: the command held through its row cycles (a clear's no-op rows
+        after it), DVALID, the row's beats; and ``remain``, the cycles until the next decision may
+        be made (``spent``: none)."""
         dmd, regs = self._dmd, self.regs
+        op = row | clear
         R = row_cycles(dmd, self._beats)
         clear_cycles = dmd.clear_row_cycles * R
         row_left = Signal(range(R))            # the pins' row cycle
         noops = Signal(range(dmd.clear_row_cycles))
         cmd = self.command
         op_row = Signal()                      # the row cycle on the pins loads a row
-        reading = dec.row | (op_row & (row_left != 0))
-        m.d.comb += [self.beats.ready.eq(reading), self.row_started.eq(dec.row)]
+        reading = row | (op_row & (row_left != 0))
+        m.d.comb += [self.beats.ready.eq(reading), self.row_started.eq(row)]
         m.d.sync += self.beat.eq(Mux(reading, self.beats.payload, 0))
         with m.If(remain != 0):
             m.d.sync += [remain.eq(remain - 1), spent.eq(remain == 1)]
         with m.If(dec.pulse | op):
-            length = Mux(dec.clear, clear_cycles, R)
+            length = Mux(clear, clear_cycles, R)
             m.d.sync += [self.dvalid.eq(1), remain.eq(length - 2), spent.eq(length == 2), row_left.eq(R - 1),
-                         op_row.eq(dec.row), noops.eq(Mux(dec.clear, dmd.clear_row_cycles - 1, 0)),
+                         op_row.eq(row), noops.eq(Mux(clear, dmd.clear_row_cycles - 1, 0)),
                          cmd.rowmd.eq(RowMode.NOOP), cmd.blkmd.eq(BlockMode.NOOP),
                          cmd.rowad.eq(0), cmd.blkad.eq(0), cmd.rst2blkz.eq(1)]
-            with m.If(dec.row):
+            with m.If(row):
                 m.d.sync += [cmd.rowmd.eq(RowMode.ADDRESSED), cmd.rowad.eq(dec.row_at)]
-            with m.Elif(dec.clear):
+            with m.Elif(clear):
                 m.d.sync += [cmd.blkmd.eq(BlockMode.CLEAR), cmd.blkad.eq(dec.block)]
             with m.Else():
                 p = dec.pulse_group

@@ -3,9 +3,9 @@ is queued.
 
 The cycle after a pulse is applied, the group's new state (its frame, display position, dark)
 is registered as a job; a first plane queued (the frame taken next, position 0) replaces it in
-that cycle. Its position in the plane order (counted from the anchor register) is worked out on
-the stage after, and the stored plane it reads (the plane's exponent above the frame's lowest
-stored plane) on the next; then the job leaves.
+that cycle. Its position in the plane order (counted from the anchor register), and the exponent
+at each position of the order, are worked out on the stage after; the stored plane it reads (its
+position's exponent above the frame's lowest stored plane) on the next; then the job leaves.
 """
 
 from amaranth import Cat, Module, Signal
@@ -15,7 +15,7 @@ from amaranth.lib.wiring import In, Out
 from ..registers import Registers
 from .group_frames import FRAME
 from .layouts import event, group_bits, load_job
-from .timebase import exponent, order_position, stored_plane
+from .timebase import exponents, order_position, stored_plane
 
 __all__ = ["LoadJobs"]
 
@@ -77,13 +77,15 @@ class LoadJobs(wiring.Component):
             m.d.sync += [job.group.eq(self.queue_first.payload), job.slot.eq(self.next.slot),
                          job.depth.eq(self.next.depth), low_plane.eq(self.next.low_plane), job.pos.eq(0),
                          job.clear.eq(0)]
-        # the job's position in the plane order (the anchor's rotation), then its stored plane
+        # the job's position in the plane order (the anchor's rotation) and the exponent at each
+        # position, then its stored plane
         staged, staged_low, at, ordered = Signal(load_job(dmd)), Signal(3), Signal(3), Signal()
+        each = Signal(data.ArrayLayout(3, 8))
         m.d.sync += [ordered.eq(formed), staged.eq(job), staged_low.eq(low_plane),
-                     at.eq(order_position(m, self.regs, job.pos, job.depth, "job_at"))]
-        e = exponent(m, self.regs, at, staged.depth, "job_exp")
+                     at.eq(order_position(m, self.regs, job.pos, job.depth, "job_at")),
+                     each.eq(exponents(m, self.regs, job.depth, "job_exps"))]
         out, valid = Signal(load_job(dmd)), Signal()
-        m.d.sync += [valid.eq(ordered), out.eq(staged), out.plane.eq(stored_plane(staged_low, e))]
+        m.d.sync += [valid.eq(ordered), out.eq(staged), out.plane.eq(stored_plane(staged_low, each[at]))]
         m.d.comb += [self.jobs.valid.eq(valid), self.jobs.payload.eq(out),
                      self.due.eq(pulsed | formed | ordered | valid)]
         return m

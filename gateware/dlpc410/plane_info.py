@@ -22,7 +22,7 @@ from amaranth.lib.wiring import In, Out
 from ..limbs import greater, limb_order
 from ..registers import DURATION_BITS, Registers
 from .group_frames import FRAME
-from .timebase import exponent, order_position
+from .timebase import exponents, order_position
 
 __all__ = ["PlaneInfo", "STAGES"]
 
@@ -104,21 +104,23 @@ class PlaneInfo(wiring.Component):
                      depth.eq(Array(f.depth for f in self.frame)[turn]),
                      show.eq(Array(f.showing for f in self.frame)[turn])]
 
-        # 1: the plane's position in the order (from the anchor), the least significant plane's
-        # time; the last plane
+        # 1: the plane's position in the order (from the anchor) and the exponent at each
+        # position, the least significant plane's time; the last plane
         advance(1)
         at = Signal(3)
         lsb = Signal.like(regs.lsb)
-        last0, dark0, depth0 = Signal(), Signal(), Signal(4)
+        last0, dark0 = Signal(), Signal()
         edark0 = Signal.like(show.dark)
         nodark0 = Signal()
-        m.d.sync += [at.eq(order_position(m, regs, pos, depth, "info_at")), depth0.eq(depth),
+        each = Signal(data.ArrayLayout(3, 8))
+        m.d.sync += [at.eq(order_position(m, regs, pos, depth, "info_at")),
+                     each.eq(exponents(m, regs, depth, "info_exps")),
                      lsb.eq(Mux(show.lsb != 0, show.lsb, regs.lsb)), last0.eq(pos == depth - 1),
                      dark0.eq(dark), edark0.eq(show.dark), nodark0.eq(show.dark == 0)]
 
         # 2: the plane's weight
         advance(2)
-        e = exponent(m, regs, at, depth0, "info_exp")
+        e = each[at]
         last1, dark1, nodark1 = Signal(), Signal(), Signal()
         edark1 = Signal.like(show.dark)
         lsb1 = Signal.like(regs.lsb)

@@ -224,7 +224,8 @@ class Planner(wiring.Component):
         first_plane = ~dark[0] & (pos[0] == 0)
         m.d.sync += [
             decided.eq(P), decided_any.eq(self.pulsing),
-            moves.eq(P & (dark | hidden)),
+            # (read only with ``decided``: no need to wait for the choice)
+            moves.eq(dark | hidden),
             ends_play.eq(P & final),
             take.eq(P[0] & usable & takes_offered),
             starts.eq(P[0] & first_plane),
@@ -239,7 +240,7 @@ class Planner(wiring.Component):
         m.d.sync += loaded.eq(loaded | ev)
         every = frames.every
         m.d.comb += [frames.take.eq(take), times.pulse.eq(decided), times.pulse_any.eq(decided_any),
-                     watch.pulse.eq(decided),
+                     watch.pulse.eq(decided), watch.pulse_any.eq(decided_any),
                      info.changed.eq(decided | Mux(every.valid, (1 << G) - 1, 0)),
                      self.frame_start.eq(starts), self.camera_start.eq(camera)]
         for g in range(G):

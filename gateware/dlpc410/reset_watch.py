@@ -61,8 +61,9 @@ class ResetWatch(wiring.Component):
         ``t_rst``, ``t_settle``, ``strict_rst``.
     rst_active : In(1)
         RST_ACTIVE, synchronised (:data:`FALL_LATENCY` cycles behind the pin).
-    pulse : In(blocks)
-        Bit g: group g's pulse, decided last cycle, is applied now.
+    pulse : In(blocks); pulse_any : In(1)
+        Bit g: group g's pulse, decided last cycle, is applied now; some bit of ``pulse``
+        (registered apart, for the depth of what it decides).
     free : Out(blocks)
         Bit g: by the next cycle, group g's last pulse has been followed by RST_ACTIVE's fall and
         ``t_settle`` since (or nothing is pending): its memory may change as far as the pin goes.
@@ -84,6 +85,7 @@ class ResetWatch(wiring.Component):
             "regs": In(Registers),
             "rst_active": In(1),
             "pulse": In(groups),
+            "pulse_any": In(1),
             "free": Out(groups),
             "late": Out(COUNTER_BITS),
             "faults": Out(COUNTER_BITS),
@@ -93,7 +95,7 @@ class ResetWatch(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         regs, G = self.regs, self._dmd.blocks
-        pulsed = self.pulse.any()
+        pulsed = self.pulse_any
 
         # the planned fall (t_rst after the pulse's decision), and t_rst + t_settle past it
         m.submodules.planned = planned = Countdown(16, lag=1, flags="settled")

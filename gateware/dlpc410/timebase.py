@@ -10,10 +10,11 @@ lookup too.
 """
 
 from amaranth import Array, Signal
+from amaranth.lib import data
 
 from ..registers import PlaneOrder
 
-__all__ = ["order_position", "exponent", "stored_plane"]
+__all__ = ["order_position", "exponents", "stored_plane"]
 
 
 def _table(function, rows=16, columns=8):
@@ -33,25 +34,26 @@ _ROTATED = _table(lambda depth, at: at % depth if depth else at, columns=16)
 def order_position(m, regs, j, depth, name):
     """The position in the plane order of ``regs`` that display position ``j`` of a frame of
     ``depth`` planes shows: ``j`` counted from the ``anchor`` register, modulo ``depth``. (Its
-    callers register it before :func:`exponent`: the two lookups together are too deep for a
-    cycle.)"""
+    callers register it, with :func:`exponents`, before it chooses an exponent: the lookups
+    together are too deep for a cycle.)"""
     k = Signal(3, name=name)
     m.d.comb += k.eq(_ROTATED[depth][j + regs.anchor])
     return k
 
 
-def exponent(m, regs, k, depth, name):
-    """Weight exponent of the plane at position ``k`` of the plane order of ``regs`` (a
-    :class:`~gateware.registers.Registers` view) in a frame of ``depth`` planes."""
-    e = Signal(3, name=name)
+def exponents(m, regs, depth, name):
+    """The weight exponent at each position ``k`` (0..7) of the plane order of ``regs`` (a
+    :class:`~gateware.registers.Registers` view) in a frame of ``depth`` planes: lookups on
+    ``depth`` alone, to be registered before a position chooses one."""
+    each = Signal(data.ArrayLayout(3, 8), name=name)
     with m.Switch(regs.order):
         with m.Case(PlaneOrder.MSB_FIRST):
-            m.d.comb += e.eq(_MSB_FIRST[depth][k])
+            m.d.comb += [each[k].eq(_MSB_FIRST[depth][k]) for k in range(8)]
         with m.Case(PlaneOrder.LSB_FIRST):
-            m.d.comb += e.eq(k)
+            m.d.comb += [each[k].eq(k) for k in range(8)]
         with m.Default():
-            m.d.comb += e.eq(regs.order_table[k])
-    return e
+            m.d.comb += each.eq(regs.order_table)
+    return each
 
 
 _STORED = _table(lambda low_plane, e: low_plane + e, rows=8)
