@@ -309,7 +309,16 @@ class Planner(wiring.Component):
                                       & (~active | (~pending & ~decided & (loaded | ev))).all())
 
         # ---- what the bus may do next cycle (registered) ----
-        # (group by group, each flag one function of its group's registered state)
+        self._bus_flags(m, times, info, watch, decided)
+        return m
+
+    def _bus_flags(self, m, times, info, watch, decided):
+        """The flags the bus decides from next cycle, registered: ``due``, ``imminent``,
+        ``imminent_clear``, ``writable`` (group by group, each one function of its group's
+        registered state and its ``times``, ``info`` and ``watch`` flags; ``decided``: the pulse
+        applied now)."""
+        regs, G, active = self.regs, self._dmd.blocks, self.active
+        pending, loaded, ev = self.pending, self.holds, self.loaded
         stagger_zero = Signal()
         m.d.sync += stagger_zero.eq(regs.stagger == 0)
         first_now = Cat((g == 0) | stagger_zero for g in range(G))
@@ -324,7 +333,6 @@ class Planner(wiring.Component):
             self.writable.eq(times.settled & watch.free & ~decided
                              & Mux(self.lead_over & ~self.retake.valid, (1 << G) - 1, 0)),
         ]
-        return m
 
     def _outcomes(self, m, info, frames, dark, usable):
         """What each group's next pulse does: ``hidden`` (bit g: it shows a plane and the next
