@@ -61,6 +61,9 @@ class Bus(wiring.Component):
         RST_ACTIVE, synchronised: with ``strict_rst`` no pulse while it is high.
     due, writable : In(blocks); imminent, imminent_clear : In(1)
         From the planner (registered).
+    due_fours : In(ceil(blocks / 4))
+        Bit q: some group of ``due[4q:4q + 4]`` is due (registered with it: the lowest due group
+        is found from these without a chain over every flag).
     loads : In(stream.Signature(ready_load))
         Ready loads from the requester, taken when their last operation is applied.
     darks : In(stream.Signature(dark_load))
@@ -95,6 +98,7 @@ class Bus(wiring.Component):
             "restart": In(1),
             "rst_active": In(1),
             "due": In(dmd.blocks),
+            "due_fours": In(-(-dmd.blocks // 4)),
             "writable": In(dmd.blocks),
             "imminent": In(1),
             "imminent_clear": In(1),
@@ -134,11 +138,12 @@ class Bus(wiring.Component):
 
         # ---- pulses: the lowest due group, if the pin allows it ----
         pin_ok = ~(regs.strict_rst & self.rst_active)
-        due = self.due
+        due, fours = self.due, self.due_fours
         P = Signal(G)
         for g in range(G):
-            m.d.comb += P[g].eq(free & pin_ok & due[g] & ~due[:g].any() if g else free & pin_ok & due[0])
-        do_pulse = free & pin_ok & due.any()
+            lower = due[g - g % 4:g].any() | fours[:g // 4].any()
+            m.d.comb += P[g].eq(free & pin_ok & due[g] & ~lower)
+        do_pulse = free & pin_ok & fours.any()
         m.d.comb += [self.choice.eq(P), self.pulsing.eq(do_pulse)]
 
         # ---- loads: the operation at the head ----
@@ -176,7 +181,7 @@ class Bus(wiring.Component):
             "row_at": 11, "fresh": 1, "starved": 1, "block_last": 1, "following": bb, "following_last": 1,
             "following_filled": 1}))
         following = (cur_block + 1)[:bb]
-        m.d.sync += [dec.pulse.eq(do_pulse), dec.pulse_group.eq(_lowest(due)),
+        m.d.sync += [dec.pulse.eq(do_pulse), dec.pulse_group.eq(_lowest(due, fours)),
                      dec.row.eq(do_row), dec.clear.eq(do_clear), dec.dark.eq(dark_ready),
                      dec.last.eq(Mux(dark_ready, cur_dark == dark.last, last_op)),
                      dec.load_group.eq(1 << Mux(dark_ready, dark.group, head.group)),
@@ -301,17 +306,20 @@ class Bus(wiring.Component):
                          cmd.blkmd.eq(BlockMode.NOOP), cmd.rst2blkz.eq(1)]
 
 
-def _lowest(bits):
-    """The index of the lowest set bit of ``bits`` (up to 16; 0 when none): in chunks of four,
-    each chunk's lowest bit and whether it has one, then the lowest chunk that has (so a LUT
-    for each, and a four-way choice)."""
-    assert len(bits) <= 16
+def _lowest(bits, fours):
+    """The index of the lowest set bit of ``bits`` (up to 16; 0 when none), ``fours`` saying
+    which chunk of four has one: each chunk's lowest bit, then the lowest chunk that has (so a
+    LUT for each, and a four-way choice)."""
+    assert len(bits) <= 16 and len(fours) == -(-len(bits) // 4)
     if len(bits) <= 4:
-        index = Const(0, 2)
-        for i in reversed(range(len(bits))):
-            index = Mux(bits[i], i, index)
-        return index
-    chunks = [bits[lo:lo + 4] for lo in range(0, len(bits), 4)]
-    lows = Array(_lowest(chunk) for chunk in chunks)
-    first = _lowest(Cat(chunk.any() for chunk in chunks))
+        return _lowest_of_four(bits)
+    lows = Array(_lowest_of_four(bits[lo:lo + 4]) for lo in range(0, len(bits), 4))
+    first = _lowest_of_four(fours)
     return Cat(lows[first], first)
+
+
+def _lowest_of_four(bits):
+    index = Const(0, 2)
+    for i in reversed(range(len(bits))):
+        index = Mux(bits[i], i, index)
+    return index

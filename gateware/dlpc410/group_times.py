@@ -16,7 +16,7 @@ bus's flags (:class:`~gateware.dlpc410.planner.Planner`) from them with little l
   pulse could cut short can start meanwhile: :func:`spec.records.register_faults`).
 """
 
-from amaranth import Const, Module, Mux, Signal
+from amaranth import Cat, Const, Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -66,6 +66,10 @@ class GroupTimes(wiring.Component):
         group g (strict: since any group's pulse; loose: since its own).
     settled : Out(blocks)
         Bit g: the group's memory may change by the next cycle, as far as its last pulse goes.
+    at_once : Out(blocks)
+        Bit g: a trigger obeyed times group g's first pulse at once (two cycles after the
+        trigger's), not chained after the group before (registered from ``active`` and
+        ``stagger``).
     """
 
     def __init__(self, dmd, *, soon, soon_clear):
@@ -85,6 +89,7 @@ class GroupTimes(wiring.Component):
             "late": Out(groups),
             "rst_over": Out(groups),
             "settled": Out(groups),
+            "at_once": Out(groups),
         })
 
     def elaborate(self, platform):
@@ -92,6 +97,11 @@ class GroupTimes(wiring.Component):
         regs, G = self.regs, self._dmd.blocks
         stagger_zero = Signal()
         m.d.sync += stagger_zero.eq(regs.stagger == 0)
+        # the groups a trigger obeyed times at once, and those it chains (registered: the
+        # registers, and so ``active``, hold still long before a trigger is obeyed)
+        at_once, chains = self.at_once, Signal(G)
+        m.d.sync += [at_once.eq(self.active & Cat((g == 0) | stagger_zero for g in range(G))),
+                     chains.eq(self.active & ~Cat((g == 0) | stagger_zero for g in range(G)))]
 
         # the flags are for the next cycle: "by the next cycle" is within 2 cycles from now; the
         # values loaded hold still the cycle before (the registers), or their flags are worked
@@ -114,11 +124,10 @@ class GroupTimes(wiring.Component):
             # is of its count before the trigger); each source with its flags worked out ahead
             delay_flags = pulse_cd.flags_registered(m, self.delay[g], f"delay_flags{g}")
             stagger_flags = pulse_cd.flags_registered(m, regs.stagger, f"stagger_flags{g}")
-            first = self.obey & self.active[g] & ((g == 0) | stagger_zero)
+            first = self.obey & at_once[g]
             if g:
                 chain = chained[g] & pulse_cds[g - 1].ends & (~chained[g - 1] if g > 1 else 1)
-                m.d.sync += chained[g].eq(Mux(self.abandon | chain, 0, chained[g] | (self.obey & self.active[g]
-                                                                                     & ~stagger_zero)))
+                m.d.sync += chained[g].eq(Mux(self.abandon | chain, 0, chained[g] | (self.obey & chains[g])))
             else:
                 chain = Const(0)
             # (one of the three at most: a group pulses only loaded, never waiting for a trigger)

@@ -19,7 +19,7 @@ is applied on its cycle.
 counted in), for the frame control, which counts in its own.
 """
 
-from amaranth import Cat, Module, Mux, Signal
+from amaranth import Cat, Const, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -37,6 +37,18 @@ from .plane_info import PlaneInfo
 from .reset_watch import ResetWatch
 
 __all__ = ["Planner", "START"]
+
+
+def at_least_two(bits):
+    """Two bits or more of ``bits`` are set (a tree of halves: each says whether it has one,
+    and whether it has two)."""
+    def tree(part):
+        if len(part) == 1:
+            return part[0], Const(0)
+        one_a, two_a = tree(part[:len(part) // 2])
+        one_b, two_b = tree(part[len(part) // 2:])
+        return one_a | one_b, two_a | two_b | (one_a & one_b)
+    return tree(list(bits))[1]
 
 
 #: What the frame control's ``start`` begins: a frame, and whether it is the one offered.
@@ -93,6 +105,8 @@ class Planner(wiring.Component):
     due : Out(blocks)
         Bit g (registered): group g is loaded, its pulse time has come and RST_ACTIVE's countdown
         allows it (the pin's own check is the bus's).
+    due_fours : Out(ceil(blocks / 4))
+        Bit q: some group of ``due[4q:4q + 4]`` is due (registered with it).
     imminent, imminent_clear : Out(1)
         (registered) A loaded group's pulse falls due within a row, within a clear (and its no-op
         rows), decided now.
@@ -151,6 +165,7 @@ class Planner(wiring.Component):
             "lead_over": In(1),
             "jobs": Out(event(load_job(dmd))),
             "due": Out(G),
+            "due_fours": Out(-(-G // 4)),
             "imminent": Out(1),
             "imminent_clear": Out(1),
             "writable": Out(G),
@@ -251,8 +266,6 @@ class Planner(wiring.Component):
                     m.d.comb += frames.advance[g].eq(info.last[g])
                 with m.Else():
                     m.d.sync += dark[g].eq(1)
-                with m.If(ends_play[g]):
-                    m.d.sync += pending[g].eq(0)
         m.submodules.started = started = Counter(COUNTER_BITS)
         m.submodules.late_count = late_count = Counter(COUNTER_BITS)
         was_late = Signal()                    # (counted a cycle later)
@@ -291,14 +304,17 @@ class Planner(wiring.Component):
                          every.payload.eq(Mux(newer, frames.offered.as_value(), frames.next.as_value()))]
             m.d.sync += loaded.eq(0)
             with m.If(abandon):
-                m.d.sync += [pending.eq(0), dark.eq(0), self.sync_out.eq(0)] + [pos[g].eq(0) for g in range(G)]
-        with m.If(self.trigger):
-            m.d.sync += pending.eq(pending | active)
+                m.d.sync += [dark.eq(0), self.sync_out.eq(0)] + [pos[g].eq(0) for g in range(G)]
         m.d.comb += [times.obey.eq(self.trigger), times.abandon.eq(abandon)]
+        # (a trigger sets the groups of the mode playing; the registers change only while none
+        # plays, so no group outside the mode ever plays)
+        pending_next = Signal(G)
+        m.d.comb += pending_next.eq(Mux(self.trigger, pending | active, Mux(abandon, 0, pending & ~ends_play)))
+        m.d.sync += pending.eq(pending_next)
 
         # ---- as the decisions so far leave them ----
         m.d.comb += [
-            self.playing.eq((active & pending & ~ends_play).any()),
+            self.playing.eq(self._playing(m, pending_next, ends_play)),
             self.ended.eq(ended | ends_seq),
             self.job_due.eq(jobs.due),
         ]
@@ -312,21 +328,30 @@ class Planner(wiring.Component):
         self._bus_flags(m, times, info, watch, decided)
         return m
 
+    def _playing(self, m, pending_next, ends_play):
+        """Some group plays, as the pulse applied now leaves it, with the OR over the groups
+        registered the cycle before (off the frame control's decision): at most one group
+        pulses at a time, and only one that plays, so some group plays if two do, or if one
+        does and the pulse applied now does not end its play (``pending_next``: the groups that
+        play next cycle; ``ends_play``: the pulse applied now ends its group's play)."""
+        some, two = Signal(), Signal()
+        m.d.sync += [some.eq(pending_next.any()), two.eq(at_least_two(pending_next))]
+        return two | (some & ~ends_play.any())
+
     def _bus_flags(self, m, times, info, watch, decided):
         """The flags the bus decides from next cycle, registered: ``due``, ``imminent``,
         ``imminent_clear``, ``writable`` (group by group, each one function of its group's
         registered state and its ``times``, ``info`` and ``watch`` flags; ``decided``: the pulse
         applied now)."""
-        regs, G, active = self.regs, self._dmd.blocks, self.active
+        G, active = self._dmd.blocks, self.active
         pending, loaded, ev = self.pending, self.holds, self.loaded
-        stagger_zero = Signal()
-        m.d.sync += stagger_zero.eq(regs.stagger == 0)
-        first_now = Cat((g == 0) | stagger_zero for g in range(G))
         armed = active & pending & ~decided & (loaded | ev)
         ready_now = times.rst_over & info.fresh
+        due = Signal(G)
+        m.d.comb += due.eq((armed & times.due & ready_now)
+                           | Mux(self.trigger, times.at_once & (loaded | ev) & ready_now, 0))
         m.d.sync += [
-            self.due.eq((armed & times.due & ready_now)
-                        | Mux(self.trigger, active & first_now & (loaded | ev) & ready_now, 0)),
+            self.due.eq(due), self.due_fours.eq(Cat(due[lo:lo + 4].any() for lo in range(0, G, 4))),
             self.imminent.eq((armed & times.soon).any()),
             self.imminent_clear.eq((armed & times.soon_clear).any()),
             # (and none in the cycle a retake is applied: the lead's countdown loads then)

@@ -240,7 +240,7 @@ class Sequencer(wiring.Component):
             bus.running.eq(control.running), bus.flushing.eq(control.flushing),
             bus.hold.eq(control.retake.valid), bus.restart.eq(control.retake.valid),
             bus.rst_active.eq(init.rst_active_synced),
-            bus.due.eq(planner.due), bus.writable.eq(planner.writable),
+            bus.due.eq(planner.due), bus.due_fours.eq(planner.due_fours), bus.writable.eq(planner.writable),
             bus.imminent.eq(planner.imminent), bus.imminent_clear.eq(planner.imminent_clear),
             planner.choice.eq(bus.choice), planner.pulsing.eq(bus.pulsing),
         ]
