@@ -23,7 +23,7 @@ writer is held in reset: it gives the port nothing, both banks are empty, and ev
 given is dropped (all belong to rows begun before the loss, whose frames are forgotten).
 """
 
-from amaranth import Module, ResetInserter, Signal
+from amaranth import Module, Mux, ResetInserter, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
@@ -113,6 +113,9 @@ class Writer(wiring.Component):
         first_row = [Signal.like(self.words.payload.row, name=f"first_row{b}") for b in range(2)]
         rows = [Signal(range(group + 1), name=f"rows{b}") for b in range(2)]
         completes = [Signal(name=f"completes{b}") for b in range(2)]
+        # the row that would join the bank next, ``first_row + rows`` (kept with them, so that
+        # whether a word joins the bank is a compare, with no sum before it)
+        expect = [Signal(len(self.words.payload.row) + 1, name=f"expect{b}") for b in range(2)]
 
         def of_bank(index, signals, name):
             value = Signal.like(signals[0], name=name)
@@ -128,9 +131,9 @@ class Writer(wiring.Component):
         f_full = of_bank(fill_bank, full, "fill_full")
         f_rows = of_bank(fill_bank, rows, "fill_rows")
         f_slot = of_bank(fill_bank, slot, "fill_slot")
-        f_first = of_bank(fill_bank, first_row, "fill_first_row")
+        f_expect = of_bank(fill_bank, expect, "fill_expect")
         continues = Signal()
-        m.d.comb += continues.eq((f_rows == 0) | ((word.slot == f_slot) & (word.row == f_first + f_rows)))
+        m.d.comb += continues.eq((f_rows == 0) | ((word.slot == f_slot) & (word.row == f_expect)))
         breaks = Signal()                        # this word starts a row that cannot join the bank
         m.d.comb += breaks.eq(~in_row & ~continues)
         take = Signal()
@@ -153,10 +156,12 @@ class Writer(wiring.Component):
             with m.If(fill_bank == b):
                 with m.If(take):
                     m.d.sync += planes[b].eq(planes[b] | (1 << word.plane))
-                    with m.If(~in_row & (rows[b] == 0)):
-                        m.d.sync += [slot[b].eq(word.slot), first_row[b].eq(word.row)]
+                    opens = ~in_row & (rows[b] == 0)
+                    with m.If(opens):
+                        m.d.sync += [slot[b].eq(word.slot), first_row[b].eq(word.row), expect[b].eq(word.row)]
                     with m.If(word.last):
-                        m.d.sync += [rows[b].eq(rows[b] + 1), completes[b].eq(word.completes)]
+                        m.d.sync += [rows[b].eq(rows[b] + 1), completes[b].eq(word.completes),
+                                     expect[b].eq(Mux(opens, word.row, expect[b]) + 1)]
                 with m.If(closes):
                     m.d.sync += full[b].eq(1)
         with m.If(closes):

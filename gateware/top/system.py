@@ -28,7 +28,7 @@ from gateware.mac import gmii
 from gateware.mac.mdio import StatusPoller
 from gateware.protocol.endpoint import Endpoint
 from gateware.protocol.port import EthernetPort, report_port
-from gateware.queue import AsyncQueue
+from gateware.queue import AsyncQueue, Queue
 from gateware.registers import LSB_BITS, TriggerMode
 from gateware.store import mcb
 from gateware.store.broker import FrameBroker
@@ -180,8 +180,14 @@ class Projector(wiring.Component):
         store_words = min(2, dmd.bits_per_dclk * self._beats // 64)
         m.submodules.store = store = Store(dmd, slots=self._slots, frame_bits=FRAME_BITS, read_width=128,
                                            plane_words=store_words)
-        wiring.connect(m, serialiser.words, store.words)
-        wiring.connect(m, serialiser.rows, store.rows)
+        # a queue on each of the serialiser's streams: the store's ready (its writer asks whether
+        # a word joins its open bank) ends at the queue, and the serialiser and the endpoint
+        # behind it see the queue's own, from its level
+        for name in ("words", "rows"):
+            source = getattr(serialiser, name)
+            m.submodules[f"to_store_{name}"] = queue = Queue(source.payload.shape(), depth=2)
+            wiring.connect(m, source, queue.w_stream)
+            wiring.connect(m, queue.r_stream, getattr(store, name))
         # The protocol counts a single streamed frame as a sequence of 1; the store calls streaming
         # a sequence of 0 and plays sequences of 2 slots or more.
         seq_len = ethernet.settings.sequence_length
