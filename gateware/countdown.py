@@ -123,7 +123,7 @@ class Countdown(wiring.Component):
 
         # r = T - t + 1, held in limbs; limb i borrows when every limb below it is zero
         borrow = [Cat(zero[:i]).all() if i else Const(1) for i in range(len(limbs))]
-        counting = ~Cat(zero).all()
+        counting = Signal()                    # r is not 0: some limb is not zero (registered)
         upper_zero = Cat(zero[1:]).all() if len(limbs) > 1 else Const(1)
         low = limbs[0]
         v = self.value
@@ -140,7 +140,8 @@ class Countdown(wiring.Component):
             # the next cycle's count is the value: done at r <= 1 + lag, late at r <= lag - slack
             for i, ((lo, hi), limb, z) in enumerate(zip(bounds, limbs, zero, strict=True)):
                 m.d.sync += [limb.eq(v[lo:hi]), z.eq(flags.zero[i])]
-            m.d.sync += [self.done.eq(flags.done), self.late.eq(flags.late), self.ends.eq(flags.ends)]
+            m.d.sync += [self.done.eq(flags.done), self.late.eq(flags.late), self.ends.eq(flags.ends),
+                         counting.eq(~flags.zero.all())]
             for i in range(len(self._within)):
                 m.d.sync += self.within[i].eq(flags.within[i])
         with m.Elif(counting):
@@ -149,9 +150,11 @@ class Countdown(wiring.Component):
                 with m.If(b):
                     m.d.sync += [limb.eq(limb - 1), z.eq(limb == 1)]
             # the flags of r - 1, from r: r - 1 <= x when r <= x + 1
+            # (r - 1 is 0 when r is 1: the low limb 1, the upper ones zero, none of them borrowing)
             m.d.sync += [self.done.eq(upper_zero & (low <= 2 + lag)),
                          self.late.eq(upper_zero & (low <= late_at + 1)),
-                         self.ends.eq(upper_zero & (low == 2))]
+                         self.ends.eq(upper_zero & (low == 2)),
+                         counting.eq(~(upper_zero & (low == 1)))]
             for i, k in enumerate(self._within):
                 m.d.sync += self.within[i].eq(upper_zero & (low <= k + 1 + lag))
         with m.Else():
