@@ -100,8 +100,8 @@ class GroupTimes(wiring.Component):
         # the groups a trigger obeyed times at once, and those it chains (registered: the
         # registers, and so ``active``, hold still long before a trigger is obeyed)
         at_once, chains = self.at_once, Signal(G)
-        m.d.sync += [at_once.eq(self.active & Cat((g == 0) | stagger_zero for g in range(G))),
-                     chains.eq(self.active & ~Cat((g == 0) | stagger_zero for g in range(G)))]
+        unchained = Cat((g == 0) | stagger_zero for g in range(G))
+        m.d.sync += [at_once.eq(self.active & unchained), chains.eq(self.active & ~unchained)]
 
         # the flags are for the next cycle: "by the next cycle" is within 2 cycles from now; the
         # values loaded hold still the cycle before (the registers), or their flags are worked
