@@ -1,12 +1,16 @@
 """First-in first-out queues of any payload shape, with typed stream ports.
 
-:class:`amaranth.lib.fifo.SyncFIFOBuffered` and :class:`~amaranth.lib.fifo.AsyncFIFO` carry
-plain bit vectors; these wrap them so that both ends are streams of the payload's own shape (a
+:class:`Queue` passes payloads in the cycles of :class:`amaranth.lib.fifo.SyncFIFOBuffered` (the
+same ``ready``, ``valid`` and payload on every cycle), built so that a stream's ``ready`` or
+``valid`` reaches its registers through one LUT: its fill is a thermometer code, not a binary
+count updated through a carry chain after the enables. :class:`AsyncQueue` wraps
+:class:`~amaranth.lib.fifo.AsyncFIFO`. Both ends of each are streams of the payload's own shape (a
 :class:`~amaranth.lib.data.Struct`, say) and join with :func:`amaranth.lib.wiring.connect`.
 """
 
-from amaranth import DomainRenamer, Module, Shape
+from amaranth import Cat, DomainRenamer, Module, Mux, Shape, Signal
 from amaranth.lib import fifo, stream, wiring
+from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 __all__ = ["Queue", "AsyncQueue"]
@@ -24,8 +28,21 @@ def _join(m, inner, w_stream, r_stream):
     ]
 
 
+def _next(pointer, modulo):
+    """``pointer + 1``, wrapping at ``modulo``."""
+    if modulo == 1 << len(pointer):
+        return (pointer + 1)[:len(pointer)]
+    return Mux(pointer == modulo - 1, 0, pointer + 1)
+
+
 class Queue(wiring.Component):
-    """A synchronous queue (:class:`~amaranth.lib.fifo.SyncFIFOBuffered`).
+    """A synchronous queue of ``depth`` payloads.
+
+    A memory of ``depth - 1`` payloads and an output register, as
+    :class:`~amaranth.lib.fifo.SyncFIFOBuffered` has them, and in its cycles: a payload written
+    into an empty queue is offered two cycles later (one, at depth 1), and ``w_stream.ready`` is
+    low only while the memory is full. (At depth 1 the register alone: it takes a payload every
+    other cycle.)
 
     Parameters
     ----------
@@ -37,23 +54,62 @@ class Queue(wiring.Component):
     -------
     w_stream : In(stream.Signature(shape))
     r_stream : Out(stream.Signature(shape))
-    level : Out(range(depth + 1))
-        Payloads queued.
+    fill : Out(depth)
+        A thermometer code of the payloads queued: bit ``i`` is high while more than ``i`` are.
+        Each bit is one LUT from registers.
     """
 
     def __init__(self, shape, depth):
+        assert depth >= 1
         self._width, self._depth = Shape.cast(shape).width, depth
         super().__init__({
             "w_stream": In(stream.Signature(shape)),
             "r_stream": Out(stream.Signature(shape)),
-            "level": Out(range(depth + 1)),
+            "fill": Out(depth),
         })
 
     def elaborate(self, platform):
         m = Module()
-        m.submodules.fifo = inner = fifo.SyncFIFOBuffered(width=self._width, depth=self._depth)
-        _join(m, inner, self.w_stream, self.r_stream)
-        m.d.comb += self.level.eq(inner.level)
+        w, r = self.w_stream, self.r_stream
+        valid = Signal()                       # the output register holds a payload
+        m.d.comb += r.valid.eq(valid)
+        if self._depth == 1:
+            m.d.comb += [w.ready.eq(~valid), self.fill.eq(valid)]
+            with m.If(w.valid & ~valid):
+                m.d.sync += [r.payload.eq(w.payload), valid.eq(1)]
+            with m.If(r.ready & valid):
+                m.d.sync += valid.eq(0)
+            return m
+
+        inner = self._depth - 1
+        m.submodules.storage = storage = Memory(shape=self._width, depth=inner, init=[])
+        w_port, r_port = storage.write_port(), storage.read_port(transparent_for=())
+        # held[i]: more than i payloads in the memory (a thermometer code, so that each bit's
+        # next value is one LUT of the enables and its neighbours, with no carry chain)
+        held = Signal(inner)
+        produce, consume = Signal(range(inner)), Signal(range(inner))
+        put = w.valid & ~held[-1]
+        fetch = held[0] & (~valid | r.ready)   # the memory's next payload to the output register
+        m.d.comb += [
+            w.ready.eq(~held[-1]),
+            w_port.addr.eq(produce), w_port.data.eq(w.payload), w_port.en.eq(put),
+            r_port.addr.eq(consume), r_port.en.eq(fetch), r.payload.eq(r_port.data),
+        ]
+        with m.If(put):
+            m.d.sync += produce.eq(_next(produce, inner))
+        with m.If(fetch):
+            m.d.sync += consume.eq(_next(consume, inner))
+        with m.If(put & ~fetch):
+            m.d.sync += held.eq(Cat(1, held[:-1]))
+        with m.Elif(fetch & ~put):
+            m.d.sync += held.eq(held[1:])
+        with m.If(fetch):
+            m.d.sync += valid.eq(1)
+        with m.Elif(r.ready):
+            m.d.sync += valid.eq(0)
+        # more than i queued: more than i in the memory, or i there and one in the register
+        m.d.comb += self.fill.eq(Cat(*(held[i] | (valid & (held[i - 1] if i else 1)) for i in range(inner)),
+                                     valid & held[-1]))
         return m
 
 

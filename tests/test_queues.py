@@ -1,17 +1,60 @@
-"""Queues whose ends start from registers: the asynchronous queue with a one-entry stage at either
-end, and the plane reader's word FIFO. Each keeps every payload, in order, under random valid and
-ready; the word FIFO passes a word a cycle."""
+"""Queues: the synchronous queue, in the standard library's FIFO's cycles; queues whose ends start
+from registers: the asynchronous queue with a one-entry stage at either end, and the plane
+reader's word FIFO. Each keeps every payload, in order, under random valid and ready; the word FIFO
+passes a word a cycle."""
 
 import random
 
 import pytest
+from amaranth import Module
+from amaranth.lib import fifo
 from amaranth.sim import Simulator
 
-from gateware.queue import AsyncQueue
+from gateware.queue import AsyncQueue, Queue
 from gateware.store.read_fifo import ReadFifo
 
 #: Unrelated clocks for the asynchronous queue's two ends.
 W_PERIOD, R_PERIOD = 8e-9, 5e-9
+
+
+@pytest.mark.parametrize("depth", [1, 2, 3, 5, 8, 17])
+@pytest.mark.parametrize("write_chance,ready_chance", [(0.9, 0.3), (0.5, 0.5), (0.3, 0.9)])
+def test_queue_in_the_standard_fifos_cycles(depth, write_chance, ready_chance, seed):
+    """The queue and :class:`amaranth.lib.fifo.SyncFIFOBuffered`, written and read alike (random
+    valid, payload and ready each cycle): the same ``w_stream.ready`` and ``r_stream.valid`` on
+    every cycle, the same payload whenever valid, and the fill's thermometer code equal to the
+    standard FIFO's level."""
+    m = Module()
+    m.submodules.dut = dut = Queue(8, depth)
+    m.submodules.ref = ref = fifo.SyncFIFOBuffered(width=8, depth=depth)
+    rng = random.Random(seed)
+    cycles = 600
+
+    async def bench(ctx):
+        levels = set()
+        for _ in range(cycles):
+            valid, ready = rng.random() < write_chance, rng.random() < ready_chance
+            payload = rng.randrange(256)
+            for end in (dut, ref):
+                ctx.set(end.w_stream.valid, valid)
+                ctx.set(end.w_stream.payload, payload)
+                ctx.set(end.r_stream.ready, ready)
+            await ctx.delay(1e-9)
+            got = [ctx.get(dut.w_stream.ready), ctx.get(dut.r_stream.valid)]
+            assert got == [ctx.get(ref.w_stream.ready), ctx.get(ref.r_stream.valid)]
+            if got[1]:
+                assert ctx.get(dut.r_stream.payload) == ctx.get(ref.r_stream.payload)
+            level = ctx.get(ref.level)
+            assert ctx.get(dut.fill) == (1 << level) - 1
+            levels.add(level)
+            await ctx.tick()
+        # the random enables reached empty, and full where writes outpace reads
+        assert 0 in levels and (depth in levels or write_chance <= ready_chance)
+
+    sim = Simulator(m)
+    sim.add_clock(1e-8)
+    sim.add_testbench(bench)
+    sim.run()
 
 
 @pytest.mark.parametrize("staged", [(), ("sync",), ("dmd",), ("sync", "dmd")], ids=lambda s: "+".join(s) or "none")

@@ -7,7 +7,7 @@ import random
 from amaranth.lib import data
 
 from gateware.dlpc410.register_crossing import RegisterCrossing
-from gateware.registers import Registers
+from gateware.registers import Registers, TriggerMode
 from sim.harness.amaranth_sim import simulate
 
 LAYOUT = data.Layout.cast(Registers)
@@ -73,3 +73,61 @@ def test_sets_cross_whole_in_order_at_rest(test_name):
     assert seen["applied"] + seen["superseded"] == len(sent)
     assert seen["superseded"] >= 1
     assert values[-len(sent[4:]):] == sent[4:]
+
+
+def _gated(value, armed):
+    """A set as the sequencer sees it: disarmed, its trigger mode software and ``chain`` low."""
+    if armed:
+        return value
+    chain, trigger = LAYOUT["chain"], LAYOUT["trigger"]
+    value &= ~(1 << chain.offset) & ~(((1 << trigger.width) - 1) << trigger.offset)
+    return value | (TriggerMode.SOFTWARE.value << trigger.offset)
+
+
+def test_disarmed_the_trigger_reads_software_and_frames_unchained(test_name):
+    """Arming toggled at random while sets arrive and apply: on every cycle the registers are the
+    set applied last, with the trigger mode software and ``chain`` low whenever the cycle before
+    was disarmed; from reset too (disarmed at power-up)."""
+    rng = random.Random(9)
+    chain, trigger = LAYOUT["chain"], LAYOUT["trigger"]
+
+    def chained_set():
+        # chained and triggered by something other than software, so that arming shows
+        hardware = rng.choice([m for m in TriggerMode if m != TriggerMode.SOFTWARE]).value
+        value = register_set(rng) & ~(((1 << trigger.width) - 1) << trigger.offset)
+        return value | (1 << chain.offset) | (hardware << trigger.offset)
+
+    power_up = chained_set()
+    dut = RegisterCrossing(data.Const(LAYOUT, power_up), armed=False)
+    sent = [chained_set() for _ in range(8)]
+    seen = {"done": False, "cycles": {False: 0, True: 0}, "reloads": 0}
+
+    async def host(ctx):
+        for value in sent:
+            ctx.set(dut.sets.payload, data.Const(LAYOUT, value))
+            ctx.set(dut.sets.valid, 1)
+            await ctx.tick()
+            ctx.set(dut.sets.valid, 0)
+            await ctx.tick().repeat(rng.randrange(40, 80))
+        await ctx.tick().repeat(100)
+        seen["done"] = True
+
+    async def sequencer(ctx):
+        srng = random.Random(10)
+        applied, armed = power_up, False
+        assert ctx.get(dut.regs).as_value().value == _gated(power_up, False)
+        while not seen["done"]:
+            if srng.random() < 0.05:
+                armed = not armed
+            ctx.set(dut.armed, armed)
+            ctx.set(dut.at_rest, srng.random() < 0.3)
+            _clk, _rst, reload = await ctx.tick("dmd").sample(dut.reload)
+            if reload:
+                applied = sent[seen["reloads"]]
+                seen["reloads"] += 1
+            assert ctx.get(dut.regs).as_value().value == _gated(applied, armed)
+            seen["cycles"][armed] += 1
+
+    simulate(dut, [host, sequencer], name=test_name, clocks={"sync": 125e6, "dmd": 200e6}, deadline=1e-4)
+    assert seen["reloads"] == len(sent)
+    assert min(seen["cycles"].values()) > 100

@@ -267,10 +267,12 @@ class Bus(wiring.Component):
         R = row_cycles(dmd, self._beats)
         clear_cycles = dmd.clear_row_cycles * R
         row_left = Signal(range(R))            # the pins' row cycle
+        # ``row_left != 0``, in a register of its own: the row's beats are read through one LUT
+        more = Signal()
         noops = Signal(range(dmd.clear_row_cycles))
         cmd = self.command
         op_row = Signal()                      # the row cycle on the pins loads a row
-        reading = row | (op_row & (row_left != 0))
+        reading = row | (op_row & more)
         m.d.comb += [self.beats.ready.eq(reading), self.row_started.eq(row)]
         m.d.sync += self.beat.eq(Mux(reading, self.beats.payload, 0))
         with m.If(remain != 0):
@@ -278,6 +280,7 @@ class Bus(wiring.Component):
         with m.If(dec.pulse | op):
             length = Mux(clear, clear_cycles, R)
             m.d.sync += [self.dvalid.eq(1), remain.eq(length - 2), spent.eq(length == 2), row_left.eq(R - 1),
+                         more.eq(R > 1),
                          op_row.eq(row), noops.eq(Mux(clear, dmd.clear_row_cycles - 1, 0)),
                          cmd.rowmd.eq(RowMode.NOOP), cmd.blkmd.eq(BlockMode.NOOP),
                          cmd.rowad.eq(0), cmd.blkad.eq(0), cmd.rst2blkz.eq(1)]
@@ -296,11 +299,12 @@ class Bus(wiring.Component):
                         m.d.sync += [cmd.blkmd.eq(BlockMode.MULTI), cmd.blkad.eq(p), cmd.rst2blkz.eq(0)]
                     with m.Case(ResetMode.SINGLE):
                         m.d.sync += [cmd.blkmd.eq(BlockMode.RESET), cmd.blkad.eq(p)]
-        with m.Elif(row_left != 0):
-            m.d.sync += row_left.eq(row_left - 1)
+        with m.Elif(more):
+            m.d.sync += [row_left.eq(row_left - 1), more.eq(row_left != 1)]
         with m.Elif(noops != 0):
             # the clear's no-op rows follow it back to back (1080p), DVALID high
-            m.d.sync += [row_left.eq(R - 1), noops.eq(noops - 1), cmd.blkmd.eq(BlockMode.NOOP), cmd.blkad.eq(0)]
+            m.d.sync += [row_left.eq(R - 1), more.eq(R > 1), noops.eq(noops - 1), cmd.blkmd.eq(BlockMode.NOOP),
+                         cmd.blkad.eq(0)]
         with m.Else():
             m.d.sync += [self.dvalid.eq(0), op_row.eq(0), cmd.rowmd.eq(RowMode.NOOP),
                          cmd.blkmd.eq(BlockMode.NOOP), cmd.rst2blkz.eq(1)]

@@ -7,18 +7,28 @@ first frame, or every group loaded and waiting for a trigger). Frames may play f
 older one not yet sent; from there they cross through a small :class:`amaranth.lib.fifo.AsyncFIFO`
 (every bit of a set crosses together) into a register on the sequencer side, which applies it
 when the sequencer rests, telling the sequencer to load its first plane again under the new
-registers.
+registers. Disarmed, the sequencer sees the trigger mode as software and frames not chained (the
+set itself is kept, and applies again once armed).
 """
 
-from amaranth import DomainRenamer, Module, Signal
+from amaranth import DomainRenamer, Module, Mux, Signal
 from amaranth.lib import fifo, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from gateware.registers import Registers
+from gateware.registers import Registers, TriggerMode
 
 from ..counter import Counter
 
 __all__ = ["RegisterCrossing"]
+
+
+def _disarmed(regs):
+    """The registers ``regs`` (a constant) as the sequencer sees them disarmed."""
+    layout, bits = Registers.as_shape(), regs.as_bits()
+    for name, value in (("chain", 0), ("trigger", TriggerMode.SOFTWARE.value)):
+        field = layout[name]
+        bits = bits & ~(((1 << field.width) - 1) << field.offset) | value << field.offset
+    return layout.from_bits(bits)
 
 
 class RegisterCrossing(wiring.Component):
@@ -30,6 +40,8 @@ class RegisterCrossing(wiring.Component):
         The registers from reset until the first set is applied.
     depth : int
         Sets in flight between the domains.
+    armed : bool
+        Whether the projector is armed from reset.
 
     Members
     -------
@@ -39,20 +51,29 @@ class RegisterCrossing(wiring.Component):
         Sets replaced in the mailbox by a newer one before they left it (``sync``).
     at_rest : In(1)
         The sequencer may take new registers (``dmd``).
+    armed : In(1)
+        The projector is armed (``dmd``, synchronised).
     regs : Out(Registers)
-        The registers the sequencer runs with (``dmd``); they change only while ``at_rest``.
+        The registers the sequencer runs with (``dmd``); they change only while ``at_rest``, but
+        for the trigger mode (software while disarmed) and ``chain`` (low while disarmed), which
+        follow ``armed`` a cycle later. Registered, so that no gate lies between them and the
+        sequencer's decisions.
     reload : Out(1)
         High in the cycle a set is applied (``dmd``), for the sequencer's ``reload``.
     applied : Out(32)
         Sets applied (``dmd``).
     """
 
-    def __init__(self, power_up, *, depth=2):
+    def __init__(self, power_up, *, depth=2, armed=True):
         self._depth = depth
+        self._power_up = power_up = Registers.const(power_up)
+        if not armed:
+            power_up = _disarmed(power_up)
         super().__init__({
             "sets": In(stream.Signature(Registers)),
             "superseded": Out(32),
             "at_rest": In(1),
+            "armed": In(1, init=armed),
             "regs": Out(Registers, init=power_up),
             "reload": Out(1),
             "applied": Out(32),
@@ -82,7 +103,13 @@ class RegisterCrossing(wiring.Component):
             m.d.dmd += [held.eq(out.payload), holding.eq(1)]
         m.submodules.applied = applied = DomainRenamer({"sync": "dmd"})(Counter(len(self.applied)))
         m.d.comb += [self.applied.eq(applied.count), applied.inc.eq(holding & self.at_rest)]
-        with m.If(holding & self.at_rest):
+        # the set applied, as sent, of the two registers arming gates
+        chain = Signal(init=self._power_up.chain)
+        trigger = Signal(TriggerMode, init=self._power_up.trigger)
+        applying = holding & self.at_rest
+        with m.If(applying):
             m.d.comb += self.reload.eq(1)
-            m.d.dmd += [self.regs.eq(held), holding.eq(0)]
+            m.d.dmd += [self.regs.eq(held), holding.eq(0), chain.eq(held.chain), trigger.eq(held.trigger)]
+        m.d.dmd += [self.regs.chain.eq(Mux(applying, held.chain, chain) & self.armed),
+                    self.regs.trigger.eq(Mux(self.armed, Mux(applying, held.trigger, trigger), TriggerMode.SOFTWARE))]
         return m

@@ -10,9 +10,10 @@ request already offered is held until taken (its words are discarded by the row 
 """
 
 from amaranth import Cat, Module, Signal
-from amaranth.lib import data, fifo, stream, wiring
+from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
+from ..queue import Queue
 from ..registers import Registers, Source
 from ..store.layouts import SLOT_BITS, PlaneRequest
 from .layouts import block_bits, group_span, load_job, ready_load
@@ -111,37 +112,47 @@ class Requester(wiring.Component):
         # (a release is written the cycle after its job is taken: a job is taken only with room
         # for it and one more)
         depth = 4
-        m.submodules.releases = releases = fifo.SyncFIFOBuffered(width=SLOT_BITS, depth=depth)
+        m.submodules.releases = releases = Queue(SLOT_BITS, depth)
         wiring.connect(m, releases.r_stream, wiring.flipped(self.release))
         last_slot = Signal(SLOT_BITS)
         seen_slot = Signal()
         releasing, released = Signal(), Signal(SLOT_BITS)
         room = Signal()
-        m.d.sync += [releasing.eq(0), room.eq(releases.level < depth - 2)]
+        m.d.sync += [releasing.eq(0), room.eq(~releases.fill[depth - 3])]
         m.d.comb += [releases.w_stream.valid.eq(releasing), releases.w_stream.payload.eq(released)]
 
-        with m.FSM(name="requester") as fsm:
+        # in IDLE, kept in a register of its own beside the state (set as the state goes to IDLE,
+        # cleared as it leaves), so that taking a job does not wait on the state's decode
+        idle = Signal(init=1)
+
+        def goto(state):
+            m.next = state
+            m.d.sync += idle.eq(state == "IDLE")
+
+        # a job is taken in IDLE
+        taken = self.jobs.valid & self.jobs.ready
+        m.d.comb += self.jobs.ready.eq(idle & room & ~releasing)
+        # the last group's first load from a new slot: no group reads the old one again
+        leaves = (head.group == last_group) & seen_slot & (head.slot != last_slot)
+        with m.If(taken & leaves):
+            m.d.sync += [releasing.eq(1), released.eq(last_slot)]
+        # flushing: stale jobs are dropped here, through the same slot accounting
+        with m.If(taken):
+            m.d.sync += [entry.eq(head), span_first.eq(head_first), span_last.eq(head_last), plane.eq(head.plane)]
+            with m.If(head.group == last_group):
+                m.d.sync += [last_slot.eq(head.slot), seen_slot.eq(1)]
+
+        with m.FSM(name="requester"):
             with m.State("IDLE"):
-                # the last group's first load from a new slot: no group reads the old one again
-                leaves = (head.group == last_group) & seen_slot & (head.slot != last_slot)
-                m.d.comb += self.jobs.ready.eq(room & ~releasing)
-                with m.If(self.jobs.valid & self.jobs.ready & leaves):
-                    m.d.sync += [releasing.eq(1), released.eq(last_slot)]
-                # flushing: stale jobs are dropped here, through the same slot accounting
-                with m.If(self.jobs.valid & self.jobs.ready):
-                    m.d.sync += [entry.eq(head), span_first.eq(head_first), span_last.eq(head_last),
-                                 plane.eq(head.plane)]
-                    with m.If(head.group == last_group):
-                        m.d.sync += [last_slot.eq(head.slot), seen_slot.eq(1)]
-                    with m.If(~flushing):
-                        m.next = "LOOK"
+                with m.If(taken & ~flushing):
+                    goto("LOOK")
             with m.State("LOOK"):
                 # the slot's occupancy is answered now: each block's bit of the job's plane
                 m.d.sync += occupied.eq(Cat(use_prng | self.occupancy[b].bit_select(plane, 1)
                                             for b in range(dmd.blocks)))
-                m.next = "MASK"
+                goto("MASK")
                 with m.If(flushing):
-                    m.next = "IDLE"
+                    goto("IDLE")
             with m.State("MASK"):
                 # (comparisons that cannot fail are left out: Verilator rejects them)
                 def in_span(b):
@@ -153,20 +164,20 @@ class Requester(wiring.Component):
                              first_row.eq(span_first * rpb), block_row.eq(span_first * rpb),
                              first_occupied.eq(occupied.bit_select(span_first, 1)),
                              at_last.eq(span_first == span_last), passed.eq(0)]
-                m.next = "PUSH"
+                goto("PUSH")
                 with m.If(flushing):
-                    m.next = "IDLE"
+                    goto("IDLE")
             with m.State("PUSH"):
                 # the bus learns the mask first, so it drains the words of one block while the
                 # next block's request waits for the store
                 with m.If(flushing):
-                    m.next = "IDLE"
+                    goto("IDLE")
                 with m.Else():
                     m.d.comb += self.loads.valid.eq(1)
                     # the requests to come: the mask from the first block on
                     m.d.sync += ahead.eq(mask >> span_first)
                     with m.If(self.loads.ready):
-                        m.next = "REQUEST"
+                        goto("REQUEST")
             with m.State("REQUEST"):
                 wanted = ahead[0] & ~use_prng
 
@@ -175,16 +186,16 @@ class Requester(wiring.Component):
                                  at_last.eq(block + 1 == last), passed.eq(at_last)]
                 # flushing: a request offered is held until taken (its words are discarded)
                 with m.If(passed | (flushing & ~wanted)):
-                    m.next = "IDLE"
+                    goto("IDLE")
                     m.d.sync += passed.eq(0)
                 with m.Elif(wanted):
                     m.d.comb += self.requests.valid.eq(1)
                     with m.If(self.requests.ready):
                         next_block()
                         with m.If(flushing):
-                            m.next = "IDLE"
+                            goto("IDLE")
                 with m.Else():
                     next_block()
         # the occupancy of the head job's slot, answered the cycle after it is taken (in LOOK)
-        m.d.comb += [self.idle.eq(fsm.ongoing("IDLE")), self.occ_slot.eq(head.slot)]
+        m.d.comb += [self.idle.eq(idle), self.occ_slot.eq(head.slot)]
         return m

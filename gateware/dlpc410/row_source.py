@@ -12,12 +12,13 @@ discarded as they arrive.
 """
 
 from amaranth import Array, Cat, Module, Mux, Signal
-from amaranth.lib import fifo, stream, wiring
+from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
 
 from spec.schedule import WORD_FIFO_ROWS, row_cycles
 
+from ..queue import Queue
 from ..registers import Registers, Source
 from .prng import Prng
 
@@ -81,7 +82,7 @@ class RowSource(wiring.Component):
         use_prng = self.regs.source == Source.PRNG
 
         m.submodules.prng = prng = Prng(words=wpc)
-        m.submodules.fifo = buffer = fifo.SyncFIFOBuffered(width=width, depth=WORD_FIFO_ROWS * R)
+        m.submodules.fifo = buffer = Queue(width, depth=WORD_FIFO_ROWS * R)
         m.d.comb += [prng.seed.eq(self.seed), prng.reseed.eq(self.reseed)]
         transfers = wpc // self._store_words   # store transfers per cycle of the row
         if transfers == 1:

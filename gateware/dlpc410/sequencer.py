@@ -226,8 +226,8 @@ class Sequencer(wiring.Component):
             source.seed.eq(self.seed), source.reseed.eq(self.reseed),
         ]
         # (registered: the frame control's flush and restart wait on it)
-        m.d.sync += control.drained.eq(requester.idle & ~planner.job_due & (jobs.level == 0) & (loads.level == 0)
-                                       & (darks.level == 0) & source.drained)
+        m.d.sync += control.drained.eq(requester.idle & ~planner.job_due & ~jobs.fill[0] & ~loads.fill[0]
+                                       & ~darks.fill[0] & source.drained)
 
         # ---- the bus ----
         wiring.connect(m, loads.r_stream, bus.loads)

@@ -234,20 +234,20 @@ class Projector(wiring.Component):
                      self.vcxo_trim.eq(trim.trim)]
 
         # ---- The sequencer's registers and arming (sync -> dmd) -------------------------------
-        m.submodules.registers = registers = RegisterCrossing(self._regs)
+        m.submodules.registers = registers = RegisterCrossing(self._regs, armed=self._armed)
         wiring.connect(m, ethernet.registers, registers.sets)
         m.d.comb += [registers.at_rest.eq(seq.at_rest), seq.reload.eq(registers.reload)]
         # Disarmed, no trigger source reaches the sequencer: the trigger mode reads as software
-        # and the software trigger is held low (a trigger pin edge then does nothing either);
-        # and frames are not chained, so a chained run ends with the frame that is playing and
-        # the sequencer comes to rest (where waiting register sets apply).
+        # (the register crossing's output) and the software trigger is held low (a trigger pin
+        # edge then does nothing either); and frames are not chained, so a chained run ends
+        # with the frame that is playing and the sequencer comes to rest (where waiting register
+        # sets apply).
         armed = Signal(init=self._armed)
         m.submodules.armed_cdc = FFSynchronizer(ethernet.settings.armed[0], armed, o_domain="dmd",
                                                 init=self._armed)
         m.d.comb += [
+            registers.armed.eq(armed),
             seq.regs.eq(registers.regs),
-            seq.regs.trigger.eq(Mux(armed, registers.regs.trigger, TriggerMode.SOFTWARE)),
-            seq.regs.chain.eq(registers.regs.chain & armed),
             soft.i.eq(ethernet.trigger),
             seq.soft_trigger.eq(soft.o & armed),
         ]
