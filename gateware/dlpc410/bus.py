@@ -266,9 +266,12 @@ class Bus(wiring.Component):
         op = row | clear
         R = row_cycles(dmd, self._beats)
         clear_cycles = dmd.clear_row_cycles * R
-        row_left = Signal(range(R))            # the pins' row cycle
-        # ``row_left != 0``, in a register of its own: the row's beats are read through one LUT
-        more = Signal()
+        # the pins' row cycle: the cycles of the row still to come, a thermometer code (bit i:
+        # more than i), so that whether there are more is a register and the row's beats are
+        # read through one LUT
+        row_left = Signal(R - 1)
+        more = row_left[0] if R > 1 else Const(0)
+        whole_row = (1 << (R - 1)) - 1
         noops = Signal(range(dmd.clear_row_cycles))
         cmd = self.command
         op_row = Signal()                      # the row cycle on the pins loads a row
@@ -279,8 +282,7 @@ class Bus(wiring.Component):
             m.d.sync += [remain.eq(remain - 1), spent.eq(remain == 1)]
         with m.If(dec.pulse | op):
             length = Mux(clear, clear_cycles, R)
-            m.d.sync += [self.dvalid.eq(1), remain.eq(length - 2), spent.eq(length == 2), row_left.eq(R - 1),
-                         more.eq(R > 1),
+            m.d.sync += [self.dvalid.eq(1), remain.eq(length - 2), spent.eq(length == 2), row_left.eq(whole_row),
                          op_row.eq(row), noops.eq(Mux(clear, dmd.clear_row_cycles - 1, 0)),
                          cmd.rowmd.eq(RowMode.NOOP), cmd.blkmd.eq(BlockMode.NOOP),
                          cmd.rowad.eq(0), cmd.blkad.eq(0), cmd.rst2blkz.eq(1)]
@@ -300,11 +302,10 @@ class Bus(wiring.Component):
                     with m.Case(ResetMode.SINGLE):
                         m.d.sync += [cmd.blkmd.eq(BlockMode.RESET), cmd.blkad.eq(p)]
         with m.Elif(more):
-            m.d.sync += [row_left.eq(row_left - 1), more.eq(row_left != 1)]
+            m.d.sync += row_left.eq(row_left[1:])
         with m.Elif(noops != 0):
             # the clear's no-op rows follow it back to back (1080p), DVALID high
-            m.d.sync += [row_left.eq(R - 1), more.eq(R > 1), noops.eq(noops - 1), cmd.blkmd.eq(BlockMode.NOOP),
-                         cmd.blkad.eq(0)]
+            m.d.sync += [row_left.eq(whole_row), noops.eq(noops - 1), cmd.blkmd.eq(BlockMode.NOOP), cmd.blkad.eq(0)]
         with m.Else():
             m.d.sync += [self.dvalid.eq(0), op_row.eq(0), cmd.rowmd.eq(RowMode.NOOP),
                          cmd.blkmd.eq(BlockMode.NOOP), cmd.rst2blkz.eq(1)]
