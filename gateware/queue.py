@@ -1,9 +1,9 @@
 """First-in first-out queues of any payload shape, with typed stream ports.
 
 :class:`Queue` passes payloads in the cycles of :class:`amaranth.lib.fifo.SyncFIFOBuffered` (the
-same ``ready``, ``valid`` and payload on every cycle), built so that a stream's ``ready`` or
-``valid`` reaches its registers through one LUT: its fill is a thermometer code, not a binary
-count updated through a carry chain after the enables. :class:`AsyncQueue` wraps
+same ``ready``, ``valid`` and payload on every cycle), built so that no carry chain follows a
+stream's ``ready`` or ``valid``: its fill is a thermometer code, not a binary count updated by an
+adder after the enables. :class:`AsyncQueue` wraps
 :class:`~amaranth.lib.fifo.AsyncFIFO`. Both ends of each are streams of the payload's own shape (a
 :class:`~amaranth.lib.data.Struct`, say) and join with :func:`amaranth.lib.wiring.connect`.
 """
