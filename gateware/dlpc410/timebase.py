@@ -30,6 +30,10 @@ _MSB_FIRST = _table(lambda depth, j: depth - 1 - j)
 #: depth``, a lookup on ``depth`` and ``j + anchor`` (0..14).
 _ROTATED = _table(lambda depth, at: at % depth if depth else at, columns=16)
 
+#: ``j + anchor`` (0..14) as a lookup on both (each bit one function of six bits), so that no
+#: carry chain comes before the rotation's lookup.
+_SUM = Array(Array(j + anchor for anchor in range(8)) for j in range(8))
+
 
 def order_position(m, regs, j, depth, name):
     """The position in the plane order of ``regs`` that display position ``j`` of a frame of
@@ -37,7 +41,7 @@ def order_position(m, regs, j, depth, name):
     callers register it, with :func:`exponents`, before it chooses an exponent: the lookups
     together are too deep for a cycle.)"""
     k = Signal(3, name=name)
-    m.d.comb += k.eq(_ROTATED[depth][j + regs.anchor])
+    m.d.comb += k.eq(_ROTATED[depth][_SUM[j][regs.anchor]])
     return k
 
 
