@@ -14,6 +14,10 @@ model's (``_model``). The DLP7000 in every reset mode at 200 and 400 MHz, and th
 choice (:mod:`spec.plan_search`) at each, under TI's strict RST_ACTIVE reading and under the
 loose one beside it; the DLP9500 global at 400 MHz.
 
+The ceiling of such plans (:func:`ceilings`, ``python -m sim.bench.rates ceiling``): the fastest
+rate any plan of one timeline for every group reaches (:mod:`spec.ceiling`), arithmetic beside
+the measured rates, and the fraction of it the plan finder's choice reaches.
+
 Binary patterns (:func:`binary`): 1-bit frames chained one after another on the full DLP7000 at
 DCLK 400 MHz, from the on-chip pseudo-random source and from the store at the row period the
 DDR2 leaves the plane reader in ``make sim``, global and phased: the period measured between
@@ -28,11 +32,11 @@ from gateware.dlpc410.trigger import PIN_TO_STROBE
 from sim.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import frame_lights
-from spec import plan_search, schedule
+from spec import ceiling, plan_search, schedule
 from spec.facts import DMDS
 from spec.registers import ResetMode, Source
 
-__all__ = ["measured_rate", "run", "cases", "best", "binary", "binary_period", "CASES"]
+__all__ = ["measured_rate", "run", "cases", "best", "ceilings", "binary", "binary_period", "CASES"]
 
 #: (DMD, reset mode, strict RST_ACTIVE reading, DCLK, settle reading): the plans measured.
 CASES = [
@@ -101,7 +105,31 @@ def run():
     measured = {}
     figures = cases(measured)
     figures.update(best(measured))
+    figures.update(ceilings(figures))
     figures.update(binary())
+    return figures
+
+
+def ceilings(measured=None):
+    """The ceiling of one-timeline plans on the DLP7000 (:mod:`spec.ceiling`: every plane order,
+    LSB and stagger, loads assumed free) at each DCLK under each RST_ACTIVE reading, arithmetic
+    (``_model``); with the plan finder's measured rates in ``measured``, the fraction of the
+    ceiling each reaches."""
+    figures, dmd = {}, DMDS["dlp7000"]
+    for dclk in (200e6, 400e6):
+        for strict in (True, False):
+            key = f"{int(dclk / 1e6)}mhz" + ("" if strict else "_loose")
+            top, each = ceiling.ceiling(dmd, dclk, strict_rst=strict)
+            figures[f"seq.gray8_ceiling_hz_dlp7000_{key}_model"] = (top.rate_hz, "Hz")
+            print(f"ceiling, DLP7000 at {dclk / 1e6:g} MHz, {'strict' if strict else 'loose'} RST_ACTIVE: "
+                  f"{top.rate_hz:.1f} Hz, {top.rate_hz / schedule.bound(dmd, dclk):.1%} of the bound")
+            for mode, c in each.items():
+                print(f"  {mode.name:6} " + ("not above global" if c is None else
+                      f"{c.rate_hz:6.1f} Hz  {c.frame_cycles:>7} cycles  order {' '.join(map(str, c.order))}  "
+                      f"LSB {c.lsb}  stagger {c.stagger}"))
+            rate = (measured or {}).get(f"seq.gray8_rate_hz_dlp7000_best_{key}")
+            if rate is not None:
+                figures[f"seq.gray8_fraction_of_ceiling_dlp7000_best_{key}"] = (rate[0] / top.rate_hz, "")
     return figures
 
 
@@ -218,5 +246,6 @@ def binary():
 
 if __name__ == "__main__":
     import sys
-    for figure, (value, unit) in (binary() if sys.argv[1:] == ["binary"] else run()).items():
+    only = {"binary": binary, "ceiling": ceilings}
+    for figure, (value, unit) in (only[sys.argv[1]]() if sys.argv[1:] else run()).items():
         print(f"{figure:50s} {value:10.1f} {unit}")
