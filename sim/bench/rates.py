@@ -246,6 +246,6 @@ def binary():
 
 if __name__ == "__main__":
     import sys
-    only = {"binary": binary, "ceiling": ceilings}
+    only = {"binary": binary, "ceiling": ceilings, "best": best}
     for figure, (value, unit) in (only[sys.argv[1]]() if sys.argv[1:] else run()).items():
         print(f"{figure:50s} {value:10.1f} {unit}")
