@@ -18,9 +18,9 @@ least, with the loads assumed free:
 * a frame lasts until the last group's last dark pulse and its reload of the next frame's
   first plane: ``(G - 1) * stagger + T + reload`` (``T``: the last dark pulse's time).
 
-Every plane order (all ``depth!``) and every LSB from the settle path up is tried, up to the LSB
-at which ``255 * LSB + reload + (G - 1) * sep`` alone passes the best frame found (no longer LSB
-can beat it). The timing is the facts table's, without the sequencer's margins, so the sequencer
+Every plane order (all ``depth!``) and every LSB from the settle path up is tried, up to the
+LSB at which ``(2**depth - 1) * LSB + reload + (G - 1) * sep`` alone passes the best frame found
+(no longer LSB can beat it). The timing is the facts table's, without the sequencer's margins, so the sequencer
 can reach no more than this (TI's settle reading; triggered frames, each ending dark).
 """
 
