@@ -34,7 +34,7 @@ import numpy as np
 
 from .facts import TIMING
 from .registers import ResetMode
-from .schedule import FABRIC_HZ, beats_at, even, groups, row_cycles
+from .schedule import FABRIC_HZ, beats_at, even, groups, row_cycles, timeline
 
 __all__ = ["Ceiling", "ceiling", "ceiling_of_mode"]
 
@@ -52,21 +52,6 @@ class Ceiling:
     @property
     def rate_hz(self):
         return FABRIC_HZ / self.frame_cycles
-
-
-def _pulses(order, lsb, reload):
-    """The timeline's pulse times: each plane's, and a dark pulse after each plane shorter than
-    ``reload`` and after the last (the frame's final dark pulse, the last time)."""
-    pulses, t = [], 0
-    for j, e in enumerate(order):
-        pulses.append(t)
-        t += lsb << e
-        if j == len(order) - 1:
-            pulses.append(t)
-        elif (lsb << e) < reload:
-            pulses.append(t)
-            t += reload
-    return np.array(pulses)
 
 
 def _stagger(pulses, G, sep, limit):
@@ -108,7 +93,7 @@ def ceiling_of_mode(dmd, dclk_hz, reset_mode, *, depth=8, strict_rst=True, t_rst
         if limit is not None and (2 ** depth - 1) * lsb + reload + (G - 1) * sep >= limit:
             return best
         for order in orders:
-            pulses = _pulses(order, lsb, reload)
+            pulses, _ = timeline(order, lsb, reload, reload)
             room = None if limit is None else (limit - int(pulses[-1]) - reload) // max(G - 1, 1)
             if G > 1:
                 if room is not None and room < sep:

@@ -74,7 +74,7 @@ __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_en
            "plan", "bound", "paper_eq_rate_hz", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS",
            "flush_rows", "PAPER_SETTLE_CYCLES", "MIN_SETTLE", "RST_MARGIN",
            "FALL_LATENCY", "DECISION_TO_PINS", "PACE_LAG",
-           "even", "ready_cycle", "reload_bound", "reload_cycles", "on_time", "frame_period"]
+           "even", "ready_cycle", "reload_bound", "reload_cycles", "on_time", "frame_period", "timeline"]
 
 #: The ``dmd`` domain's clock: every cycle count of the model and the sequencer is in its cycles.
 #: DCLK is this (one beat per cycle) or twice this (two beats per cycle: 400 MHz through the
@@ -822,6 +822,24 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     return Plan(p, frame_cycles, lsb_min, binds, dclk_hz)
 
 
+def timeline(exps, lsb, hide, dark_gap):
+    """One group's frame of planes of weight exponents ``exps`` (in display order): the time of
+    each pulse from the first (the last: the frame's final dark pulse), and whether each one's
+    plane ends in a dark pulse (a plane shorter than ``hide``, or the last; the next plane comes
+    ``dark_gap`` after the dark pulse) rather than hiding the next plane's load."""
+    pulses, darks, t = [], [], 0
+    for j, e in enumerate(exps):
+        pulses.append(t)
+        t += lsb << e
+        dark = (lsb << e) < hide or j == len(exps) - 1
+        darks.append(dark)
+        if dark:
+            pulses.append(t)
+            darks.append(False)
+            t += dark_gap
+    return np.array(pulses), darks
+
+
 def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
     """Phased PWM with groups spread apart instead of on the LSB lattice: every group plays the
     plain timeline (dark gaps not rounded to LSB multiples) ``stagger`` after the one before.
@@ -837,20 +855,8 @@ def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
     best = None
     step = max(2, even(lsb_min // 64))
     for lsb in range(lsb_min, lsb_min + lsb_min // 4, step):
-        pulses, jobs, darks, t = [0], [], [], 0
-        for j, e in enumerate(exps):
-            d = lsb << e
-            t += d
-            pulses.append(t)
-            if d >= p.hide and j != len(exps) - 1:
-                jobs.append(load_g)
-                darks.append(False)
-            else:
-                jobs += [clear_g, load_g]
-                darks += [True, False]
-                t += p.dark_gap
-                pulses.append(t)
-        pulses = np.array(pulses[:-1])
+        pulses, darks = timeline(exps, lsb, p.hide, p.dark_gap)
+        jobs = [clear_g if dark else load_g for dark in darks]
         cap = ((beat if best is None else best[1]) - int(pulses[-1])) // (G - 1)
         if cap <= sep:
             break

@@ -34,11 +34,12 @@ def test_stagger_is_the_smallest_that_keeps_every_pulse_pair_apart(steps, G, sep
     assert ceiling._stagger(pulses, G, sep, 1 << 40) == _brute_stagger(list(pulses), G, sep)
 
 
-def test_pulses_put_a_dark_pulse_after_each_short_plane_and_the_last():
+def test_timeline_puts_a_dark_pulse_after_each_short_plane_and_the_last():
     # planes of 1, 4 and 2 units (1 and 2 shorter than the reload of 3), the last ending dark
-    assert list(ceiling._pulses((0, 2, 1), 1, 3)) == [0, 1, 4, 8, 10]
+    pulses, darks = schedule.timeline((0, 2, 1), 1, 3, 3)
+    assert list(pulses) == [0, 1, 4, 8, 10] and darks == [True, False, False, True, False]
     # a plane as long as the reload hides the next plane's load
-    assert list(ceiling._pulses((0, 1), 3, 3)) == [0, 3, 9]
+    assert list(schedule.timeline((0, 1), 3, 3, 3)[0]) == [0, 3, 9]
 
 
 def _brute_frame(dmd, mode, depth, strict, lsbs, staggers):
