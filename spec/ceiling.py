@@ -36,7 +36,7 @@ from .facts import TIMING
 from .registers import ResetMode
 from .schedule import FABRIC_HZ, beats_at, even, groups, row_cycles, timeline
 
-__all__ = ["Ceiling", "ceiling", "ceiling_of_mode"]
+__all__ = ["Ceiling", "ceiling", "ceiling_of_mode", "facts_cycles"]
 
 
 @dataclass(frozen=True)
@@ -74,13 +74,19 @@ def _stagger(pulses, G, sep, limit):
     return s
 
 
+def facts_cycles(t_rst_s=None, t_settle_s=None):
+    """RST_ACTIVE and the settle time in ``dmd`` cycles: the facts table's (or the times given),
+    without the sequencer's margins."""
+    return tuple(math.ceil((TIMING[name].value if given is None else given) * FABRIC_HZ - 1e-9)
+                 for name, given in (("t_rst_active", t_rst_s), ("t_settle", t_settle_s)))
+
+
 def ceiling_of_mode(dmd, dclk_hz, reset_mode, *, depth=8, strict_rst=True, t_rst_s=None, t_settle_s=None,
                     beat=None):
     """The :class:`Ceiling` of one reset mode (None if none beats ``beat`` frame cycles);
     ``t_rst_s``, ``t_settle_s``: other timing than the facts table's."""
     R = row_cycles(dmd, beats_at(dclk_hz))
-    t_rst = math.ceil((TIMING["t_rst_active"].value if t_rst_s is None else t_rst_s) * FABRIC_HZ - 1e-9)
-    t_settle = math.ceil((TIMING["t_settle"].value if t_settle_s is None else t_settle_s) * FABRIC_HZ - 1e-9)
+    t_rst, t_settle = facts_cycles(t_rst_s, t_settle_s)
     grp = groups(dmd, reset_mode)
     G, size = len(grp), max(len(b) for b in grp)
     reload = t_rst + t_settle + size * dmd.rows_per_block * R

@@ -10,6 +10,7 @@ MODULES = [
     "sim.bench.camera",
     "sim.bench.dlpc410_model",
     "sim.bench.formal",
+    "sim.bench.group_orders",
     "sim.bench.host",
     "sim.bench.mac",
     "sim.bench.net",
