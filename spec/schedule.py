@@ -184,9 +184,15 @@ class Params:
     beats: int = 1               # DCLK beats per dmd cycle: the sequencer's build, not a register
     t_flip: int = 0              # the four-DMD paper's settle reading: a group's pulses at least this
                                  # far apart (t_settle 0: memory loads once RST_ACTIVE falls); 0: TI's
+    # the model only, not registers: each group's own order table and offset from the trigger
+    # (plans beyond one timeline; empty: ``order`` and ``g * stagger`` for every group)
+    group_tables: tuple = ()
+    group_offsets: tuple = ()
 
     def registers(self, dmd):
         """The values of :class:`~gateware.registers.Registers`, as a dict."""
+        if self.group_tables or self.group_offsets:
+            raise ValueError("the registers hold one plane order and one stagger for every group")
         regs = {k: getattr(self, k) for k in (
             "lsb", "t_rst", "t_settle", "hide", "dark_gap", "stagger", "period", "reload_lead",
             "camera_offset", "camera_width", "anchor")}
@@ -364,8 +370,11 @@ class _Model:
 
     # -- the planner -------------------------------------------------------------------------
 
-    def exps_of(self, fi):
-        return exponents(self.p.order, self.p.order_table, self.res.shown[fi].depth, self.p.anchor)
+    def exps_of(self, fi, g):
+        p = self.p
+        if p.group_tables:
+            return exponents(PlaneOrder.TABLE, p.group_tables[g], self.res.shown[fi].depth, p.anchor)
+        return exponents(p.order, p.order_table, self.res.shown[fi].depth, p.anchor)
 
     def enqueue(self, g, fi, j):
         """Queue the load of frame ``fi``'s display position ``j`` (None: clears) for group g."""
@@ -377,7 +386,7 @@ class _Model:
             self.darks.append([g, [("clear", b) for b in self.grp[g]], 0])
             return
         ops = []
-        plane = frame.stored_plane(self.exps_of(fi)[j])
+        plane = frame.stored_plane(self.exps_of(fi, g)[j])
         for b in self.grp[g]:
             if self.p.source == Source.PRNG or frame.occupied(plane, b):
                 ops += [("row", r) for r in range(b * dmd.rows_per_block, (b + 1) * dmd.rows_per_block)]
@@ -407,7 +416,7 @@ class _Model:
         p, s = self.p, self.st[g]
         kind, fi, j = s.pos
         frame = self.res.shown[fi]
-        exps = self.exps_of(fi)
+        exps = self.exps_of(fi, g)
         last = j == len(exps) - 1
         follow = last and self.follows(g, t)
         if kind == "plane":
@@ -495,7 +504,7 @@ class _Model:
         self.res.accepted.append(t)
         for g, s in enumerate(self.st):
             s.pending = True
-            s.pulse_at = t + 2 + g * self.p.stagger
+            s.pulse_at = t + 2 + (self.p.group_offsets[g] if self.p.group_offsets else g * self.p.stagger)
 
     def release_held(self, t):
         """A held trigger is obeyed on the first cycle every group is ready."""
@@ -543,7 +552,7 @@ class _Model:
                 res.late += 1
             kind, fi, j = s.pos
             res.commands.append((t, "pulse", tuple(self.grp[g])))
-            res.pulses.append((t, g, kind, fi, self.exps_of(fi)[j] if kind == "plane" else None))
+            res.pulses.append((t, g, kind, fi, self.exps_of(fi, g)[j] if kind == "plane" else None))
             if kind == "plane" and j == 0 and g == 0:
                 res.frame_starts.append(t)
                 frame = res.shown[fi]

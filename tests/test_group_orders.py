@@ -3,6 +3,7 @@ plans pass the independent check, reach the one-timeline ceiling where that is o
 pass the bound, and the check fails each rule it checks when that rule is broken."""
 
 import copy
+from dataclasses import replace
 
 import pytest
 
@@ -62,3 +63,29 @@ def test_check_fails_each_broken_rule(plans, how):
     assert go.check(plan) == []
     assert go.check(_broken(plan, how)) != []
 
+
+
+def test_the_models_sequencer_plays_each_group_in_its_own_order():
+    # one timeline written as group orders and offsets: the model plays exactly the same
+    t, base = go.sequencer_terms(TEST_DMD, 200e6, ResetMode.SINGLE, trigger_hold=True)
+    p, frame = base.params, schedule.Frame(0, 8)
+    exps = tuple(schedule.exponents(p.order, p.order_table, 8, p.anchor))
+    same = replace(p, group_tables=(exps,) * t.G, group_offsets=tuple(g * p.stagger for g in range(t.G)))
+    first = schedule.ready_cycle(TEST_DMD, p, frame)
+    assert (schedule.simulate(TEST_DMD, same, [frame], [first]).commands
+            == schedule.simulate(TEST_DMD, p, [frame], [first]).commands)
+    # each group in an order of its own (the table turned round by the group), from an offset
+    # of its own: the model shows each group's planes in its order, from its offset
+    tables = tuple(exps[g:] + exps[:g] for g in range(t.G))
+    offsets = tuple(g * p.stagger + (g % 2) * 2 * t.t_rst for g in range(t.G))
+    q = replace(p, group_tables=tables, group_offsets=offsets)
+    r = schedule.simulate(TEST_DMD, q, [frame], [schedule.ready_cycle(TEST_DMD, q, frame)])
+    for g in range(t.G):
+        shown = [e for _, h, kind, _, e in r.pulses if h == g and kind == "plane"]
+        assert tuple(shown) == tables[g]
+    # (the first planes are loaded before the trigger and the offsets t_rst apart: the first
+    # pulses come on time, whatever comes late after them)
+    starts = [min(at for at, h, *_ in r.pulses if h == g) for g in range(t.G)]
+    assert [s - starts[0] for s in starts] == list(offsets)
+    with pytest.raises(ValueError):
+        q.registers(TEST_DMD)
