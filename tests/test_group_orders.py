@@ -20,7 +20,7 @@ def plans():
     out = {}
     for mode in (ResetMode.DUAL, ResetMode.SINGLE):
         top = ceiling.ceiling_of_mode(TEST_DMD, 200e6, mode, depth=DEPTH)
-        out[mode] = (go.solve(go.terms(TEST_DMD, 200e6, mode, depth=DEPTH), seconds=10), top)
+        out[mode] = (go.solve(go.terms(TEST_DMD, 200e6, mode, depth=DEPTH), seconds=5), top)
     return out
 
 
