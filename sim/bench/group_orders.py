@@ -98,14 +98,11 @@ def sequencer_terms(dmd, dclk_hz, reset_mode, **plan_kwargs):
     and dark gap, its shortest LSB); ``plan_kwargs``: that function's (``words_per_cycle``,
     ``trigger_hold``, ...)."""
     base = schedule.plan(dmd, dclk_hz, reset_mode=reset_mode, **order_kwargs(PlaneOrder.TABLE, 8), **plan_kwargs)
-    p, R = base.params, row_cycles(dmd, beats_at(dclk_hz))
-    size = max(len(b) for b in groups(dmd, reset_mode))
+    p = base.params
     assert p.hide == p.dark_gap, "a plane hides a load exactly when it is as long as a dark gap"
-    G = len(groups(dmd, reset_mode))
-    # the slack the spread search leaves a load for other groups' pulses taking row cycles
-    t = Terms(G, 8, even(base.lsb_min), p.hide, p.t_rst, p.t_settle, R,
-              (size * dmd.rows_per_block - 1) * (p.row_period or R) + R, size * dmd.clear_row_cycles * R,
-              2 * R * G)
+    t = terms(dmd, dclk_hz, reset_mode, row_period=p.row_period)
+    # a load done the slack the spread search leaves it for other groups' pulses taking row cycles
+    t = replace(t, lsb=even(base.lsb_min), reload=p.hide, t_rst=p.t_rst, t_settle=p.t_settle, slack=2 * t.row * t.G)
     return t, base
 
 
