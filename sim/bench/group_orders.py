@@ -224,8 +224,7 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0):
         all_loads.append([v(loads[e]) for e in order])
         cl = {e: v(ce) for e, ce in clears}
         # clears in dark-pulse order, the frame's last dark pulse's last
-        all_clears.append([cl[e] for e in order if e in cl and not (e == order[-1])]
-                          + ([cl[order[-1]]] if order[-1] in cl else [v(c)]))
+        all_clears.append([cl[e] for e in order[:-1] if e in cl] + [cl.get(order[-1], v(c))])
     return GroupPlan(t, v(F), offsets, orders, all_loads, all_clears, math.ceil(solver.best_objective_bound))
 
 
