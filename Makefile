@@ -27,15 +27,18 @@ test: $(STAMP)
 # planned, or both; VIRTUAL=<seconds>|demo: the virtual projector on a TAP device in a network
 # namespace of its own, which host software in that namespace can talk to; needs root;
 # WINDOW=1: also dump every signal of the core (VCD) from the first frame's last datagram through
-# the store to just after its first pulse, with a GTKWave save file grouped by block).
+# the store to just after its first pulse, with a GTKWave save file grouped by block;
+# GROUP_ORDERS=<seconds>: the plan is the constraint solver's, dual reset's groups each in a plane
+# order of its own, searched that long).
 DCLK ?= 400
 DMD ?=
 FAULTS ?=
 VIRTUAL ?=
 WINDOW ?=
+GROUP_ORDERS ?=
 sim: $(STAMP)
 	$(PY) -m flow sim --dclk $(DCLK) $(if $(DMD),--dmd $(DMD)) $(if $(FAULTS),--faults $(FAULTS)) $(if $(VIRTUAL),--virtual $(VIRTUAL)) \
-		$(if $(WINDOW),--window)
+		$(if $(WINDOW),--window) $(if $(GROUP_ORDERS),--group-orders $(GROUP_ORDERS))
 
 # The Spartan-6 ISE trees (Verilog, UCF, ISE scripts) and each block's Verilog, in build/spartan6:
 # the Atlys's, the sync master's (sync_master/) and the DLP9500's on the SVEC (dlp9500/), linted.

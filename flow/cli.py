@@ -36,6 +36,9 @@ def main(argv=None):
                      help="the DMD the core is built for (default dlp7000; dlp9500: four buses)")
     sim.add_argument("--faults", choices=("stalls", "rst", "all"), default=None,
                      help="memory stalls at random, RST_ACTIVE held longer than planned, or both (sim.xga.FAULTS)")
+    sim.add_argument("--group-orders", type=float, default=None, metavar="SECONDS",
+                     help="play the constraint solver's plan, dual reset's groups each in a plane order of its own "
+                          "(spec.group_orders), searched this long (kept in build/plans for later runs)")
     sim.add_argument("--window", action="store_true",
                      help="also dump every signal of the core from the first frame's last datagram (every frame "
                           "sent whole, that one held back) through the store to just after its first pulse, with "
@@ -74,7 +77,7 @@ def main(argv=None):
     if args.command == "sim":
         from sim.system import main as run
         return run(frames=args.frames, dclk_hz=args.dclk * 1e6, faults=args.faults, window=args.window,
-                   dmd=args.dmd)
+                   dmd=args.dmd, group_orders=args.group_orders)
     if args.command == "waves":
         from sim.harness.waves import main as run
         return run()

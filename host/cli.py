@@ -15,7 +15,7 @@ import sys
 
 import numpy as np
 
-from spec import plan_search, schedule
+from spec import group_orders, plan_search, schedule
 from spec.facts import DMDS, SETTLE_READINGS
 from spec.registers import ResetMode, TriggerMode
 
@@ -63,7 +63,9 @@ def _plan(args):
     common = dict(depth=args.depth, exposure_s=args.exposure, words_per_cycle=args.read_rate,
                   t_rst_cycles=_t_rst(args), reading=args.settle_reading, anchor=args.anchor,
                   strict_rst=args.rst_active == "strict")
-    if args.best:
+    if args.group_orders:
+        plan = _group_orders(dmd, args)
+    elif args.best:
         found = plan_search.find(dmd, args.dclk, **common)
         print(f"plan finder: every reset mode, plane order and hide threshold under the {args.settle_reading} "
               f"settle reading and the {args.rst_active} RST_ACTIVE reading\n{found.table()}\n"
@@ -86,6 +88,29 @@ def _plan(args):
     if fault:
         raise ClientError(fault)
     return dmd, plan
+
+
+def _group_orders(dmd, args):
+    """``--group-orders SECONDS``: each group of the reset mode in a plane order of its own, from
+    an offset of its own, as the solver finds them (:func:`spec.group_orders.find`: 8-bit frames,
+    TI's readings, the shortest LSB)."""
+    given = {"--depth": args.depth != 8, "--exposure": args.exposure, "--anchor": args.anchor,
+             "--settle-reading": args.settle_reading != "ti", "--rst-active": args.rst_active != "strict"}
+    if any(given.values()):
+        raise ClientError(f"--group-orders plans 8-bit frames at the shortest LSB under TI's readings, from "
+                          f"the order's start: not with {', '.join(k for k, v in given.items() if v)}")
+    try:
+        found = group_orders.find(dmd, args.dclk, ResetMode[args.reset_mode], seconds=args.group_orders,
+                                  words_per_cycle=args.read_rate, t_rst_cycles=_t_rst(args))
+    except ImportError:
+        raise ClientError("--group-orders needs the constraint solver: pip install 'dmd-projector[solver]'") from None
+    if found is None:
+        raise ClientError(f"the solver found no plan the sequencer plays on time in {args.group_orders:g} s")
+    plan, _ = found
+    print("groups in plane orders of their own (spec.group_orders), offset and order of each:")
+    for g, (offset, table) in enumerate(zip(plan.params.group_offsets, plan.params.group_tables, strict=True)):
+        print(f"  group {g:2}  offset {offset:>7}  order {' '.join(map(str, table))}")
+    return plan
 
 
 def describe(plan):
@@ -161,6 +186,10 @@ def main(argv=None):
                            help="search every reset mode, plane order and hide threshold for the fastest legal "
                                 "plan (spec.plan_search; about two minutes on the DLP7000) instead of "
                                 "--reset-mode and --order")
+    configure.add_argument("--group-orders", type=float, default=0.0, metavar="SECONDS",
+                           help="search this long with a constraint solver for a plan of --reset-mode's groups each "
+                                "in a plane order of its own, from an offset of its own (faster than one order "
+                                "for every group; 8-bit frames; needs the 'solver' extra; docs/bounds.md)")
     configure.add_argument("--order", default="MSB_FIRST", choices=list(plan_search.ORDER_NAMES),
                            help="plane order; INTERLEAVED: each short plane behind a long one (7 1 6 2 5 3 4 0)")
     configure.add_argument("--anchor", type=int, default=0, choices=range(8),

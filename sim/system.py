@@ -87,14 +87,16 @@ def latency(shown):
     return latencies[len(latencies) // 2], latencies[-1]
 
 
-def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=False, dmd="dlp7000"):
+def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=False, dmd="dlp7000", group_orders=None):
     """``make sim``: the full-XGA run of :mod:`sim.xga` on the default scene; prints the figures.
     ``faults`` (``make sim FAULTS=stalls|rst|all``): the same run with the chips misbehaving
     (:data:`sim.xga.FAULTS`). ``window`` (``make sim WINDOW=1``): every signal of the core is
     dumped from the first frame's last datagram (every frame sent whole, that one held back) to
     just after its first clocking pulse, with a save file of its own. ``dmd`` (``make sim
     DMD=dlp9500``): the projector's core for another DMD (the DLP9500: four buses, 1920 of 2048
-    columns seen)."""
+    columns seen). ``group_orders`` (``make sim GROUP_ORDERS=<seconds>``): the plan is the
+    constraint solver's, dual reset's groups each in a plane order of its own
+    (:mod:`spec.group_orders`), searched that long."""
     frames = frames or XGA_FRAMES
     name, dmd = dmd, DMDS[dmd]
     print(f"make sim: the projector's core (generated Verilog, Verilator) on the default scene, "
@@ -115,9 +117,9 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=False, dmd="dlp70
               f"a first short run measures it (status rst_active_cycles_max) and the run is planned with it")
     t0 = time.monotonic()
     key = "-".join(["scene", *([name] if name != "dlp7000" else []), *([faults] if faults else []),
-                    *(["window"] if window else [])])
+                    *(["window"] if window else []), *(["group-orders"] if group_orders else [])])
     r = xga.run(key, frames=frames, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK, dclk_hz=dclk_hz,
-                faults=faults, window=window, dmd=dmd, entries=XGA_ENTRIES)
+                faults=faults, window=window, dmd=dmd, entries=XGA_ENTRIES, group_orders=group_orders)
     shown, status = r["frames"], r["status"]
     ns = 1e9 / xga.DMD_HZ
     typical, worst = latency(shown)
@@ -135,10 +137,11 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=False, dmd="dlp70
           f"worst {worst + optical} cycles ({(worst + optical) * ns / 1e3:.2f} us)")
     agree = ("frame starts equal the schedule model's" if r["compared_with_model"]
              else "the sequencer waits for late rows: not compared with the schedule model")
+    order = "each group in its own order from its own offset" if r["order"] == "groups" else \
+        f"{r['order']}, stagger {r['stagger_cycles']}"
     print(f"frame period back to back, measured on the pins: {measured} cycles = {xga.DMD_HZ / measured:.1f} Hz "
           f"({agree}; periods {periods}); schedule model (the plan finder's: {r['reset_mode']} reset, "
-          f"{r['order']}, LSB {r['lsb_cycles']} cycles, stagger {r['stagger_cycles']}, "
-          f"rows every {r['row_period']} cycles, t_rst {r['t_rst_cycles']} "
+          f"{order}, LSB {r['lsb_cycles']} cycles, rows every {r['row_period']} cycles, t_rst {r['t_rst_cycles']} "
           f"cycles{' as measured' if r['t_rst_measured'] else ''}): {r['period_cycles']} "
           f"cycles = {r['rate_hz']:.1f} Hz")
     spans = sorted({f["span_cycles"] for f in shown})

@@ -53,6 +53,7 @@ from sim.models.camera import Camera, to_lsb
 from sim.models.dlpc410 import Dlpc410
 from sim.models.mcb import McbTiming
 from sim.scene import default_scene
+from spec import group_orders as spec_group_orders
 from spec import plan_search, records, schedule
 from spec.facts import DMDS, TIMING
 from spec.registers import PlaneOrder, ResetMode
@@ -85,22 +86,35 @@ WAVE_VIEW = 3000
 WINDOW_AFTER_US = 5
 
 
-def plan(dclk_hz=DCLK_HZ, t_rst_cycles=None, dmd=DMD):
+def plan(dclk_hz=DCLK_HZ, t_rst_cycles=None, dmd=DMD, group_orders=None):
     """The schedule for the run, as a user plans it (``python -m host configure --best``): the
     plan finder's fastest legal plan (every reset mode, plane order and hide threshold) for rows
     paced to the read bandwidth the memory leaves the plane reader, early triggers held;
     ``t_rst_cycles``: the controller's RST_ACTIVE as the projector measured it (default: the
-    facts table's). The finder's choice is kept in the build directory, keyed by the arguments
-    and the planner's source, so that later runs plan only that one choice."""
-    kwargs = {"depth": 8, "words_per_cycle": read_rate(McbTiming(), DMD_HZ), "trigger_hold": True,
-              "t_rst_cycles": t_rst_cycles}
+    facts table's). ``group_orders``: seconds of the constraint solver's search for dual reset's
+    groups each in a plane order of its own (``configure --group-orders``) instead. The finder's
+    choice is kept in the build directory, keyed by the arguments and the planner's source, so
+    that later runs plan only that one choice."""
+    kwargs = {"words_per_cycle": read_rate(McbTiming(), DMD_HZ), "trigger_hold": True, "t_rst_cycles": t_rst_cycles}
+    if not group_orders:
+        kwargs["depth"] = 8
     source = b"".join(path.read_bytes() for path in sorted((ROOT / "spec").glob("*.py")))
-    key = hashlib.sha256(json.dumps([dmd.name, dclk_hz, kwargs]).encode() + source).hexdigest()[:16]
+    key = hashlib.sha256(json.dumps([dmd.name, dclk_hz, kwargs, group_orders]).encode() + source).hexdigest()[:16]
     path = build_dir("plans") / f"{key}.json"
     with open(path.with_suffix(".lock"), "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)          # (test workers that plan at once search once)
-        if path.exists():
-            choice = json.loads(path.read_text())
+        choice = json.loads(path.read_text()) if path.exists() else None
+        if group_orders:
+            if choice is None:
+                found = spec_group_orders.find(dmd, dclk_hz, ResetMode.DUAL, seconds=group_orders, **kwargs)
+                if found is None:
+                    raise RuntimeError(f"the solver found no plan the sequencer plays on time in {group_orders:g} s")
+                p = found[0].params
+                choice = {"lsb": p.lsb, "orders": p.group_tables, "offsets": p.group_offsets}
+                path.write_text(json.dumps(choice))
+            _, base = spec_group_orders.sequencer_terms(dmd, dclk_hz, ResetMode.DUAL, **kwargs)
+            return spec_group_orders.played(dmd, base, choice["lsb"], choice["orders"], choice["offsets"])
+        if choice is not None:
             found = plan_search.candidate(dmd, dclk_hz, ResetMode[choice["reset_mode"]],
                                           PlaneOrder[choice["order"]], choice["hide"], **kwargs)
         else:
@@ -192,7 +206,7 @@ def _status(tx_trace):
 
 
 def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, faults=None, log=print,
-        calibrated=True, window=False, dmd=DMD, entries=None):
+        calibrated=True, window=False, dmd=DMD, entries=None, group_orders=None):
     """Build and run the XGA system simulation on ``frames`` frames of the default scene, stored
     as a sequence (played in slot order, or by ``entries``: the slot of each entry of its entry
     table, in a loop); ``one_by_one`` frames triggered each when the sequencer is ready, then
@@ -205,12 +219,14 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
     ``calibrated`` is false. ``window``: dumps every signal from the first frame's last GMII byte
     to its first clocking pulse (every frame sent whole; see the module's notes); the report's
     ``window`` says where, its span and its markers. ``dmd``:
-    the DLP7000 (default) or another DMD of :data:`spec.facts.DMDS` (the DLP9500: four buses)."""
+    the DLP7000 (default) or another DMD of :data:`spec.facts.DMDS` (the DLP9500: four buses).
+    ``group_orders``: the run plays the solver's plan of groups in orders of their own, searched
+    this many seconds (:func:`plan`)."""
     t_rst_cycles = None
     if calibrated and "dlpc410_rst_extra" in FAULTS.get(faults, {}):
         t_rst_cycles = calibrate(key, dclk_hz, faults, log, dmd)
         log(f"RST_ACTIVE measured by the projector: {t_rst_cycles} cycles from the pulse; planned with it")
-    the_plan = plan(dclk_hz, t_rst_cycles, dmd)
+    the_plan = plan(dclk_hz, t_rst_cycles, dmd, group_orders)
     directory = build_dir("system", key)
     t0 = time.monotonic()
     images = default_scene(frames, dmd.rows, dmd.columns)

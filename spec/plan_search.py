@@ -34,7 +34,7 @@ ORDERS = tuple(ORDER_NAMES.values())
 
 def order_name(order):
     """The name of one of :data:`ORDERS`."""
-    return next(name for name, o in ORDER_NAMES.items() if o == order)
+    return next((name for name, o in ORDER_NAMES.items() if o == order), PlaneOrder(order).name)
 
 
 def interleaved(depth):

@@ -332,7 +332,11 @@ def register_faults(wire, row_cycles, clear_row_cycles):
 
     ``stagger_keepable``: in a phased mode each group's first pulse is timed from the one before
     it, so groups a stagger apart keep their times exactly when the stagger is 0 or at least a
-    block clear's row cycles (no load of a clear's length fits between two first pulses)."""
+    block clear's row cycles (no load of a clear's length fits between two first pulses);
+    ``group_offsets_keepable``: likewise each group's offset of :attr:`PlaneOrder.GROUPS
+    <spec.registers.PlaneOrder.GROUPS>` (each is timed from the first pulses a trigger times at
+    once), and group 0's is 0: its first pulse starts the frame (the trigger's latency, the
+    camera, ``sync_out``) and no group's comes before it."""
     faults = {}
     for f, (_, wire_width) in zip(_registers.FIELDS, SEQUENCER, strict=True):
         if wire_width > f.bits:
@@ -347,6 +351,12 @@ def register_faults(wire, row_cycles, clear_row_cycles):
     faults["period_keepable"] = ((wire["trigger"] == _registers.TriggerMode.PERIODIC.value)
                                  & (wire["period"] < wire["lsb"]))
     faults["settle_keepable"] = wire["t_settle"] < _registers.MIN_SETTLE
+    width = next(f.width for f in _registers.FIELDS if f.name == "group_offsets")
+    offsets = [(wire["group_offsets"] >> (width * g)) & ((1 << width) - 1) for g in range(_registers.MAX_GROUPS)]
+    faults["group_offsets_even"] = _any([(o & 1) != 0 for o in offsets])
+    faults["group_offsets_keepable"] = ((wire["order"] == _registers.PlaneOrder.GROUPS.value)
+                                        & ((offsets[0] != 0) | _any([(o != 0) & (o < clear_row_cycles * row_cycles)
+                                                                     for o in offsets[1:]])))
     faults["stagger_keepable"] = ((wire["reset_mode"] != _registers.ResetMode.GLOBAL.value) & (wire["stagger"] != 0)
                                   & (wire["stagger"] < clear_row_cycles * row_cycles))
     return faults

@@ -13,7 +13,8 @@ binds.
 import enum
 
 __all__ = ["ResetMode", "PlaneOrder", "TriggerMode", "Source", "FIELDS", "Field",
-           "TIME_BITS", "LSB_BITS", "DURATION_BITS", "MIN_SETTLE", "group_size", "layout_bits", "pack", "unpack"]
+           "TIME_BITS", "LSB_BITS", "DURATION_BITS", "MIN_SETTLE", "MAX_GROUPS", "group_size", "layout_bits",
+           "pack", "unpack"]
 
 #: Width of the free-running time base. Comparisons are made on differences, so the base may
 #: wrap (every 8 days at 400 MHz) without harm; every wait is shorter than 2**(TIME_BITS-1).
@@ -22,6 +23,9 @@ TIME_BITS = 48
 LSB_BITS = 32
 #: Width of any plane duration (LSB shifted by up to 7) and of the other long waits.
 DURATION_BITS = LSB_BITS + 8
+#: Pulse groups the per-group registers hold: the most any DMD has (the DLP7000's 16 blocks,
+#: single reset).
+MAX_GROUPS = 16
 #: The shortest ``t_settle`` the sequencer keeps exactly: its settle countdown starts the cycle
 #: after its RST_ACTIVE countdown ends, and a countdown's flags are registered.
 MIN_SETTLE = 3
@@ -40,6 +44,8 @@ class PlaneOrder(enum.IntEnum):
     MSB_FIRST = 0
     LSB_FIRST = 1
     TABLE = 2    # ``order_table[j]`` = weight exponent (0 = least significant) shown j-th
+    GROUPS = 3   # group g shows ``group_tables[8g + j]`` j-th, its first pulse ``group_offsets[g]``
+                 # after the trigger's (in place of ``g * stagger``): plans beyond one timeline
 
 
 class TriggerMode(enum.IntEnum):
@@ -119,6 +125,12 @@ FIELDS = [
                            "plane order from position anchor (modulo the frame's depth), wrapping "
                            "round to the order's first; the trigger (in SYNC, the sync pulse) "
                            "lands on that plane. 0: the order as it is"),
+    Field("group_tables", 3, count=8 * MAX_GROUPS,
+          doc="with PlaneOrder.GROUPS: entry 8g + j is the weight exponent group g shows j-th"),
+    Field("group_offsets", 24, count=MAX_GROUPS,
+          doc="with PlaneOrder.GROUPS: entry g is the cycles from the first pulse a trigger times "
+              "at once to group g's first pulse (0: at once; even, 0 or at least a block clear's "
+              "row cycles, as stagger; group 0's 0: its first pulse starts the frame)"),
 ]
 
 _BY_NAME = {f.name: f for f in FIELDS}
@@ -158,7 +170,7 @@ def pack(values):
 
 
 def unpack(bits):
-    """The packed set (an int) -> ``{name: int}`` (entries of ``order_table`` as a list)."""
+    """The packed set (an int) -> ``{name: int}`` (the entries of a table as a list)."""
     out = {}
     for name, (offset, width) in layout_bits().items():
         raw = (bits >> offset) & ((1 << width) - 1)

@@ -67,7 +67,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .facts import SETTLE_READINGS, TIMING, BlockMode
-from .registers import MIN_SETTLE, PlaneOrder, ResetMode, Source, TriggerMode, group_size
+from .registers import MAX_GROUPS, MIN_SETTLE, PlaneOrder, ResetMode, Source, TriggerMode, group_size
 
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate", "FABRIC_HZ",
            "beats_at", "row_cycles", "row_rate_words",
@@ -184,19 +184,26 @@ class Params:
     beats: int = 1               # DCLK beats per dmd cycle: the sequencer's build, not a register
     t_flip: int = 0              # the four-DMD paper's settle reading: a group's pulses at least this
                                  # far apart (t_settle 0: memory loads once RST_ACTIVE falls); 0: TI's
-    # the model only, not registers: each group's own order table and offset from the trigger
-    # (plans beyond one timeline; empty: ``order`` and ``g * stagger`` for every group)
+    # with ``order`` GROUPS: each group's own order table and first pulse's offset (plans beyond
+    # one timeline, in place of ``order_table`` and ``g * stagger``), one entry a group
     group_tables: tuple = ()
     group_offsets: tuple = ()
 
+    def __post_init__(self):
+        if (self.order == PlaneOrder.GROUPS) != bool(self.group_tables) or \
+                len(self.group_tables) != len(self.group_offsets) or len(self.group_tables) > MAX_GROUPS:
+            raise ValueError("PlaneOrder.GROUPS takes an order table and an offset for each group, and only it")
+
     def registers(self, dmd):
         """The values of :class:`~gateware.registers.Registers`, as a dict."""
-        if self.group_tables or self.group_offsets:
-            raise ValueError("the registers hold one plane order and one stagger for every group")
         regs = {k: getattr(self, k) for k in (
             "lsb", "t_rst", "t_settle", "hide", "dark_gap", "stagger", "period", "reload_lead",
             "camera_offset", "camera_width", "anchor")}
+        unused = MAX_GROUPS - len(self.group_tables)
+        tables = [list(t) + list(range(len(t), 8)) for t in self.group_tables] + [list(range(8))] * unused
         regs.update(reset_mode=self.reset_mode, order=self.order, order_table=list(self.order_table),
+                    group_tables=[e for t in tables for e in t],
+                    group_offsets=list(self.group_offsets) + [0] * unused,
                     chain=int(self.chain), strict_rst=int(self.strict_rst), trigger=self.trigger,
                     trigger_hold=int(self.trigger_hold),
                     source=self.source, row_period=self.row_period or row_cycles(dmd, self.beats),
@@ -372,8 +379,8 @@ class _Model:
 
     def exps_of(self, fi, g):
         p = self.p
-        if p.group_tables:
-            return exponents(PlaneOrder.TABLE, p.group_tables[g], self.res.shown[fi].depth, p.anchor)
+        if p.order == PlaneOrder.GROUPS:
+            return exponents(p.order, p.group_tables[g], self.res.shown[fi].depth, p.anchor)
         return exponents(p.order, p.order_table, self.res.shown[fi].depth, p.anchor)
 
     def enqueue(self, g, fi, j):
@@ -504,7 +511,7 @@ class _Model:
         self.res.accepted.append(t)
         for g, s in enumerate(self.st):
             s.pending = True
-            s.pulse_at = t + 2 + (self.p.group_offsets[g] if self.p.group_offsets else g * self.p.stagger)
+            s.pulse_at = t + 2 + (self.p.group_offsets[g] if self.p.order == PlaneOrder.GROUPS else g * self.p.stagger)
 
     def release_held(self, t):
         """A held trigger is obeyed on the first cycle every group is ready."""

@@ -1,6 +1,8 @@
-"""Plans of groups in plane orders of their own (:mod:`sim.bench.group_orders`): the solver's
-plans pass the independent check, reach the one-timeline ceiling where that is optimal, never
-pass the bound, and the check fails each rule it checks when that rule is broken."""
+"""Plans of groups in plane orders of their own (:mod:`spec.group_orders`): the solver's plans
+pass the independent check (:mod:`sim.bench.group_orders`), reach the one-timeline ceiling where
+that is optimal, never pass the bound, and the check fails each rule it checks when that rule is
+broken; the plan finder's register set is one the projector takes, played by the model with no
+pulse late."""
 
 import copy
 from dataclasses import replace
@@ -8,9 +10,10 @@ from dataclasses import replace
 import pytest
 
 from sim.bench import group_orders as go
-from spec import ceiling, schedule
+from spec import ceiling, records, schedule
+from spec import group_orders as solver
 from spec.facts import TEST_DMD
-from spec.registers import ResetMode
+from spec.registers import PlaneOrder, ResetMode
 
 DEPTH = 4
 
@@ -20,7 +23,7 @@ def plans():
     out = {}
     for mode in (ResetMode.DUAL, ResetMode.SINGLE):
         top = ceiling.ceiling_of_mode(TEST_DMD, 200e6, mode, depth=DEPTH)
-        out[mode] = (go.solve(go.terms(TEST_DMD, 200e6, mode, depth=DEPTH), seconds=5), top)
+        out[mode] = (solver.solve(solver.terms(TEST_DMD, 200e6, mode, depth=DEPTH), seconds=5), top)
     return out
 
 
@@ -67,10 +70,11 @@ def test_check_fails_each_broken_rule(plans, how):
 
 def test_the_models_sequencer_plays_each_group_in_its_own_order():
     # one timeline written as group orders and offsets: the model plays exactly the same
-    t, base = go.sequencer_terms(TEST_DMD, 200e6, ResetMode.SINGLE, trigger_hold=True)
+    t, base = solver.sequencer_terms(TEST_DMD, 200e6, ResetMode.SINGLE, trigger_hold=True)
     p, frame = base.params, schedule.Frame(0, 8)
     exps = tuple(schedule.exponents(p.order, p.order_table, 8, p.anchor))
-    same = replace(p, group_tables=(exps,) * t.G, group_offsets=tuple(g * p.stagger for g in range(t.G)))
+    same = replace(p, order=PlaneOrder.GROUPS, group_tables=(exps,) * t.G,
+                   group_offsets=tuple(g * p.stagger for g in range(t.G)))
     first = schedule.ready_cycle(TEST_DMD, p, frame)
     assert (schedule.simulate(TEST_DMD, same, [frame], [first]).commands
             == schedule.simulate(TEST_DMD, p, [frame], [first]).commands)
@@ -78,7 +82,7 @@ def test_the_models_sequencer_plays_each_group_in_its_own_order():
     # of its own: the model shows each group's planes in its order, from its offset
     tables = tuple(exps[g:] + exps[:g] for g in range(t.G))
     offsets = tuple(g * p.stagger + (g % 2) * 2 * t.t_rst for g in range(t.G))
-    q = replace(p, group_tables=tables, group_offsets=offsets)
+    q = replace(p, order=PlaneOrder.GROUPS, group_tables=tables, group_offsets=offsets)
     r = schedule.simulate(TEST_DMD, q, [frame], [schedule.ready_cycle(TEST_DMD, q, frame)])
     for g in range(t.G):
         shown = [e for _, h, kind, _, e in r.pulses if h == g and kind == "plane"]
@@ -87,5 +91,23 @@ def test_the_models_sequencer_plays_each_group_in_its_own_order():
     # pulses come on time, whatever comes late after them)
     starts = [min(at for at, h, *_ in r.pulses if h == g) for g in range(t.G)]
     assert [s - starts[0] for s in starts] == list(offsets)
+    # the order and the tables go together
     with pytest.raises(ValueError):
-        q.registers(TEST_DMD)
+        replace(q, order=PlaneOrder.TABLE)
+    with pytest.raises(ValueError):
+        replace(p, order=PlaneOrder.GROUPS)
+
+
+def test_the_finder_gives_a_register_set_the_projector_takes():
+    found = solver.find(TEST_DMD, 200e6, ResetMode.SINGLE, seconds=3, trigger_hold=True)
+    assert found is not None
+    plan, groups = found
+    p = plan.params
+    assert p.order == PlaneOrder.GROUPS and go.check(groups) == []
+    assert (p.group_tables, p.group_offsets) == (tuple(groups.orders), tuple(groups.offsets))
+    frame = schedule.Frame(0, 8)
+    assert schedule.simulate(TEST_DMD, p, [frame], [schedule.ready_cycle(TEST_DMD, p, frame)]).late == 0
+    assert plan.frame_cycles == schedule.frame_period(TEST_DMD, p, frame)
+    wire = records.register_wire(p.registers(TEST_DMD))
+    faults = records.register_faults(wire, schedule.row_cycles(TEST_DMD, 1), TEST_DMD.clear_row_cycles)
+    assert [k for k, bad in faults.items() if bad] == []

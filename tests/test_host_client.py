@@ -408,8 +408,18 @@ def test_sequencer_record_refuses_what_the_projector_would_drop():
         codec.sequencer_record({**wire, "lsb": 3}, dmd=TEST_DMD)
     with pytest.raises(ValueError, match="lsb_keepable"):
         codec.sequencer_record({**wire, "lsb": 2}, dmd=TEST_DMD)
-    with pytest.raises(ValueError, match="order_known"):
-        codec.sequencer_record({**wire, "order": 3}, dmd=TEST_DMD)
+    # group g's offset is in bits 24g.. of the field: group 1 a row cycle after the first pulses
+    # (a block clear on the DLP7000: 16 cycles), too close for a first pulse timed from them;
+    # an odd offset
+    groups = {**wire, "order": PlaneOrder.GROUPS.value}
+    with pytest.raises(ValueError, match="group_offsets_keepable"):
+        codec.sequencer_record({**groups, "group_offsets": 14 << 24}, dmd=DMDS["dlp7000"])
+    assert not records.register_faults({**groups, "group_offsets": 16 << 24}, 16, 1)["group_offsets_keepable"]
+    # group 0 starts the frame: its offset is 0
+    assert records.register_faults({**groups, "group_offsets": 16}, 16, 1)["group_offsets_keepable"]
+    with pytest.raises(ValueError, match="group_offsets_even"):
+        codec.sequencer_record({**groups, "group_offsets": 4001 << 24}, dmd=TEST_DMD)
+    codec.sequencer_record({**groups, "group_offsets": 4000 << 24}, dmd=TEST_DMD)
     periodic = {**wire, "trigger": TriggerMode.PERIODIC.value}
     with pytest.raises(ValueError, match="period_keepable"):
         codec.sequencer_record({**periodic, "period": wire["lsb"] - 2}, dmd=TEST_DMD)
@@ -718,3 +728,30 @@ def test_cli_master(master, capsys):
         with pytest.raises(SystemExit) as leaving:
             cli.main(base + wrong)
         assert leaving.value.code == 2
+
+
+def test_cli_configure_group_orders_sends_each_groups_order(projector, capsys):
+    """``configure --group-orders``: the solver's plan (each group its own order and offset) is
+    printed group by group and sent as the projector takes it; the schedule model plays the set
+    the projector took with no pulse late. Options it does not plan for are refused."""
+    from spec import group_orders, registers
+    base = ["--address", "127.0.0.1", "--port", str(projector.port)]
+    setting = ["configure", "--dmd", "test", "--dclk", "200e6", "--reset-mode", "SINGLE", "--group-orders", "3"]
+    assert cli.main(base + setting) == 0
+    assert cli.main(base + ["status"]) == 0
+    model = projector.model
+    assert model.counters["records_sequencer"] == 1 and model.counters["drop_app_value"] == 0
+    taken = registers.unpack(records.registers_bits(model.registers[-1]))
+    assert taken["order"] == PlaneOrder.GROUPS
+    out = capsys.readouterr().out
+    tables = [tuple(taken["group_tables"][8 * g:8 * g + 8]) for g in range(TEST_DMD.blocks)]
+    for g, table in enumerate(tables):
+        assert f"group {g:2}  offset {taken['group_offsets'][g]:>7}  order {' '.join(map(str, table))}" in out
+    # the tables and offsets taken, played by the model on the finder's base plan: no pulse late
+    _, start = group_orders.sequencer_terms(TEST_DMD, 200e6, ResetMode.SINGLE)
+    offsets = taken["group_offsets"][:TEST_DMD.blocks]
+    plan = group_orders.played(TEST_DMD, start, taken["lsb"], tables, offsets)
+    assert plan is not None and records.register_wire(plan.params.registers(TEST_DMD)) == model.registers[-1]
+    assert f"{plan.rate_hz:.1f} frames/s" in out
+    assert cli.main(base + setting + ["--depth", "6"]) == 1
+    assert "not with --depth" in capsys.readouterr().err

@@ -11,17 +11,20 @@ bus's flags (:class:`~gateware.dlpc410.planner.Planner`) from them with little l
   the RST_ACTIVE countdown ends, so no sum is formed: timers chain);
 * a trigger obeyed: group 0's first pulse falls due two cycles after the trigger's cycle, and
   group ``g``'s ``stagger`` after group ``g - 1``'s (each loaded as the one before ends; with
-  ``stagger`` 0 all at once). A group waiting in that chain has no time yet: its flags say not
-  due, and not soon (``stagger`` is 0 or at least a clear's row cycles, so no load that a first
-  pulse could cut short can start meanwhile: :func:`spec.records.register_faults`).
+  ``stagger`` 0 all at once). In :attr:`~spec.registers.PlaneOrder.GROUPS` each group's first
+  pulse is its own offset after the time of the pulses at once instead (loaded as a timer of
+  that time, ``start``, ends; offset 0: at once). A group waiting in that chain has no time
+  yet: its flags say not due, and not soon (``stagger`` and each offset are 0 or at least a
+  clear's row cycles, so no load that a first pulse could cut short can start meanwhile:
+  :func:`spec.records.register_faults`).
 """
 
-from amaranth import Cat, Const, Module, Mux, Signal
+from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
 from ..countdown import Countdown
-from ..registers import DURATION_BITS, Registers
+from ..registers import DURATION_BITS, PlaneOrder, Registers
 
 __all__ = ["GroupTimes"]
 
@@ -41,7 +44,7 @@ class GroupTimes(wiring.Component):
     Members
     -------
     regs : In(:class:`~gateware.registers.Registers`)
-        ``t_rst``, ``t_settle``, ``stagger``, ``strict_rst``.
+        ``t_rst``, ``t_settle``, ``stagger``, ``strict_rst``, ``order`` and ``group_offsets``.
     pulse : In(blocks)
         Bit g: group g's pulse decided last cycle is applied now.
     pulse_any : In(1)
@@ -68,8 +71,8 @@ class GroupTimes(wiring.Component):
         Bit g: the group's memory may change by the next cycle, as far as its last pulse goes.
     at_once : Out(blocks)
         Bit g: a trigger obeyed times group g's first pulse at once (two cycles after the
-        trigger's), not chained after the group before (registered from ``active`` and
-        ``stagger``).
+        trigger's), not chained after the group before or offset (registered from ``active``,
+        ``stagger`` and the offsets).
     """
 
     def __init__(self, dmd, *, soon, soon_clear):
@@ -95,13 +98,20 @@ class GroupTimes(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         regs, G = self.regs, self._dmd.blocks
-        stagger_zero = Signal()
-        m.d.sync += stagger_zero.eq(regs.stagger == 0)
-        # the groups a trigger obeyed times at once, and those it chains (registered: the
-        # registers, and so ``active``, hold still long before a trigger is obeyed)
+        # each group's first pulse after the time of those at once: ``g * stagger`` (chained) or
+        # its offset (registered: the registers, and so ``active``, hold still long before a
+        # trigger is obeyed)
+        offsets, stagger_zero = Signal(), Signal()
+        firsts = [Signal(24, name=f"first{g}") for g in range(G)]
+        m.d.sync += [offsets.eq(regs.order == PlaneOrder.GROUPS), stagger_zero.eq(regs.stagger == 0)]
+        m.d.sync += [first.eq(Mux(offsets, regs.group_offsets[g], regs.stagger)) for g, first in enumerate(firsts)]
+        # the groups a trigger obeyed times at once, and those it chains
         at_once, chains = self.at_once, Signal(G)
-        unchained = Cat((g == 0) | stagger_zero for g in range(G))
+        unchained = Cat(Mux(offsets, first == 0, (g == 0) | stagger_zero) for g, first in enumerate(firsts))
         m.d.sync += [at_once.eq(self.active & unchained), chains.eq(self.active & ~unchained)]
+        # the time of the pulses at once, for the offsets
+        m.submodules.start = start = Countdown(3, lag=LAG)
+        m.d.comb += [start.load.eq(self.obey), start.value.eq(2)]
 
         # the flags are for the next cycle: "by the next cycle" is within 2 cycles from now; the
         # values loaded hold still the cycle before (the registers), or their flags are worked
@@ -121,22 +131,22 @@ class GroupTimes(wiring.Component):
             # the pulse time: the delay after a pulse; the first pulse of a frame (group 0's two
             # cycles after the trigger's, the others' ``stagger`` after the group's before them,
             # chained: as the group before ends its count, unless it waits itself and the end
-            # is of its count before the trigger); each source with its flags worked out ahead
+            # is of its count before the trigger; or each its offset after ``start``'s time);
+            # each source with its flags worked out ahead
             delay_flags = pulse_cd.flags_registered(m, self.delay[g], f"delay_flags{g}")
-            stagger_flags = pulse_cd.flags_registered(m, regs.stagger, f"stagger_flags{g}")
+            first_flags = pulse_cd.flags_registered(m, firsts[g], f"first_flags{g}")
             first = self.obey & at_once[g]
-            if g:
-                chain = chained[g] & pulse_cds[g - 1].ends & (~chained[g - 1] if g > 1 else 1)
-                m.d.sync += chained[g].eq(Mux(self.abandon | chain, 0, chained[g] | (self.obey & chains[g])))
-            else:
-                chain = Const(0)
+            after = start.ends if g == 0 else \
+                Mux(offsets, start.ends, pulse_cds[g - 1].ends & (~chained[g - 1] if g > 1 else 1))
+            chain = chained[g] & after
+            m.d.sync += chained[g].eq(Mux(self.abandon | chain, 0, chained[g] | (self.obey & chains[g])))
             # (one of the three at most: a group pulses only loaded, never waiting for a trigger)
             m.d.comb += [
                 pulse_cd.load.eq(self.pulse[g] | first | chain),
                 pulse_cd.value.eq(Mux(self.pulse[g], self.delay[g], 0) | Mux(first, 2, 0)
-                                  | Mux(chain, regs.stagger, 0)),
+                                  | Mux(chain, firsts[g], 0)),
                 pulse_cd.load_flags.eq(Mux(self.pulse[g], delay_flags, 0) | Mux(first, pulse_cd.flags_of(2), 0)
-                                       | Mux(chain, stagger_flags, 0)),
+                                       | Mux(chain, first_flags, 0)),
             ]
 
             # RST_ACTIVE over, then the settle time

@@ -15,7 +15,7 @@ from amaranth.lib.wiring import In, Out
 from ..registers import Registers
 from .group_frames import FRAME
 from .layouts import event, group_bits, load_job
-from .timebase import exponents, order_position, stored_plane
+from .timebase import exponents, group_tables, order_position, stored_plane
 
 __all__ = ["LoadJobs"]
 
@@ -30,7 +30,7 @@ class LoadJobs(wiring.Component):
     Members
     -------
     regs : In(:class:`~gateware.registers.Registers`)
-        ``order``, ``order_table``, ``anchor``.
+        ``order``, ``order_table``, ``group_tables``, ``anchor``.
     pulse : In(blocks); pulse_any : In(1)
         Bit g: group g's pulse is applied now (one bit at most); some bit of ``pulse``.
     pos : In(ArrayLayout(3, blocks)); dark : In(blocks); frame : In(ArrayLayout(FRAME, blocks))
@@ -64,6 +64,8 @@ class LoadJobs(wiring.Component):
         dmd, G, gb = self._dmd, self._dmd.blocks, group_bits(self._dmd)
         job = Signal(load_job(dmd))
         low_plane = Signal(3)                  # the job's frame's lowest stored plane
+        table = Signal(24)                     # the job's group's order table (GROUPS)
+        tables = group_tables(self.regs, G)
         pulsed, group, formed = Signal(), Signal(gb), Signal()
         m.d.sync += [pulsed.eq(self.pulse_any),
                      group.eq(Cat(Cat(self.pulse[g] for g in range(G) if g >> b & 1).any() for b in range(gb))),
@@ -71,11 +73,12 @@ class LoadJobs(wiring.Component):
         with m.If(pulsed):
             kept = self.frame[group]
             m.d.sync += [job.group.eq(group), job.slot.eq(kept.slot), job.depth.eq(kept.depth),
-                         low_plane.eq(kept.low_plane), job.pos.eq(self.pos[group]),
+                         low_plane.eq(kept.low_plane), job.pos.eq(self.pos[group]), table.eq(tables[group]),
                          job.clear.eq(self.dark.bit_select(group, 1))]
         with m.If(self.queue_first.valid):
             m.d.sync += [job.group.eq(self.queue_first.payload), job.slot.eq(self.next.slot),
                          job.depth.eq(self.next.depth), low_plane.eq(self.next.low_plane), job.pos.eq(0),
+                         table.eq(tables[self.queue_first.payload]),
                          job.clear.eq(0)]
         # the job's position in the plane order (the anchor's rotation) and the exponent at each
         # position, then its stored plane
@@ -83,7 +86,7 @@ class LoadJobs(wiring.Component):
         each = Signal(data.ArrayLayout(3, 8))
         m.d.sync += [ordered.eq(formed), staged.eq(job), staged_low.eq(low_plane),
                      at.eq(order_position(m, self.regs, job.pos, job.depth, "job_at")),
-                     each.eq(exponents(m, self.regs, job.depth, "job_exps"))]
+                     each.eq(exponents(m, self.regs, job.depth, "job_exps", table))]
         out, valid = Signal(load_job(dmd)), Signal()
         m.d.sync += [valid.eq(ordered), out.eq(staged), out.plane.eq(stored_plane(staged_low, each[at]))]
         m.d.comb += [self.jobs.valid.eq(valid), self.jobs.payload.eq(out),

@@ -22,7 +22,7 @@ from amaranth.lib.wiring import In, Out
 from ..limbs import greater, limb_order
 from ..registers import DURATION_BITS, Registers
 from .group_frames import FRAME
-from .timebase import exponents, order_position
+from .timebase import exponents, group_tables, order_position
 
 __all__ = ["PlaneInfo", "STAGES"]
 
@@ -40,7 +40,7 @@ class PlaneInfo(wiring.Component):
     Members
     -------
     regs : In(:class:`~gateware.registers.Registers`)
-        ``order``, ``order_table``, ``anchor``, ``lsb``, ``hide``, ``dark_gap``.
+        ``order``, ``order_table``, ``group_tables``, ``anchor``, ``lsb``, ``hide``, ``dark_gap``.
     pos : In(ArrayLayout(3, blocks)); dark : In(blocks); frame : In(ArrayLayout(FRAME, blocks))
         Each group's display position, whether its next pulse is a dark one, and its frame.
     changed : In(blocks)
@@ -99,13 +99,14 @@ class PlaneInfo(wiring.Component):
         # 0: the group's state
         pos, dark, depth = Signal(3), Signal(), Signal(4)
         show = Signal(data.Layout.cast(frame)["showing"].shape)
-        m.d.sync += [tags[0].eq(turn), valid[0].eq(1),
+        table = Signal(24)
+        m.d.sync += [tags[0].eq(turn), valid[0].eq(1), table.eq(group_tables(regs, G)[turn]),
                      pos.eq(Array(self.pos)[turn]), dark.eq(self.dark.bit_select(turn, 1)),
                      depth.eq(Array(f.depth for f in self.frame)[turn]),
                      show.eq(Array(f.showing for f in self.frame)[turn])]
 
         # 1: the plane's position in the order (from the anchor) and the exponent at each
-        # position, the least significant plane's time; the last plane
+        # position (of the group's table, picked at 0), the least significant plane's time; the last plane
         advance(1)
         at = Signal(3)
         lsb = Signal.like(regs.lsb)
@@ -114,7 +115,7 @@ class PlaneInfo(wiring.Component):
         nodark0 = Signal()
         each = Signal(data.ArrayLayout(3, 8))
         m.d.sync += [at.eq(order_position(m, regs, pos, depth, "info_at")),
-                     each.eq(exponents(m, regs, depth, "info_exps")),
+                     each.eq(exponents(m, regs, depth, "info_exps", table)),
                      lsb.eq(Mux(show.lsb != 0, show.lsb, regs.lsb)), last0.eq(pos == depth - 1),
                      dark0.eq(dark), edark0.eq(show.dark), nodark0.eq(show.dark == 0)]
 

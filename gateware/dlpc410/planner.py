@@ -128,8 +128,8 @@ class Planner(wiring.Component):
     frame_start, camera_start : Out(1)
         The pulse applied now is the first of a frame (that pulses the camera).
     sync_out : Out(1)
-        High while a frame is shown, with the pins (first pulse to the last group's final dark
-        pulse).
+        High while a frame is shown, with the pins (group 0's first pulse to the final dark pulse
+        of the last group to end).
     frames_started, late, bad_frames : Out(COUNTER_BITS)
         Frames started; pulses made after their time; frames dropped for their bit depth.
     rst_late, rst_faults, rst_longest : Out(COUNTER_BITS)
@@ -230,8 +230,6 @@ class Planner(wiring.Component):
         P = self.choice
         usable = offers.offer.valid & ~use_prng
         hidden, final, takes_offered = self._outcomes(m, info, frames, dark, usable)
-        # the reset mode's last group (its groups are 0 .. n - 1)
-        last_group = Cat(active[g] & (~active[g + 1] if g + 1 < G else 1) for g in range(G))
         decided = Signal(G)                    # the pulse decided last cycle, applied now
         decided_any = Signal()
         moves, ends_play, take, starts, camera, ends_seq, late_now = (
@@ -275,7 +273,8 @@ class Planner(wiring.Component):
         ended = Signal()
         with m.If(starts):
             m.d.sync += self.sync_out.eq(1)
-        with m.If((ends_play & last_group).any()):
+        # (the last group to end its play: in GROUPS, whichever it is)
+        with m.If(ends_play.any() & ~(pending & ~ends_play).any()):
             m.d.sync += self.sync_out.eq(0)
         with m.If(ends_seq):
             m.d.sync += ended.eq(1)

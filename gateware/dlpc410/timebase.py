@@ -6,15 +6,16 @@ plane at display position ``j`` (the plane of weight ``2**e``), and the stored p
 frame's depth and its sequence entry). Both are small tables (of ``depth`` and ``j``; of the
 lowest plane and ``e``), written as lookups, not sums, so no carry chain is made for them. The
 anchor register starts the order at a position of its own: ``(j + anchor) mod depth``, a
-lookup too.
+lookup too. In :attr:`~spec.registers.PlaneOrder.GROUPS` each group has a table of its own
+(:func:`group_tables`), picked by the group a cycle before a position chooses from it.
 """
 
-from amaranth import Array, Signal
+from amaranth import Array, Cat, Signal
 from amaranth.lib import data
 
 from ..registers import PlaneOrder
 
-__all__ = ["order_position", "exponents", "stored_plane"]
+__all__ = ["order_position", "group_tables", "exponents", "stored_plane"]
 
 
 def _table(function, rows=16, columns=8):
@@ -45,18 +46,27 @@ def order_position(m, regs, j, depth, name):
     return k
 
 
-def exponents(m, regs, depth, name):
+def group_tables(regs, groups):
+    """Each of ``groups`` groups' order table (eight 3-bit exponents) in ``regs``, an
+    :class:`~amaranth.hdl.Array` to index by group (and register: a wide choice)."""
+    return Array(Cat(regs.group_tables[8 * g + j] for j in range(8)) for g in range(groups))
+
+
+def exponents(m, regs, depth, name, table):
     """The weight exponent at each position ``k`` (0..7) of the plane order of ``regs`` (a
-    :class:`~gateware.registers.Registers` view) in a frame of ``depth`` planes: lookups on
-    ``depth`` alone, to be registered before a position chooses one."""
+    :class:`~gateware.registers.Registers` view) in a frame of ``depth`` planes (in GROUPS,
+    ``table``'s: the group's, from :func:`group_tables`, registered): lookups on ``depth``
+    alone, to be registered before a position chooses one."""
     each = Signal(data.ArrayLayout(3, 8), name=name)
     with m.Switch(regs.order):
         with m.Case(PlaneOrder.MSB_FIRST):
             m.d.comb += [each[k].eq(_MSB_FIRST[depth][k]) for k in range(8)]
         with m.Case(PlaneOrder.LSB_FIRST):
             m.d.comb += [each[k].eq(k) for k in range(8)]
-        with m.Default():
+        with m.Case(PlaneOrder.TABLE):
             m.d.comb += each.eq(regs.order_table)
+        with m.Case(PlaneOrder.GROUPS):
+            m.d.comb += each.eq(table)
     return each
 
 

@@ -10,7 +10,6 @@ MODULES = [
     "sim.bench.camera",
     "sim.bench.dlpc410_model",
     "sim.bench.formal",
-    "sim.bench.group_orders",
     "sim.bench.host",
     "sim.bench.mac",
     "sim.bench.net",

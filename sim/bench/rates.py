@@ -14,6 +14,11 @@ model's (``_model``). The DLP7000 in every reset mode at 200 and 400 MHz, and th
 choice (:mod:`spec.plan_search`) at each, under TI's strict RST_ACTIVE reading and under the
 loose one beside it; the DLP9500 global at 400 MHz.
 
+Plans beyond one timeline (:mod:`sim.bench.group_orders`: dual reset's groups each in a plane
+order of its own, from an offset of its own, found by a constraint solver) are measured the same
+way at each DCLK; the headline ``seq.gray8_rate_hz_dlp7000`` is the faster of the two kinds at
+200 MHz.
+
 The ceiling of such plans (:func:`ceilings`, ``python -m sim.bench.rates ceiling``): the fastest
 rate any plan of one timeline for every group reaches (:mod:`spec.ceiling`), arithmetic beside
 the measured rates, and the fraction of it the plan finder's choice reaches.
@@ -29,6 +34,7 @@ back to back: ``rows * row_period`` cycles a pattern).
 import numpy as np
 
 from gateware.dlpc410.trigger import PIN_TO_STROBE
+from sim.bench import group_orders
 from sim.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import frame_lights
@@ -106,6 +112,11 @@ def run():
     figures = cases(measured)
     figures.update(best(measured))
     figures.update(ceilings(figures))
+    figures.update(group_orders.figures())
+    # the headline: the fastest legal plan measured at 200 MHz under TI's rules, of one timeline
+    # (the plan finder's) or of groups in orders of their own (the solver's)
+    figures["seq.gray8_rate_hz_dlp7000"] = max(figures["seq.gray8_rate_hz_dlp7000_best_200mhz"],
+                                               figures["seq.gray8_rate_hz_dlp7000_dual_200mhz_group_orders"])
     figures.update(binary())
     return figures
 
@@ -181,8 +192,6 @@ def best(measured=None):
             figures[f"seq.gray8_rate_hz_dlp7000_best_{key}"] = (rate, "Hz")
             figures[f"seq.gray8_rate_hz_dlp7000_best_{key}_model"] = (plan.rate_hz, "Hz")
             figures[f"seq.gray8_fraction_of_bound_dlp7000_best_{key}"] = (rate / schedule.bound(dmd, dclk), "")
-    # the headline: the best plan under TI's rules (the strict reading) at 200 MHz
-    figures["seq.gray8_rate_hz_dlp7000"] = figures["seq.gray8_rate_hz_dlp7000_best_200mhz"]
     # the camera's error over a frame played back to back at each best plan
     figures["seq.gray_error_lsb_max_at_best_rate"] = (max(errors), "LSB")
     return figures
@@ -246,6 +255,6 @@ def binary():
 
 if __name__ == "__main__":
     import sys
-    only = {"binary": binary, "ceiling": ceilings, "best": best}
+    only = {"binary": binary, "ceiling": ceilings, "best": best, "group_orders": group_orders.figures}
     for figure, (value, unit) in (only[sys.argv[1]]() if sys.argv[1:] else run()).items():
         print(f"{figure:50s} {value:10.1f} {unit}")

@@ -74,7 +74,9 @@ def sequencer_record(sequence=0, **changes):
 BAD_REGISTERS = {
     "lsb_odd": {"lsb": GOOD_WIRE["lsb"] + 1},
     "lsb_zero": {"lsb": 0},
-    "order_unknown": {"order": 3},
+    "order_too_wide": {"order": 4},
+    "group_offset_odd": {"group_offsets": 3 << 24},
+    "group_zero_offset": {"order": 3, "group_offsets": 4},
     "reset_mode_too_wide": {"reset_mode": 4},
     "chain_not_a_bit": {"chain": 2},
     "stagger_odd": {"stagger": 3},

@@ -92,7 +92,7 @@ def control_traffic(dmd):
         codec.control_record(51, armed=3),
         codec.sequencer_record(wire, 52),
         codec.sequencer_record({**wire, "lsb": wire["lsb"] | 1}, 53),
-        codec.sequencer_record({**wire, "order": 3}, 54),
+        codec.sequencer_record({**wire, "order": PlaneOrder.GROUPS.value, "group_offsets": 4}, 54),
         codec.sequencer_record({**wire, "row_period": 0}, 55),
         codec.sequencer_record({**wire, "order": PlaneOrder.LSB_FIRST.value}, 56),
         codec.sequencer_record(wire, 57)[:-2],

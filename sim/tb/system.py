@@ -175,7 +175,7 @@ def bad_records(system, picture):
     body = wire.unpack(records.IMAGE, image[n:])
     return [
         codec.sequencer_record({**good_regs, "lsb": good_regs["lsb"] + 1}, system.next_sequence()),
-        codec.sequencer_record({**good_regs, "order": 3}, system.next_sequence()),
+        codec.sequencer_record({**good_regs, "order": 4}, system.next_sequence()),    # order over 2 bits
         codec.sequencer_record(good_regs, system.next_sequence())[:-1],          # a byte short
         codec.control_record(system.next_sequence(), armed=2),
         codec.control_record(system.next_sequence(), bit_depth=9),
