@@ -273,8 +273,9 @@ class Planner(wiring.Component):
         ended = Signal()
         with m.If(starts):
             m.d.sync += self.sync_out.eq(1)
-        # (the last group to end its play: in GROUPS, whichever it is)
-        with m.If(ends_play.any() & ~(pending & ~ends_play).any()):
+        # (the last group to end its play: in GROUPS, whichever it is; ``playing`` is worked out
+        # from the groups that played the cycle before)
+        with m.If(ends_play.any() & ~self.playing):
             m.d.sync += self.sync_out.eq(0)
         with m.If(ends_seq):
             m.d.sync += ended.eq(1)
