@@ -212,7 +212,7 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0):
     return GroupPlan(t, v(F), offsets, orders, all_loads, all_clears, math.ceil(solver.best_objective_bound))
 
 
-def find(dmd, dclk_hz, reset_mode, *, seconds=60.0, workers=2, extra_rows=2, margin=0, **plan_kwargs):
+def find(dmd, dclk_hz, reset_mode, *, seconds=60.0, workers=2, extra_rows=4, margin=0, **plan_kwargs):
     """The fastest plan of groups in orders of their own the solver finds within ``seconds``
     under the sequencer's terms (:func:`sequencer_terms`; ``plan_kwargs`` as
     :func:`spec.schedule.plan`'s), that the schedule model's sequencer plays with no pulse late:
