@@ -76,6 +76,9 @@ TOPLEVEL = "fast_system"
 _STALLS = {"mcb_stall_permille": 50, "mcb_stall_max_ns": 2000, "mcb_stall_seed": 7}
 _RST = {"dlpc410_rst_extra": 91}
 FAULTS = {"stalls": _STALLS, "rst": _RST, "all": {**_STALLS, **_RST}}
+#: Cycles more for every load of the solver's plans (``make sim GROUP_ORDERS``): before its pulse
+#: and in the dark gap that covers a reload (:func:`spec.group_orders.sequencer_terms`).
+GROUP_ORDERS_MARGIN = 0
 #: The VCD of the pins covers the first triggered frame, from this many cycles before its trigger
 #: to this many after its last pulse; its save file opens on this many cycles from the trigger.
 WAVE_WINDOW = (1000, 2000)
@@ -99,6 +102,8 @@ def plan(dclk_hz=DCLK_HZ, t_rst_cycles=None, dmd=DMD, group_orders=None):
     if not group_orders:
         kwargs["depth"] = 8
     source = b"".join(path.read_bytes() for path in sorted((ROOT / "spec").glob("*.py")))
+    if group_orders:
+        kwargs["margin"] = GROUP_ORDERS_MARGIN
     key = hashlib.sha256(json.dumps([dmd.name, dclk_hz, kwargs, group_orders]).encode() + source).hexdigest()[:16]
     path = build_dir("plans") / f"{key}.json"
     with open(path.with_suffix(".lock"), "w") as lock:

@@ -88,17 +88,21 @@ def terms(dmd, dclk_hz, reset_mode, *, depth=8, row_period=None):
                  t_rst, t_settle, R, load, clear)
 
 
-def sequencer_terms(dmd, dclk_hz, reset_mode, **plan_kwargs):
+def sequencer_terms(dmd, dclk_hz, reset_mode, *, margin=0, **plan_kwargs):
     """The :class:`Terms` the sequencer keeps, and the one-timeline plan they come from
     (:func:`spec.schedule.plan`: its RST_ACTIVE with the sequencer's margin, its hide threshold
     and dark gap, its shortest LSB); ``plan_kwargs``: that function's (``words_per_cycle``,
-    ``trigger_hold``, ...)."""
+    ``trigger_hold``, ...). ``margin`` (even): cycles more for every load, before its pulse and
+    in the dark gap (and hide threshold) that covers a reload, for a memory that may stall."""
     base = schedule.plan(dmd, dclk_hz, reset_mode=reset_mode, **order_kwargs(PlaneOrder.TABLE, 8), **plan_kwargs)
     p = base.params
     assert p.hide == p.dark_gap, "a plane hides a load exactly when it is as long as a dark gap"
+    assert margin % 2 == 0, "dark gaps are even"
+    base = replace(base, params=replace(p, hide=p.hide + margin, dark_gap=p.dark_gap + margin))
     t = terms(dmd, dclk_hz, reset_mode, row_period=p.row_period)
     # a load done the slack the spread search leaves it for other groups' pulses taking row cycles
-    t = replace(t, lsb=even(base.lsb_min), reload=p.hide, t_rst=p.t_rst, t_settle=p.t_settle, slack=2 * t.row * t.G)
+    t = replace(t, lsb=even(base.lsb_min), reload=p.hide + margin, t_rst=p.t_rst, t_settle=p.t_settle,
+                slack=2 * t.row * t.G + margin)
     return t, base
 
 
@@ -219,11 +223,10 @@ def find(dmd, dclk_hz, reset_mode, *, seconds=60.0, workers=2, extra_rows=4, mar
     (:class:`spec.schedule.Plan` of :attr:`~spec.registers.PlaneOrder.GROUPS`, its
     :class:`GroupPlan`), or None. At the settle path's LSB a dark pulse's clears may find no cycle
     to wait for a row under way (the model loads as soon as it can): the LSB then takes a row
-    cycle more, up to ``extra_rows``. ``margin``: cycles more each load must end before its pulse
-    (for a memory that may stall)."""
-    seq_terms, base = sequencer_terms(dmd, dclk_hz, reset_mode, **plan_kwargs)
+    cycle more, up to ``extra_rows``. ``margin``: as :func:`sequencer_terms`'s."""
+    seq_terms, base = sequencer_terms(dmd, dclk_hz, reset_mode, margin=margin, **plan_kwargs)
     for extra in range(extra_rows + 1):
-        t = replace(seq_terms, lsb=seq_terms.lsb + extra * seq_terms.row, slack=seq_terms.slack + margin)
+        t = replace(seq_terms, lsb=seq_terms.lsb + extra * seq_terms.row)
         found = solve(t, seconds=seconds, workers=workers)
         if found is not None:
             plan = played(dmd, base, t.lsb, found.orders, found.offsets)

@@ -45,7 +45,7 @@ class PlaneOrder(enum.IntEnum):
     LSB_FIRST = 1
     TABLE = 2    # ``order_table[j]`` = weight exponent (0 = least significant) shown j-th
     GROUPS = 3   # group g shows ``group_tables[8g + j]`` j-th, its first pulse ``group_offsets[g]``
-                 # after the trigger's (in place of ``g * stagger``): plans beyond one timeline
+                 # after group 0's (in place of ``g * stagger``): plans beyond one timeline
 
 
 class TriggerMode(enum.IntEnum):

@@ -13,9 +13,9 @@ bus's flags (:class:`~gateware.dlpc410.planner.Planner`) from them with little l
   group ``g``'s ``stagger`` after group ``g - 1``'s (each loaded as the one before ends; with
   ``stagger`` 0 all at once). In :attr:`~spec.registers.PlaneOrder.GROUPS` each group's first
   pulse is its own offset after group 0's instead (loaded as a timer of that time, ``start``,
-  ends; offset 0: at once). A group waiting in that chain has no time
-  yet: its flags say not due, and not soon (``stagger`` and each offset are 0 or at least a
-  clear's row cycles, so no load that a first pulse could cut short can start meanwhile:
+  ends; offset 0: at once). A group waiting in that chain has no time yet: its flags say not
+  due, and not soon (``stagger`` and each offset are 0 or at least a clear's row cycles, so no
+  load that a first pulse could cut short can start meanwhile:
   :func:`spec.records.register_faults`).
 """
 
