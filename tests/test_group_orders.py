@@ -111,3 +111,18 @@ def test_the_finder_gives_a_register_set_the_projector_takes():
     wire = records.register_wire(p.registers(TEST_DMD))
     faults = records.register_faults(wire, schedule.row_cycles(TEST_DMD, 1), TEST_DMD.clear_row_cycles)
     assert [k for k, bad in faults.items() if bad] == []
+
+
+def test_a_margin_ends_every_load_that_much_sooner():
+    """``margin``: every load ends that much sooner before its pulse, and the dark gap (and the
+    hide threshold with it) covers it; the finder's plan keeps it (the independent check with the
+    margin in its terms)."""
+    bare, start = solver.sequencer_terms(TEST_DMD, 200e6, ResetMode.SINGLE, trigger_hold=True)
+    kept, base = solver.sequencer_terms(TEST_DMD, 200e6, ResetMode.SINGLE, margin=8, trigger_hold=True)
+    assert (kept.slack, kept.reload) == (bare.slack + 8, bare.reload + 8)
+    assert base.params.dark_gap == base.params.hide == start.params.dark_gap + 8
+    plan, groups = solver.find(TEST_DMD, 200e6, ResetMode.SINGLE, seconds=3, margin=8, trigger_hold=True)
+    assert groups.terms.slack == kept.slack and go.check(groups) == []
+    assert plan.params.dark_gap == base.params.dark_gap
+    with pytest.raises(AssertionError):
+        solver.sequencer_terms(TEST_DMD, 200e6, ResetMode.SINGLE, margin=3)
