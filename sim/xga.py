@@ -78,7 +78,7 @@ _RST = {"dlpc410_rst_extra": 91}
 FAULTS = {"stalls": _STALLS, "rst": _RST, "all": {**_STALLS, **_RST}}
 #: Cycles more for every load of the solver's plans (``make sim GROUP_ORDERS``): before its pulse
 #: and in the dark gap that covers a reload (:func:`spec.group_orders.sequencer_terms`).
-GROUP_ORDERS_MARGIN = 0
+GROUP_ORDERS_MARGIN = 300
 #: The VCD of the pins covers the first triggered frame, from this many cycles before its trigger
 #: to this many after its last pulse; its save file opens on this many cycles from the trigger.
 WAVE_WINDOW = (1000, 2000)
