@@ -64,7 +64,7 @@ def _plan(args):
                   t_rst_cycles=_t_rst(args), reading=args.settle_reading, anchor=args.anchor,
                   strict_rst=args.rst_active == "strict")
     if args.group_orders:
-        plan = _group_orders(dmd, args)
+        plan = _group_orders(dmd, args, common)
     elif args.best:
         found = plan_search.find(dmd, args.dclk, **common)
         print(f"plan finder: every reset mode, plane order and hide threshold under the {args.settle_reading} "
@@ -90,10 +90,11 @@ def _plan(args):
     return dmd, plan
 
 
-def _group_orders(dmd, args):
+def _group_orders(dmd, args, common):
     """``--group-orders SECONDS``: each group of the reset mode in a plane order of its own, from
     an offset of its own, as the solver finds them (:func:`spec.group_orders.find`: 8-bit frames,
-    TI's readings, the shortest LSB)."""
+    TI's readings, the shortest LSB; ``common``: the plan's arguments, as :func:`_plan` read
+    them)."""
     given = {"--depth": args.depth != 8, "--exposure": args.exposure, "--anchor": args.anchor,
              "--settle-reading": args.settle_reading != "ti", "--rst-active": args.rst_active != "strict"}
     if any(given.values()):
@@ -101,7 +102,7 @@ def _group_orders(dmd, args):
                           f"the order's start: not with {', '.join(k for k, v in given.items() if v)}")
     try:
         found = group_orders.find(dmd, args.dclk, ResetMode[args.reset_mode], seconds=args.group_orders,
-                                  words_per_cycle=args.read_rate, t_rst_cycles=_t_rst(args))
+                                  words_per_cycle=common["words_per_cycle"], t_rst_cycles=common["t_rst_cycles"])
     except ImportError:
         raise ClientError("--group-orders needs the constraint solver: pip install 'dmd-projector[solver]'") from None
     if found is None:

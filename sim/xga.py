@@ -98,12 +98,9 @@ def plan(dclk_hz=DCLK_HZ, t_rst_cycles=None, dmd=DMD, group_orders=None):
     groups each in a plane order of its own (``configure --group-orders``) instead. The finder's
     choice is kept in the build directory, keyed by the arguments and the planner's source, so
     that later runs plan only that one choice."""
-    kwargs = {"words_per_cycle": read_rate(McbTiming(), DMD_HZ), "trigger_hold": True, "t_rst_cycles": t_rst_cycles}
-    if not group_orders:
-        kwargs["depth"] = 8
+    kwargs = {"words_per_cycle": read_rate(McbTiming(), DMD_HZ), "trigger_hold": True, "t_rst_cycles": t_rst_cycles,
+              **({"margin": GROUP_ORDERS_MARGIN} if group_orders else {"depth": 8})}
     source = b"".join(path.read_bytes() for path in sorted((ROOT / "spec").glob("*.py")))
-    if group_orders:
-        kwargs["margin"] = GROUP_ORDERS_MARGIN
     key = hashlib.sha256(json.dumps([dmd.name, dclk_hz, kwargs, group_orders]).encode() + source).hexdigest()[:16]
     path = build_dir("plans") / f"{key}.json"
     with open(path.with_suffix(".lock"), "w") as lock:

@@ -379,9 +379,8 @@ class _Model:
 
     def exps_of(self, fi, g):
         p = self.p
-        if p.order == PlaneOrder.GROUPS:
-            return exponents(p.order, p.group_tables[g], self.res.shown[fi].depth, p.anchor)
-        return exponents(p.order, p.order_table, self.res.shown[fi].depth, p.anchor)
+        table = p.group_tables[g] if p.order == PlaneOrder.GROUPS else p.order_table
+        return exponents(p.order, table, self.res.shown[fi].depth, p.anchor)
 
     def enqueue(self, g, fi, j):
         """Queue the load of frame ``fi``'s display position ``j`` (None: clears) for group g."""
