@@ -204,7 +204,7 @@ SYSTEM_STATUS = [
     ("triggers_early", 32),    # triggers before the DLPC410 finished initialising
     ("pulses_late", 32),       # clocking pulses made after their time
     ("row_underruns", 32),     # row loads that waited for the store
-    ("frames_bad_depth", 32),  # frames offered with a bit depth outside 1..8
+    ("frames_bad_depth", 32),  # frames offered with a bit depth outside 1..8 or their order cannot show
     ("registers_applied", 32), # sequencer register sets taken by the sequencer
     ("registers_superseded", 32),  # register sets replaced by a newer one before the sequencer took them
     ("mac_good", 32),          # frames on the receive pins, by the MAC's verdict
@@ -336,7 +336,14 @@ def register_faults(wire, row_cycles, clear_row_cycles):
     ``group_offsets_keepable``: likewise each group's offset of :attr:`PlaneOrder.GROUPS
     <spec.registers.PlaneOrder.GROUPS>` (each is timed from the first pulses a trigger times at
     once), and group 0's is 0: its first pulse starts the frame (the trigger's latency, the
-    camera, ``sync_out``) and no group's comes before it."""
+    camera, ``sync_out``) and no group's comes before it.
+
+    ``order_table_permutation``, ``group_tables_permutation``: in :attr:`PlaneOrder.TABLE
+    <spec.registers.PlaneOrder.TABLE>` the order table, in :attr:`PlaneOrder.GROUPS
+    <spec.registers.PlaneOrder.GROUPS>` every one of the group tables (used by the reset mode or
+    not), names each weight exponent 0..7 once: a table that repeats a plane would show wrong
+    levels. A frame of fewer planes plays only if the first entries of each table in force name
+    its planes (the sequencer drops any other, and counts it)."""
     faults = {}
     for f, (_, wire_width) in zip(_registers.FIELDS, SEQUENCER, strict=True):
         if wire_width > f.bits:
@@ -352,14 +359,39 @@ def register_faults(wire, row_cycles, clear_row_cycles):
                                  & (wire["period"] < wire["lsb"]))
     faults["settle_keepable"] = wire["t_settle"] < _registers.MIN_SETTLE
     width = next(f.width for f in _registers.FIELDS if f.name == "group_offsets")
-    offsets = [(wire["group_offsets"] >> (width * g)) & ((1 << width) - 1) for g in range(_registers.MAX_GROUPS)]
+    offsets = [_bits(wire["group_offsets"], width * g, width) for g in range(_registers.MAX_GROUPS)]
     faults["group_offsets_even"] = _any([(o & 1) != 0 for o in offsets])
     faults["group_offsets_keepable"] = ((wire["order"] == _registers.PlaneOrder.GROUPS.value)
                                         & ((offsets[0] != 0) | _any([(o != 0) & (o < clear_row_cycles * row_cycles)
                                                                      for o in offsets[1:]])))
     faults["stagger_keepable"] = ((wire["reset_mode"] != _registers.ResetMode.GLOBAL.value) & (wire["stagger"] != 0)
                                   & (wire["stagger"] < clear_row_cycles * row_cycles))
+    faults["order_table_permutation"] = ((wire["order"] == _registers.PlaneOrder.TABLE.value)
+                                         & (_permutation(wire["order_table"], 0) == 0))
+    faults["group_tables_permutation"] = ((wire["order"] == _registers.PlaneOrder.GROUPS.value)
+                                          & (_all([_permutation(wire["group_tables"], g)
+                                                    for g in range(_registers.MAX_GROUPS)]) == 0))
     return faults
+
+
+def _permutation(tables, t):
+    """Whether table ``t`` of the packed order tables ``tables`` (eight 3-bit exponents each)
+    names every exponent 0..7 once: its eight entries differ pairwise."""
+    exps = [_bits(tables, 3 * (8 * t + j), 3) for j in range(8)]
+    return _all([exps[i] != exps[j] for i in range(8) for j in range(i)])
+
+
+def _bits(value, offset, width):
+    """``width`` bits of ``value`` (an int, or an Amaranth value: sliced, so that no logic as
+    wide as the whole value is formed) from bit ``offset``."""
+    try:
+        return (_operator.index(value) >> offset) & ((1 << width) - 1)
+    except TypeError:
+        return value[offset:offset + width]
+
+
+def _all(terms):
+    return _functools.reduce(_operator.and_, terms)
 
 
 def delta_faults(wire):

@@ -41,9 +41,12 @@ first pulse falls due at ``s + 2 + g * stagger`` (the frame control's decision t
 otherwise it is counted as an overrun. A pulse due at ``T`` is made on the first free even cycle
 from ``even(T)`` on, and counts as late when made after ``even(T)``.
 
-Frames: group 0 takes the next offered frame when its last pulse of a frame is made (else the
-frame repeats). Triggered and not chained, a frame offered while no group plays (every group
-has made its frame's last pulse) is taken at once: every group's first plane is loaded again
+Frames: the first group to move on from a frame takes the next offered frame when it makes its
+last pulse of the frame (else the frame repeats); the others take the same frame when they move
+on. In one timeline that group is group 0; in GROUPS it is whichever group ends its frame first
+(a group taking another frame than the one group 0 shows next would tear the frame).
+Triggered and not chained, a frame offered while no group plays (every group has made its
+frame's last pulse) is taken at once: every group's first plane is loaded again
 from it, no sooner than ``reload_lead`` cycles later (the store's first words), unless the
 triggers come at a steady pace and the next one is due before such a reload could end
 (:func:`reload_bound`): then the newer frame waits for the trigger after, and no trigger is
@@ -74,7 +77,7 @@ __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_en
            "plan", "bound", "paper_eq_rate_hz", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS",
            "flush_rows", "PAPER_SETTLE_CYCLES", "MIN_SETTLE", "RST_MARGIN",
            "FALL_LATENCY", "DECISION_TO_PINS", "PACE_LAG",
-           "even", "ready_cycle", "reload_bound", "reload_cycles", "on_time", "frame_period", "timeline"]
+           "even", "shows_depth", "ready_cycle", "reload_bound", "reload_cycles", "on_time", "frame_period", "timeline"]
 
 #: The ``dmd`` domain's clock: every cycle count of the model and the sequencer is in its cycles.
 #: DCLK is this (one beat per cycle) or twice this (two beats per cycle: 400 MHz through the
@@ -300,11 +303,25 @@ class _Group:
         self.pos = None           # ("plane", frame_index, j) or ("dark", frame_index, j)
 
 
+def shows_depth(p, depth, n_groups):
+    """Whether the plane order of ``p`` shows a frame of ``depth`` planes on ``n_groups`` groups:
+    1..8, and with an order table the first ``depth`` entries of every table in force (in
+    GROUPS, each group's, as :meth:`Params.registers` writes it) name exponents 0..depth-1 (a
+    frame the sequencer cannot show is dropped when offered, and counted)."""
+    if not 1 <= depth <= 8:
+        return False
+    tables = {PlaneOrder.TABLE: [p.order_table],
+              PlaneOrder.GROUPS: [list(t) + list(range(len(t), 8)) for t in p.group_tables[:n_groups]]}
+    return all(sorted(t[:depth]) == list(range(depth)) for t in tables.get(p.order, []))
+
+
 class _Frames:
     """The frames offered, in turn from their ``ready`` cycle (the store's answers), and the
-    frames taken (``shown``). A frame with a bad bit depth is dropped the cycle it is offered."""
+    frames taken (``shown``). A frame with a bit depth the order does not show
+    (:func:`shows_depth`) is dropped the cycle after it is offered."""
 
-    def __init__(self, frames, result):
+    def __init__(self, frames, result, p, n_groups):
+        self.p, self.n_groups = p, n_groups
         self.offered = list(frames)
         self.shown = result.shown
         self.result = result
@@ -313,15 +330,16 @@ class _Frames:
     def offer(self):
         """(bad frames before it, cycle the sequencer sees it from) of the next good frame, or
         None. The store offers it from its ``ready`` cycle (a bad one before it is dropped the
-        cycle it is offered); the sequencer sees an offer :data:`OFFER_LAG` cycles later. The time
-        base stands at 0 until the controller is initialised, so what is offered at 0 is offered
-        long before it runs: seen from 0, and a bad frame then dropped in no time."""
+        cycle after it is offered, the next offered the cycle after that); the sequencer sees an
+        offer :data:`OFFER_LAG` cycles later. The time base stands at 0 until the controller is
+        initialised, so what is offered at 0 is offered long before it runs: seen from 0, and a
+        bad frame then dropped in no time."""
         at = self.offer_from
         for k, f in enumerate(self.offered):
             at = max(at, f.ready)
-            if 1 <= f.depth <= 8:
+            if shows_depth(self.p, f.depth, self.n_groups):
                 return k, at + OFFER_LAG if at > 0 else 0
-            at += 1 if at > 0 else 0
+            at += 2 if at > 0 else 0
         return None
 
     def take(self, t, repeat=True):
@@ -355,12 +373,16 @@ class _Model:
         self.res.groups = self.st
         self.queue = []                     # loads: [group, ops, index]
         self.darks = []                     # dark clears, apart: [group, ops, index]
-        self.frames = _Frames([Frame(0, 1)] if p.source == Source.PRNG else frames, self.res)
+        self.frames = _Frames([Frame(0, 1)] if p.source == Source.PRNG else frames, self.res, p, self.G)
         self.strobes = sorted(strobes)
         self.si = 0                         # strobes handled
         self.next_row = 0
         self.rst_any = 0
         self.next_frame = None
+        # groups still showing the frame before ``next_frame``: the first group to move on to a
+        # new frame takes the one offered (in one timeline, group 0; in GROUPS, whichever ends
+        # its frame first), the others follow it
+        self.behind = set()
         self.queued_at = self.G + 2         # the first planes are queued one group a cycle
         self.bus_free = 0
         self.t = 0
@@ -401,19 +423,25 @@ class _Model:
         self.queue.append([g, ops, 0])
 
     def next_frame_for(self, g):
-        if g == 0:
+        """The frame group ``g`` moves on to: the one offered (or its own again) if it is the
+        first group to move on, else the one the first took."""
+        if g in self.behind:
+            self.behind.discard(g)
+        else:
             self.next_frame = self.frames.take(self.t)
+            self.behind = set(range(self.G)) - {g}
         return self.next_frame
 
     def follows(self, g, t):
         """Whether the frame after group ``g``'s frame starts without a trigger: chained, or that
-        frame follows (group 0: the one offered now, if any, else its own again; the others: the
-        one group 0 took); never after the last frame of a sequence played once."""
+        frame follows (the first group to move on: the one offered now, if any, else its own
+        again; the others: the one the first took); never after the last frame of a sequence
+        played once."""
         p, frame = self.p, self.res.shown[self.st[g].pos[1]]
         if frame.last:
             return False
         after = self.res.shown[self.next_frame]
-        nxt = self.frames.offer() if g == 0 and p.source != Source.PRNG else None
+        nxt = self.frames.offer() if g not in self.behind and p.source != Source.PRNG else None
         if nxt is not None and nxt[1] <= t:
             after = self.frames.offered[nxt[0]]
         return p.chain or after.follow
@@ -453,6 +481,7 @@ class _Model:
 
     def start(self):
         fi = self.next_frame = self.frames.take(self.t)
+        self.behind = set()
         for g in range(self.G):
             self.st[g].pos = ("plane", fi, 0)
             self.enqueue(g, fi, 0)
@@ -496,6 +525,7 @@ class _Model:
         stale loads still queued (their words are discarded for ``flush_rows`` row periods)."""
         wait = 0 if self.waiting(t) else flush_rows(self.dmd) * self.row_period
         fi = self.next_frame = self.frames.take(t, repeat=False)
+        self.behind = set()
         self.ended = False
         self.queued_at = t + max(wait, 1) + self.G + 1
         self.queue.clear()

@@ -1,6 +1,8 @@
 """The command bus alone (Amaranth simulator): a row load that waits for its data from the store
 is counted once, however many cycles it waits; rows whose data is there are not counted."""
 
+from amaranth import Cat
+
 from gateware.dlpc410.bus import Bus
 from gateware.dlpc410.interface import RowMode
 from sim.harness.amaranth_sim import simulate
@@ -49,3 +51,33 @@ def test_underruns_count_rows_not_cycles(test_name):
         assert ctx.get(dut.underruns) == len(starved)
 
     simulate(dut, [bench], name=test_name, deadline=1e-3)
+
+
+def test_lowest_due_and_its_flag(test_name):
+    """The pulse the bus chooses is the lowest due group, and ``lowest_due_has`` answers that
+    group's flag: against the lowest set bit, for random due and flag vectors (some all clear)."""
+    import random
+
+    from amaranth import Module, Signal
+
+    from gateware.dlpc410.bus import lowest_due, lowest_due_has
+
+    G = 16
+    due, flags = Signal(G), Signal(G)
+    fours = Signal(G // 4)
+    lowest, has = Signal(G), Signal()
+    m = Module()
+    m.d.comb += [fours.eq(Cat(due[q:q + 4].any() for q in range(0, G, 4))),
+                 lowest.eq(lowest_due(due, fours)), has.eq(lowest_due_has(due, fours, flags))]
+    rng = random.Random(3)
+    cases = [(0, rng.getrandbits(G))] + [(rng.getrandbits(G) & rng.getrandbits(G), rng.getrandbits(G))
+                                         for _ in range(3000)]
+
+    async def bench(ctx):
+        for d, f in cases:
+            ctx.set(due, d)
+            ctx.set(flags, f)
+            low = d & -d                       # the lowest set bit (0: none)
+            assert ctx.get(lowest) == low
+            assert ctx.get(has) == (1 if f & low else 0)
+    simulate(m, [bench], name=test_name, clocks={}, waves=False)

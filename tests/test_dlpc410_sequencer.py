@@ -144,6 +144,40 @@ def test_each_group_plays_its_own_order_from_its_own_offset(mode, tables, offset
 
 
 @pytest.mark.verilog
+@pytest.mark.parametrize("mode,order,tables,shows", [
+    (ResetMode.QUAD, PlaneOrder.TABLE, ((3, 7, 0, 5, 1, 6, 2, 4),), False),
+    (ResetMode.QUAD, PlaneOrder.TABLE, ((2, 0, 3, 1, 7, 4, 6, 5),), True),
+    (ResetMode.DUAL, PlaneOrder.GROUPS, ((3, 1, 0, 2, 7, 6, 5, 4), (7, 6, 5, 4, 3, 2, 1, 0)), False),
+    (ResetMode.DUAL, PlaneOrder.GROUPS, ((3, 1, 0, 2, 7, 6, 5, 4), (3, 2, 1, 0, 7, 6, 5, 4)), True),
+], ids=["table_drops", "table_shows", "groups_drop", "groups_show"])
+def test_frame_its_order_cannot_show_is_dropped(mode, order, tables, shows, test_name):
+    """A 4-plane frame between two 8-plane ones: shown when the first four entries of every
+    table in force name planes 0..3, else dropped when offered and counted (never shown with
+    planes beyond its own). Commands equal the model's, every grey level exact. In GROUPS the
+    second group ends the 4-plane frame before the first: it takes the next frame itself, and
+    the first follows it (a group that loaded the frame before again would tear the frame)."""
+    p = fast_plan(reset_mode=mode).params
+    if order == PlaneOrder.TABLE:
+        p = replace(p, order=order, order_table=tables[0])
+    else:
+        p = replace(p, order=order, group_tables=tables, group_offsets=(0, 156))
+    # each frame offered just after the trigger that starts the one before it
+    offered, pins = [], []
+    for slot, depth in [(0, 8), (1, 4), (0, 8)]:
+        offered.append((slot, depth, pins[-1] + PIN_TO_STROBE + 4 if pins else 0))
+        pins.append(next_ready(p, model_frames(offered, None), [t + PIN_TO_STROBE for t in pins]) - PIN_TO_STROBE)
+    # dropped, the 4-plane frame leaves the first frame to show again at the second trigger
+    shown = [(0, 8), (1, 4), (0, 8)] if shows else [(0, 8), (0, 8), (0, 8)]
+    run, model = check(p, shown, None, pins, test_name, offered=offered, extra=32 * p.lsb)
+    assert len(run.lights) == 3
+    assert run.status["bad_frames"] == model.bad_frames == (0 if shows else 1)
+    assert [(f.slot, f.depth) for f in model.shown] == (shown if shows else shown[::2])
+    if order == PlaneOrder.GROUPS and shows:
+        ends = [max(t for t, h, _, fi, _ in model.pulses if h == g and fi == 1) for g in range(2)]
+        assert ends[1] < ends[0]
+
+
+@pytest.mark.verilog
 @pytest.mark.parametrize("mode,order,anchor,first", [
     (ResetMode.GLOBAL, PlaneOrder.LSB_FIRST, 7, (7, 1)),   # the MSB plane first (the paper's anchor)
     (ResetMode.DUAL, PlaneOrder.MSB_FIRST, 3, (4, 2)),

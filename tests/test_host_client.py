@@ -428,6 +428,34 @@ def test_sequencer_record_refuses_what_the_projector_would_drop():
     assert head["type"] == records.RecordType.SEQUENCER and body == wire and rest == b""
 
 
+def test_order_tables_must_name_every_plane_once():
+    """TABLE's order table, and in GROUPS every group's table (used by the reset mode or not),
+    must name each exponent 0..7 once; 2,000 random tables against a sorted comparison."""
+    from spec import schedule
+    wire = records.register_wire(schedule.plan(TEST_DMD, 200e6).params.registers(TEST_DMD))
+    rng = np.random.default_rng(5)
+
+    def packed(tables):
+        return sum(int(e) << 3 * (8 * t + j) for t, table in enumerate(tables) for j, e in enumerate(table))
+    for _ in range(1000):
+        table = rng.permutation(8) if rng.random() < 0.5 else rng.integers(0, 8, 8)
+        bad = sorted(table) != list(range(8))
+        faults = records.register_faults({**wire, "order": PlaneOrder.TABLE.value,
+                                          "order_table": packed([table])}, 16, 1)
+        assert faults["order_table_permutation"] == bad
+        g = int(rng.integers(0, 16))
+        tables = [range(8)] * 16
+        tables[g] = table
+        faults = records.register_faults({**wire, "order": PlaneOrder.GROUPS.value,
+                                          "group_tables": packed(tables)}, 16, 1)
+        assert faults["group_tables_permutation"] == bad
+    # not checked in an order that does not read the table
+    repeats = packed([(7, 6, 5, 4, 3, 2, 1, 1)])
+    codec.sequencer_record({**wire, "order": PlaneOrder.MSB_FIRST.value, "order_table": repeats}, dmd=TEST_DMD)
+    with pytest.raises(ValueError, match="order_table_permutation"):
+        codec.sequencer_record({**wire, "order": PlaneOrder.TABLE.value, "order_table": repeats}, dmd=TEST_DMD)
+
+
 def test_a_periodic_trigger_faster_than_the_plans_frames_is_refused(projector, capsys):
     """A period the projector would take (at least one plane) but every frame of the planned
     depth outlasts: ``configure`` refuses it with the plan's trigger period, before sending."""

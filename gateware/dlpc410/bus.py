@@ -31,7 +31,28 @@ from ..registers import Registers, ResetMode
 from .interface import BlockMode, RowMode
 from .layouts import COUNTER_BITS, Command, dark_load, group_bits, ready_load
 
-__all__ = ["Bus", "DECISION_TO_PINS"]
+__all__ = ["Bus", "DECISION_TO_PINS", "lowest_due", "lowest_due_has"]
+
+
+def lowest_due(due, fours):
+    """The lowest due group, one-hot (the pulse the bus chooses, when it may pulse): from the
+    ``due`` flags and their ``fours`` (bit q: some flag of ``due[4q:4q + 4]``), so that no chain
+    runs over every flag."""
+    return Cat(due[g] & ~(due[g - g % 4:g].any() | fours[:g // 4].any()) for g in range(len(due)))
+
+
+def lowest_due_has(due, fours, flags):
+    """Whether the lowest due group (:func:`lowest_due`'s) has its bit of ``flags`` set: the
+    lowest due quad's answer, each quad's from its own four groups (a priority choice at each
+    level, so that the answer is two small choices deep, not a chain over every group)."""
+    def first(bits, values):                  # the value at the lowest set bit (0: none set)
+        out = 0
+        for bit, value in reversed(list(zip(bits, values, strict=True))):
+            out = Mux(bit, value, out)
+        return out
+    quads = [range(q, min(q + 4, len(due))) for q in range(0, len(due), 4)]
+    return first([fours[i] for i in range(len(quads))],
+                 [first([due[g] for g in quad], [flags[g] for g in quad]) for quad in quads])
 
 
 class Bus(wiring.Component):
@@ -140,9 +161,7 @@ class Bus(wiring.Component):
         pin_ok = ~(regs.strict_rst & self.rst_active)
         due, fours = self.due, self.due_fours
         P = Signal(G)
-        for g in range(G):
-            lower = due[g - g % 4:g].any() | fours[:g // 4].any()
-            m.d.comb += P[g].eq(free & pin_ok & due[g] & ~lower)
+        m.d.comb += P.eq(Mux(free & pin_ok, lowest_due(due, fours), 0))
         do_pulse = free & pin_ok & fours.any()
         m.d.comb += [self.choice.eq(P), self.pulsing.eq(do_pulse)]
 

@@ -71,7 +71,7 @@ class FrameControl(wiring.Component):
         No frame plays and no load is under way: before the first frame, or every group loaded
         and waiting for a trigger (as registered the cycle before, less this cycle's decisions).
     offer : In(:class:`~gateware.dlpc410.frame_offer.Offer`)
-        The frame the store offers (``valid`` unless group 0's take answers it now; a start or
+        The frame the store offers (``valid`` unless a group's take answers it now; a start or
         retake applied now is counted in here).
     playing, ended : In(1)
         From the planner.
@@ -202,7 +202,7 @@ class FrameControl(wiring.Component):
         # trigger is obeyed before every group is loaded again), and the settle times of the last
         # pulses still hold. With ``reload`` at rest, the same frame is loaded again under new
         # registers.
-        # (the offer is ``valid`` unless group 0's take answers it now; a start, restart or newer
+        # (the offer is ``valid`` unless a group's take answers it now; a start, restart or newer
         # frame's take applied now answers it too, and ends a sequence's ``ended``: neither is
         # counted in here, off the loop from the decisions applied to the next, as no frame is
         # taken or trigger obeyed then: a start or restart leaves ``run`` low, every take leaves

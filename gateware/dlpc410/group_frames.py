@@ -1,9 +1,10 @@
 """The frame each pulse group shows: its slot, bit depth, lowest stored plane and entry settings,
 and the newest frame taken, which a group takes next.
 
-Group 0 takes the frame offered (``take``) when it moves on to a new frame; the others take the
-newest one taken when they move on (``advance``); a start or a retake gives every group, and the
-next frame, one frame (``every``).
+The first group to move on to a new frame takes the frame offered (``take``; in one timeline
+group 0, in GROUPS whichever ends its frame first); the others take the newest one taken when
+they move on (``advance``); a start or a retake gives every group, and the next frame, one frame
+(``every``).
 """
 
 from amaranth import Module, Mux, Signal

@@ -28,6 +28,7 @@ from spec.schedule import row_cycles
 from ..counter import Counter
 from ..registers import LSB_BITS, Registers, Source
 from ..store.layouts import SLOT_BITS, FrameInfo, Showing
+from .bus import lowest_due_has
 from .frame_offer import FrameOffer, Offer
 from .group_frames import GroupFrames
 from .group_times import GroupTimes
@@ -71,12 +72,15 @@ class Planner(wiring.Component):
         Bit g: group g is one of the reset mode's.
     rst_active : In(1)
         RST_ACTIVE, synchronised.
+    reload : In(1)
+        The registers change in this cycle.
     frames : In(stream.Signature(FrameInfo))
-        The newest complete frame. A bit depth outside 1..8 is dropped when offered, and counted.
+        The newest complete frame. A bit depth outside 1..8, or one the plane order cannot show,
+        is dropped when offered, and counted.
         A frame taken is answered (``ready``) the cycle after it was taken.
     offer : Out(Offer)
         The frame offered, as the store offered it the cycle before
-        (:data:`spec.schedule.OFFER_LAG`), for the frame control: ``valid`` unless group 0's take
+        (:data:`spec.schedule.OFFER_LAG`), for the frame control: ``valid`` unless a group's take
         of it is answered now (a start or retake the frame control applies now is its own to
         count in).
     choice : In(blocks)
@@ -140,9 +144,10 @@ class Planner(wiring.Component):
         (or is about to).
 
     A frame's entry (:class:`~gateware.store.layouts.Showing`) sets its least significant
-    plane's time, and for the frame after it (group 0: the one offered, if any, else its own
-    again; the others: the one group 0 took) whether it follows without a trigger, after at
-    least its dark time; the last frame of a sequence played once is followed by nothing.
+    plane's time, and for the frame after it (the first group to move on: the one offered, if
+    any, else its own again; the others: the one it took) whether it follows without a trigger,
+    after at least its dark time; the last frame of a sequence played once is followed by
+    nothing.
     """
 
     def __init__(self, dmd, *, beats=1):
@@ -153,6 +158,7 @@ class Planner(wiring.Component):
             "regs": In(Registers),
             "active": In(G),
             "rst_active": In(1),
+            "reload": In(1),
             "frames": In(stream.Signature(FrameInfo)),
             "offer": Out(Offer),
             "choice": In(G),
@@ -214,10 +220,11 @@ class Planner(wiring.Component):
         m.d.comb += [self.depth.eq(first.depth),
                      self.lsb.eq(Mux(first.showing.lsb != 0, first.showing.lsb, regs.lsb))]
 
-        # ---- the frame offered: taken by group 0 (last cycle), or by a start or retake now ----
-        m.submodules.offers = offers = FrameOffer()
+        # ---- the frame offered: taken by a group (last cycle), or by a start or retake now ----
+        m.submodules.offers = offers = FrameOffer(G)
         wiring.connect(m, wiring.flipped(self.frames), offers.frames)
-        taking = Signal()                      # group 0 took the offered frame last cycle
+        m.d.comb += [offers.regs.eq(regs), offers.active.eq(active), offers.reload.eq(self.reload)]
+        taking = Signal()                      # a group took the offered frame last cycle
         m.d.comb += [offers.answered.eq(taking | (self.start.valid & self.start.payload.take)
                                         | (self.retake.valid & self.retake.payload.newer)),
                      self.offer.eq(offers.offer), self.offer.valid.eq(offers.held & ~taking),
@@ -229,7 +236,13 @@ class Planner(wiring.Component):
         # ---- the decision: what the pulse the bus chooses does (registered) ----
         P = self.choice
         usable = offers.offer.valid & ~use_prng
-        hidden, final, takes_offered = self._outcomes(m, info, frames, dark, usable)
+        # groups still showing the frame before the newest taken: the first group to move on
+        # to a new frame takes the one offered (in one timeline group 0; in GROUPS whichever
+        # ends its frame first), the others follow it (registered: pulses are decided at least
+        # two cycles apart, so a move applied now is counted in by the next decision)
+        behind = Signal(G)
+        hidden, final, (takes_at_dark, takes_hiding, takes_followed) = self._outcomes(
+            m, info, frames, dark, usable, ~behind)
         decided = Signal(G)                    # the pulse decided last cycle, applied now
         decided_any = Signal()
         moves, ends_play, take, starts, camera, ends_seq, late_now = (
@@ -240,7 +253,11 @@ class Planner(wiring.Component):
             # (read only with ``decided``: no need to wait for the choice)
             moves.eq(dark | hidden),
             ends_play.eq(P & final),
-            take.eq(P[0] & usable & takes_offered),
+            # (the bus pulses the lowest due group: whether that group takes is asked of the due
+            # flags themselves, the bus's gating added last, a shallower path than through P)
+            take.eq(self.pulsing & usable & (lowest_due_has(self.due, self.due_fours, takes_at_dark)
+                                             | (lowest_due_has(self.due, self.due_fours, takes_hiding)
+                                                & takes_followed))),
             starts.eq(P[0] & first_plane),
             camera.eq(P[0] & first_plane & ~first.showing.camera_off),
             ends_seq.eq(P[0] & first_plane & first.showing.last),
@@ -264,6 +281,12 @@ class Planner(wiring.Component):
                     m.d.comb += frames.advance[g].eq(info.last[g])
                 with m.Else():
                     m.d.sync += dark[g].eq(1)
+        # (from registered flags: the group moving on now, whether it leads; its plane
+        # information is the decision's still)
+        ends_frame = decided & moves & info.last
+        led = (ends_frame & ~behind).any()
+        for g in range(G):
+            m.d.sync += behind[g].eq(~every.valid & ~ends_frame[g] & Mux(led, active[g], behind[g]))
         m.submodules.started = started = Counter(COUNTER_BITS)
         m.submodules.late_count = late_count = Counter(COUNTER_BITS)
         was_late = Signal()                    # (counted a cycle later)
@@ -359,23 +382,24 @@ class Planner(wiring.Component):
                              & Mux(self.lead_over & ~self.retake.valid, (1 << G) - 1, 0)),
         ]
 
-    def _outcomes(self, m, info, frames, dark, usable):
+    def _outcomes(self, m, info, frames, dark, usable, first):
         """What each group's next pulse does: ``hidden`` (bit g: it shows a plane and the next
         one is loaded behind it), ``final`` (bit g: its dark pulse ends the group's play), and
-        ``takes_offered`` (group 0's pulse takes the frame offered, if ``usable``)."""
+        whether it takes the frame offered, if ``usable`` (it is the ``first`` group to move on
+        to a new frame): bit g of the first of ``(at_dark, hiding, followed)`` at its frame's
+        last dark pulse, of the second at a last plane that hides the next frame's first if the
+        frame offered follows (the third, one bit: it does)."""
         regs, G = self.regs, self._dmd.blocks
         offered_follow = self.offer.showing.follow
-        hidden, final = Signal(G), Signal(G)
+        hidden, final, takes_at_dark, takes_hiding = Signal(G), Signal(G), Signal(G), Signal(G)
         for g in range(G):
-            # the frame after this one starts without a trigger: chained, or it follows (group 0
-            # takes the one offered, if any); never after a sequence's last frame
+            # the frame after this one starts without a trigger: chained, or it follows (the
+            # first group to move on takes the one offered, if any); never after a sequence's
+            # last frame
             ends_sequence = frames.frame[g].showing.last
             follows_next = (regs.chain | frames.next.showing.follow) & ~ends_sequence
-            if g == 0:
-                follows_offered = (regs.chain | offered_follow) & ~ends_sequence
-                follow = Mux(usable, follows_offered, follows_next)
-            else:
-                follow = follows_next
+            follows_offered = (regs.chain | offered_follow) & ~ends_sequence
+            follow = Mux(usable & first[g], follows_offered, follows_next)
             # the next plane is loaded behind this one; at a frame's end only if the frame after
             # follows and this one wants no dark time
             m.d.comb += [
@@ -383,8 +407,13 @@ class Planner(wiring.Component):
                              | (~dark[g] & info.big[g] & info.keeps_dark[g] & follow)),
                 final[g].eq(dark[g] & info.last[g] & ~follow),
             ]
-        # group 0 takes the frame offered at its frame's last pulse, dark or hiding the next
-        # (which, being the offered frame's first plane, follows as the offered frame says)
-        takes_offered = info.last[0] & (dark[0] | (info.big[0] & info.keeps_dark[0] & ~frames.frame[0].showing.last
-                                                    & (regs.chain | offered_follow)))
-        return hidden, final, takes_offered
+            # the first group takes the frame offered at its frame's last pulse, dark or hiding
+            # the next (which, being the offered frame's first plane, follows as the offered
+            # frame says). The group's own flags are registered: they change only when it
+            # pulses, and it pulses again only once its plane information is fresh, a cycle
+            # after which they are too (``first`` changes as the others move on: not registered)
+            at_dark, may_hide = Signal(name=f"takes_dark{g}"), Signal(name=f"takes_hiding{g}")
+            m.d.sync += [at_dark.eq(info.last[g] & dark[g]),
+                         may_hide.eq(info.last[g] & info.big[g] & info.keeps_dark[g] & ~ends_sequence)]
+            m.d.comb += [takes_at_dark[g].eq(first[g] & at_dark), takes_hiding[g].eq(first[g] & may_hide)]
+        return hidden, final, (takes_at_dark, takes_hiding, regs.chain | offered_follow)

@@ -70,6 +70,12 @@ def sequencer_record(sequence=0, **changes):
     return codec.sequencer_record({**GOOD_WIRE, **changes}, sequence)
 
 
+def _packed(tables):
+    """Order tables of eight exponents as the record carries them: entry j of table t in bits
+    3(8t + j) up."""
+    return sum(e << 3 * (8 * t + j) for t, table in enumerate(tables) for j, e in enumerate(table))
+
+
 #: Sequencer records the sequencer could not obey: ``name -> changes to a good set``.
 BAD_REGISTERS = {
     "lsb_odd": {"lsb": GOOD_WIRE["lsb"] + 1},
@@ -77,6 +83,9 @@ BAD_REGISTERS = {
     "order_too_wide": {"order": 4},
     "group_offset_odd": {"group_offsets": 3 << 24},
     "group_zero_offset": {"order": 3, "group_offsets": 4},
+    # a plane named twice in the order table; in the last group's table (the others name 0..7)
+    "order_table_repeats": {"order": 2, "order_table": _packed([(7, 6, 5, 4, 3, 2, 1, 1)])},
+    "group_table_repeats": {"order": 3, "group_tables": _packed([range(8)] * 15 + [(0, 1, 2, 3, 4, 5, 6, 0)])},
     "reset_mode_too_wide": {"reset_mode": 4},
     "chain_not_a_bit": {"chain": 2},
     "stagger_odd": {"stagger": 3},
