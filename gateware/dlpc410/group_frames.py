@@ -42,7 +42,14 @@ class GroupFrames(wiring.Component):
     coming : Out(FRAME)
         The frame a group moving on now takes: the one offered if it is taken, else ``next``.
     advance : In(blocks)
-        Bit g: group g moves on to ``coming``.
+        Bit g: group g moves on to ``coming`` (from registered flags: its plane information is
+        still the decision's).
+    active : In(blocks)
+        Bit g: group g is one of the reset mode's.
+    first : Out(blocks)
+        Bit g: no group has moved on from the frame group g shows: it is the first to, and takes
+        the frame offered (registered: pulses are decided at least two cycles apart, so a move
+        applied now is counted in by the next decision).
     every : In(event(FRAME))
         Every group, and the next frame, take this frame (after ``advance`` and ``take``).
     """
@@ -57,6 +64,8 @@ class GroupFrames(wiring.Component):
             "take": In(1),
             "coming": Out(FRAME),
             "advance": In(G),
+            "active": In(G),
+            "first": Out(G),
             "every": In(event(FRAME)),
         })
 
@@ -76,6 +85,12 @@ class GroupFrames(wiring.Component):
                 m.d.sync += give(g, self.coming)
         with m.If(self.take):
             m.d.sync += next_frame.eq(self.offered)
+        # groups still showing the frame before ``next``: set for the others when one leads
+        behind = Signal(G)
+        led = (self.advance & ~behind).any()
+        m.d.comb += self.first.eq(~behind)
+        for g in range(G):
+            m.d.sync += behind[g].eq(~self.every.valid & ~self.advance[g] & Mux(led, self.active[g], behind[g]))
         with m.If(self.every.valid):
             m.d.sync += next_frame.eq(self.every.payload)
             for g in range(G):

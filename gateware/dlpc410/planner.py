@@ -205,6 +205,7 @@ class Planner(wiring.Component):
         pending, loaded, dark = self.pending, self.holds, Signal(G)
         pos = [Signal(3, name=f"pos{g}") for g in range(G)]
         m.submodules.frames = frames = GroupFrames(dmd)
+        m.d.comb += frames.active.eq(active)
         m.submodules.info = info = PlaneInfo(dmd)
         m.submodules.times = times = GroupTimes(dmd, soon=R, soon_clear=dmd.clear_row_cycles * R)
         m.submodules.reset_watch = watch = ResetWatch(dmd)
@@ -236,13 +237,9 @@ class Planner(wiring.Component):
         # ---- the decision: what the pulse the bus chooses does (registered) ----
         P = self.choice
         usable = offers.offer.valid & ~use_prng
-        # groups still showing the frame before the newest taken: the first group to move on
-        # to a new frame takes the one offered (in one timeline group 0; in GROUPS whichever
-        # ends its frame first), the others follow it (registered: pulses are decided at least
-        # two cycles apart, so a move applied now is counted in by the next decision)
-        behind = Signal(G)
+        # (the first group to move on to a new frame takes the one offered: ``frames.first``)
         hidden, final, (takes_at_dark, takes_hiding, takes_followed) = self._outcomes(
-            m, info, frames, dark, usable, ~behind)
+            m, info, frames, dark, usable, frames.first)
         decided = Signal(G)                    # the pulse decided last cycle, applied now
         decided_any = Signal()
         moves, ends_play, take, starts, camera, ends_seq, late_now = (
@@ -281,12 +278,6 @@ class Planner(wiring.Component):
                     m.d.comb += frames.advance[g].eq(info.last[g])
                 with m.Else():
                     m.d.sync += dark[g].eq(1)
-        # (from registered flags: the group moving on now, whether it leads; its plane
-        # information is the decision's still)
-        ends_frame = decided & moves & info.last
-        led = (ends_frame & ~behind).any()
-        for g in range(G):
-            m.d.sync += behind[g].eq(~every.valid & ~ends_frame[g] & Mux(led, active[g], behind[g]))
         m.submodules.started = started = Counter(COUNTER_BITS)
         m.submodules.late_count = late_count = Counter(COUNTER_BITS)
         was_late = Signal()                    # (counted a cycle later)
