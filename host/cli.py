@@ -63,6 +63,8 @@ def _plan(args):
     common = dict(depth=args.depth, exposure_s=args.exposure, words_per_cycle=args.read_rate,
                   t_rst_cycles=_t_rst(args), reading=args.settle_reading, anchor=args.anchor,
                   strict_rst=args.rst_active == "strict")
+    if args.chained and not args.group_orders:
+        raise ClientError("--chained plans with --group-orders")
     if args.group_orders:
         plan = _group_orders(dmd, args, common)
     elif args.best:
@@ -102,7 +104,8 @@ def _group_orders(dmd, args, common):
                           f"the order's start: not with {', '.join(k for k, v in given.items() if v)}")
     try:
         found = group_orders.find(dmd, args.dclk, ResetMode[args.reset_mode], seconds=args.group_orders,
-                                  words_per_cycle=common["words_per_cycle"], t_rst_cycles=common["t_rst_cycles"])
+                                  chained=args.chained, words_per_cycle=common["words_per_cycle"],
+                                  t_rst_cycles=common["t_rst_cycles"])
     except ImportError:
         raise ClientError("--group-orders needs the constraint solver: pip install 'dmd-projector[solver]'") from None
     if found is None:
@@ -191,6 +194,10 @@ def main(argv=None):
                            help="search this long with a constraint solver for a plan of --reset-mode's groups each "
                                 "in a plane order of its own, from an offset of its own (faster than one order "
                                 "for every group; 8-bit frames; needs the 'solver' extra; docs/bounds.md)")
+    configure.add_argument("--chained", action="store_true",
+                           help="with --group-orders: every frame follows the one before without a trigger, each "
+                                "group starting its next frame as it ends its own (a stored sequence played back "
+                                "to back; faster still: no group waits for the last to be loaded again)")
     configure.add_argument("--order", default="MSB_FIRST", choices=list(plan_search.ORDER_NAMES),
                            help="plane order; INTERLEAVED: each short plane behind a long one (7 1 6 2 5 3 4 0)")
     configure.add_argument("--anchor", type=int, default=0, choices=range(8),

@@ -60,7 +60,8 @@ class GroupPlan:
     """A plan: each group's offset and plane order (weight exponents in display order), the
     frame (frames back to back), the start of each group's loads (one per plane, in display
     order) and of its clears (one per dark pulse but the frame's last), and the solver's proven
-    lower bound on the frame."""
+    lower bound on the frame; ``chained``: each group's next frame follows its own (else every
+    group's first pulse is its offset after a trigger that comes once every group is loaded)."""
     terms: Terms
     frame: int
     offsets: list
@@ -68,6 +69,7 @@ class GroupPlan:
     loads: list
     clears: list
     lower: int
+    chained: bool = False
 
     @property
     def rate_hz(self):
@@ -106,12 +108,14 @@ def sequencer_terms(dmd, dclk_hz, reset_mode, *, margin=0, **plan_kwargs):
     return t, base
 
 
-def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0):
+def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
     """The fastest plan the solver finds within ``seconds`` (below ``limit`` frame cycles), or
     None. Each load may begin anywhere in its window (a scheduler by deadline could serve it so;
     the sequencer's queue serves loads in the order of the pulses that freed them). The search
     is parallel (``workers``): what it finds in a given time may differ from run to run; its
-    lower bound is proved."""
+    lower bound is proved. ``chained``: each group's next frame follows its own, a dark gap after
+    its last dark pulse (the frame is a group's span); the solver then keeps the groups' offsets
+    as close as it can (the spread, by which frames overlap)."""
     from ortools.sat.python import cp_model
 
     m = cp_model.CpModel()
@@ -156,7 +160,13 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0):
         final = var(f"final{g}", 0, 2 * H)               # the frame's last dark pulse
         m.add(final == end - t.reload).only_enforce_if(last_dark)
         m.add(final == end).only_enforce_if(~last_dark)
-        m.add(F >= final + t.reload)
+        # the next frame: triggered, every group's first pulse its offset after the trigger,
+        # which comes once every group is loaded again; chained, each group's own frame after
+        # its own (a frame of every group's span)
+        if chained:
+            m.add(F == final + t.reload - o)
+        else:
+            m.add(F >= final + t.reload)
         loads, clears = [], []
         for e in range(N):
             m.add(s[e] == o).only_enforce_if(x[N, e])
@@ -175,7 +185,13 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0):
             m.add(before == final - F).only_enforce_if(x[N, e])
             ld = var(f"l{g}.{e}", -H, H)
             m.add(ld >= before + frozen)
-            m.add(ld + t.load + t.slack <= s[e])
+            done = m.add(ld + t.load + t.slack <= s[e])
+            if chained:
+                # the first plane's load, in the dark gap after the group's own frame before:
+                # the slack that gap leaves (the sequencer's dark gap covers one load and its
+                # own slack), not the one a load behind a plane keeps
+                done.only_enforce_if(~x[N, e])
+                m.add(ld + t.reload - frozen <= s[e]).only_enforce_if(x[N, e])
             on_bus(ld, t.load, f"l{g}.{e}")
             loads.append(ld)
             if dark[e]:
@@ -196,7 +212,14 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0):
         keep.append((o, s, loads, clears, c))
     m.add_no_overlap(rst)
     m.add_no_overlap(bus)
-    m.minimize(F)
+    if chained:
+        # the frame is each group's span (the shortest: the last plane a dark one); then the
+        # spread of the groups' offsets, by which a group's next frame overlaps another's this one
+        spread = var("spread", 0, H)
+        m.add_max_equality(spread, [o for o, *_ in keep])
+        m.minimize(F * (H + 1) + spread)
+    else:
+        m.minimize(F)
     solver = cp_model.CpSolver()
     solver.parameters.max_time_in_seconds = seconds
     solver.parameters.num_workers = workers
@@ -213,36 +236,54 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0):
         cl = {e: v(ce) for e, ce in clears}
         # clears in dark-pulse order, the frame's last dark pulse's last
         all_clears.append([cl[e] for e in order[:-1] if e in cl] + [cl.get(order[-1], v(c))])
-    return GroupPlan(t, v(F), offsets, orders, all_loads, all_clears, math.ceil(solver.best_objective_bound))
+    # (chained, the objective bounds the frame in its high part)
+    lower = math.ceil(solver.best_objective_bound)
+    lower = lower // (H + 1) if chained else lower
+    return GroupPlan(t, v(F), offsets, orders, all_loads, all_clears, lower, chained)
 
 
-def find(dmd, dclk_hz, reset_mode, *, seconds=60.0, workers=2, extra_rows=4, margin=0, **plan_kwargs):
+def find(dmd, dclk_hz, reset_mode, *, seconds=60.0, workers=2, extra_rows=4, margin=0, chained=False,
+         attempts=4, **plan_kwargs):
     """The fastest plan of groups in orders of their own the solver finds within ``seconds``
     under the sequencer's terms (:func:`sequencer_terms`; ``plan_kwargs`` as
     :func:`spec.schedule.plan`'s), that the schedule model's sequencer plays with no pulse late:
     (:class:`spec.schedule.Plan` of :attr:`~spec.registers.PlaneOrder.GROUPS`, its
     :class:`GroupPlan`), or None. At the settle path's LSB a dark pulse's clears may find no cycle
     to wait for a row under way (the model loads as soon as it can): the LSB then takes a row
-    cycle more, up to ``extra_rows``. ``margin``: as :func:`sequencer_terms`'s."""
+    cycle more, up to ``extra_rows``. ``margin``: as :func:`sequencer_terms`'s. ``chained``: each
+    frame follows the one before without a trigger (:attr:`~spec.schedule.Params.chain`), each
+    group its own frame after its own; the solver's loads may be placed where the sequencer's
+    queue would not put them, so up to ``attempts`` searches (seeds) at each LSB."""
     seq_terms, base = sequencer_terms(dmd, dclk_hz, reset_mode, margin=margin, **plan_kwargs)
+    if chained:
+        base = replace(base, params=replace(base.params, chain=True))
     for extra in range(extra_rows + 1):
         t = replace(seq_terms, lsb=seq_terms.lsb + extra * seq_terms.row)
-        found = solve(t, seconds=seconds, workers=workers)
-        if found is not None:
+        for seed in range(attempts if chained else 1):
+            found = solve(t, seconds=seconds, workers=workers, seed=seed, chained=chained)
+            if found is None:
+                break
             plan = played(dmd, base, t.lsb, found.orders, found.offsets)
             if plan is not None:
                 return plan, found
     return None
 
 
+#: Frames a chained plan is played for by :func:`played` (the first ones start from a trigger).
+CHAINED_FRAMES = 6
+
+
 def played(dmd, base, lsb, orders, offsets):
     """``base`` (a :func:`sequencer_terms` plan) with each group's order and offset, at ``lsb``, as
-    the schedule model's sequencer plays it from a trigger: the :class:`spec.schedule.Plan` (its
-    trigger-to-trigger period), or None if a pulse comes late."""
+    the schedule model's sequencer plays it from a trigger (chained: :data:`CHAINED_FRAMES`
+    frames, each after the one before): the :class:`spec.schedule.Plan` (its trigger-to-trigger
+    period, or chained its frame period), or None if a pulse comes late."""
     p = replace(base.params, lsb=lsb, order=PlaneOrder.GROUPS, group_tables=tuple(map(tuple, orders)),
                 group_offsets=tuple(offsets))
     frame = schedule.Frame(0, len(orders[0]))
-    if schedule.simulate(dmd, p, [frame], [schedule.ready_cycle(dmd, p, frame)]).late:
+    n = CHAINED_FRAMES if p.chain else 1
+    if schedule.simulate(dmd, p, [frame] * n, [schedule.ready_cycle(dmd, p, frame)], max_frames=n - 1 or None).late:
         return None
+    kind = "the solver's, chained" if p.chain else "the solver's"
     return replace(base, params=p, frame_cycles=schedule.frame_period(dmd, p, frame),
-                   binds=f"groups in plane orders of their own (the solver's), LSB {lsb}")
+                   binds=f"groups in plane orders of their own ({kind}), LSB {lsb}")

@@ -32,7 +32,8 @@ The command bus makes one decision every even cycle on which no row cycle is run
 DLPC410 runs at DCLK/2, so gaps are even): a pulse whose time has come and whose group is
 loaded, if the RST_ACTIVE rule allows it (strict: ``t_rst`` after any pulse; otherwise after the
 same group's); else the oldest dark pulse's next clear if its group's settle time is over, or
-else the next load operation, if its group's settle time is over and the row pacing allows it;
+else the next load operation, if its group's settle time is over, the row pacing allows it and
+the oldest dark pulse's group's memory does not free before it ends (its clears would wait);
 each only if no loaded pulse falls due before the operation ends; else nothing. A pulse that
 cannot be made on time is made late and counted (the plan below never lets that happen).
 
@@ -145,6 +146,11 @@ FALL_LATENCY = 2
 #: synchroniser; ``t_rst`` must cover the pin's high time plus this.
 RST_MARGIN = DECISION_TO_PINS + 1 + FALL_LATENCY
 
+#: A load operation waits for the oldest dark pulse's clears only from this many cycles after
+#: that group's RST_ACTIVE count ends (the sequencer's settle countdown starts as it ends, and
+#: its flags are registered twice on their way to the bus).
+CLEAR_HOLD_AFTER_RST = 4
+
 #: A trigger's pace reaches the frame control's newer-frame guard this many cycles after the
 #: trigger (the guard's thresholds, the interval plus an eighth and the interval less
 #: :func:`reload_bound`, are summed in a pipeline of the gateware).
@@ -250,6 +256,7 @@ class Result:
     held: int = 0                # triggers held until every group was ready
     ended: int = 0               # triggers ignored after a sequence played once had ended
     bad_frames: int = 0
+    loads_held: int = 0          # decisions at which a load operation waited for a dark's clears
     accepted: list = field(default_factory=list)   # cycles triggers were obeyed (strobe or held)
     frame_starts: list = field(default_factory=list)
     camera_starts: list = field(default_factory=list)  # frame starts whose frame pulses the camera
@@ -575,8 +582,9 @@ class _Model:
 
     def decide(self, t):
         """The bus's decision at an even free cycle: a due pulse, else the next clear of the
-        oldest dark pulse's group once its memory may change, else the next load operation, else
-        nothing. Returns True when a pulse was made."""
+        oldest dark pulse's group once its memory may change, else the next load operation
+        (unless it would hold up those clears: :meth:`clears_soon`), else nothing. Returns True
+        when a pulse was made."""
         p, st, res, R = self.p, self.st, self.res, self.R
         rst_ok = [t - (self.rst_any if p.strict_rst else st[g].rst_free) >= 0 for g in range(self.G)]
         due = [g for g in range(self.G) if st[g].pending and st[g].loaded_at is not None
@@ -608,7 +616,9 @@ class _Model:
             length = R if op == "row" else self.dmd.clear_row_cycles * R
             imminent = any(st[h].pending and st[h].loaded_at is not None and st[h].loaded_at <= t
                            and even(st[h].pulse_at) < t + length for h in range(self.G))
-            if t >= st[g].writable and not imminent and (op != "row" or t >= self.next_row):
+            held = queue is self.queue and self.clears_soon(t, length)
+            res.loads_held += held and t >= st[g].writable and not imminent
+            if t >= st[g].writable and not imminent and not held and (op != "row" or t >= self.next_row):
                 res.commands.append((t, op, arg))
                 for k in range(1, self.dmd.clear_row_cycles if op == "clear" else 1):
                     res.commands.append((t + k * R, "noop", None))
@@ -620,6 +630,15 @@ class _Model:
                     queue.pop(0)
                     st[g].loaded_at = t + length
         return False
+
+    def clears_soon(self, t, length):
+        """A load operation of ``length`` cycles decided at ``t`` would hold up the oldest dark
+        pulse's clears: that group's RST_ACTIVE count is over and its memory frees before the
+        operation ends (the clears' deadline is the shortest plane's, a load's is a long one's)."""
+        if not self.darks:
+            return False
+        s = self.st[self.darks[0][0]]
+        return t >= s.rst_free + CLEAR_HOLD_AFTER_RST and s.writable <= t + length - 2
 
     # -- time --------------------------------------------------------------------------------
 

@@ -12,11 +12,12 @@ import pytest
 
 from gateware.dlpc410.trigger import PIN_TO_STROBE
 from sim.models import bitplane
+from sim.models.camera import Camera
 from sim.models.dlpc410 import RULES, RuleBreak
 from sim.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
-from sim.tb.seq_sim import INIT_CYCLES, dlpc410_for, frame_lights, run_bench
-from spec import prng, schedule
+from sim.tb.seq_sim import CAMERA_DELAY, CAMERA_RAMP, INIT_CYCLES, dlpc410_for, frame_lights, run_bench
+from spec import group_orders, prng, schedule
 from spec.facts import TEST_DMD, TEST_DMD4, TEST_DMD4_400, TEST_DMD_400
 from spec.registers import PlaneOrder, ResetMode, Source, TriggerMode
 
@@ -230,6 +231,67 @@ def test_two_beats_per_cycle(dmd, mode, order, store_words, test_name):
         pins.append(next_ready(p, model_frames(offered, images, dmd), strobes, dmd) - PIN_TO_STROBE)
     run, _ = check(p, frames, images, pins, test_name, offered=offered, dmd=dmd, store_words=store_words)
     assert len(run.lights) == 2
+
+
+@pytest.mark.verilog
+def test_a_load_row_waits_for_a_dark_pulses_clears(test_name, monkeypatch):
+    """A row of a load is not started when the oldest dark pulse's group's memory frees before
+    the row would end: the clears go first (their deadline is the shortest plane's). Two groups
+    in orders of their own at the settle path's LSB, whose clears have no cycle to spare, on a
+    DMD of four cycles a row cycle: with the rule the model plays the frames with no pulse late,
+    a row held back at least once, and the gateware's commands are the model's cycle for cycle,
+    every level exact; without it (rows served as soon as they may) a pulse comes late."""
+    dmd = TEST_DMD_400                                          # at 200 MHz: four cycles a row
+    plan = fast_plan(dmd, reset_mode=ResetMode.DUAL, trigger_hold=True)
+    p = plan.params
+    R = schedule.row_cycles(dmd, 1)
+    settle_path = p.t_rst + p.t_settle + 2 * dmd.clear_row_cycles * R      # two blocks a group
+    p = replace(p, lsb=settle_path, dark_gap=p.hide, order=PlaneOrder.GROUPS,
+                group_tables=((2, 4, 3, 7, 1, 5, 0, 6), (7, 5, 3, 1, 4, 6, 2, 0)), group_offsets=(0, 362))
+    frames = [(0, 8), (1, 8)]
+    offered, pins = [], []
+    for slot, depth in frames:
+        offered.append((slot, depth, pins[-1] + PIN_TO_STROBE + 4 if pins else 0))
+        pins.append(next_ready(p, model_frames(offered, None, dmd), [t + PIN_TO_STROBE for t in pins], dmd)
+                    - PIN_TO_STROBE)
+    run, model = check(p, frames, None, pins, test_name, offered=offered, dmd=dmd)
+    assert len(run.lights) == 2 and model.loads_held > 0
+    strobes = [t + PIN_TO_STROBE for t in pins]
+    monkeypatch.setattr(schedule._Model, "clears_soon", lambda self, t, length: False)
+    assert schedule.simulate(dmd, p, model_frames(offered, None, dmd), strobes).late > 0
+
+
+@pytest.mark.verilog
+def test_chained_groups_each_start_their_next_frame_as_they_end_their_own(test_name):
+    """Chained frames of groups in orders of their own (the plan finder's, at TI's times): one
+    trigger, then each group starts its next frame a dark gap after its own last dark pulse
+    (read from the pins, written out here from the plane times), the commands the model's cycle
+    for cycle, the rule model silent; over one period, from a frame's first pulse to the
+    next's, every group's light is its frame's, every level exact."""
+    plan, _ = group_orders.find(DMD, 200e6, ResetMode.SINGLE, seconds=3, chained=True, trigger_hold=True)
+    p = plan.params
+    frame = schedule.Frame(0, 8)
+    ready = next_ready(p, [frame], [])
+    cycles = ready + 4 * plan.frame_cycles
+    model = schedule.simulate(DMD, p, [frame], [ready + PIN_TO_STROBE], until=cycles)
+    run = run_rig(DMD, p, [(0, 8)], None, pins=[ready], cycles=cycles, name=test_name)
+    commands = same_commands(run, model)
+    assert run.status["late"] == 0 == model.late
+    # each block's pulses on the pins: a frame is its group's table, each plane ``lsb << e``
+    # long, a plane shorter than the hide threshold (and the last) then dark for the dark gap
+    size = DMD.blocks // len(p.group_tables)
+    starts = []
+    for g, table in enumerate(p.group_tables):
+        lengths = [p.lsb << e for e in table]
+        darks = sum(n < p.hide or j == len(table) - 1 for j, n in enumerate(lengths))
+        pulses = [t for t, kind, blocks in commands if kind == "pulse" and g * size in blocks]
+        firsts = pulses[::len(table) + darks]
+        periods = {b - a for a, b in zip(firsts, firsts[1:], strict=False)}
+        assert len(firsts) >= 3 and periods == {sum(lengths) + darks * p.dark_gap}, f"group {g}"
+        starts.append(firsts)
+    camera = Camera(run.model, ramp_cycles=CAMERA_RAMP, delay_cycles=CAMERA_DELAY, visible=False)
+    light = camera.image(starts[0][1], starts[0][2])
+    assert np.array_equal(light, ramp_image(DMD, 0).astype(np.int64) * p.lsb)
 
 
 @pytest.mark.verilog

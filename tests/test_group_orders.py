@@ -126,3 +126,30 @@ def test_a_margin_ends_every_load_that_much_sooner():
     assert plan.params.dark_gap == base.params.dark_gap
     with pytest.raises(AssertionError):
         solver.sequencer_terms(TEST_DMD, 200e6, ResetMode.SINGLE, margin=3)
+
+
+def test_chained_plans_end_each_groups_frame_at_its_own():
+    """Chained, each group's next frame follows its own: the solver's plan passes the independent
+    check with that rule, and its frame is a group's planes and reloads (no group waits for the
+    last one to be loaded again), shorter than the triggered plan's; the finder's chained
+    register set plays in the model with no pulse late, each group's next first pulse a dark gap
+    after its last dark pulse."""
+    t = solver.terms(TEST_DMD, 200e6, ResetMode.DUAL, depth=DEPTH)
+    triggered = solver.solve(t, seconds=5)
+    chained = solver.solve(t, seconds=5, chained=True)
+    assert chained.chained and go.check(chained) == []
+    lengths = [t.lsb << e for e in range(DEPTH)]
+    span = sum(lengths) + t.reload * sum(n < t.reload for n in lengths)
+    assert span <= chained.lower <= chained.frame < triggered.frame
+    # a chained plan read as a triggered one leaves the late groups no reload
+    assert go.check(replace(chained, chained=False)) != []
+    plan, groups = solver.find(TEST_DMD, 200e6, ResetMode.SINGLE, seconds=3, chained=True, trigger_hold=True)
+    p = plan.params
+    assert p.chain and go.check(groups) == []
+    frame = schedule.Frame(0, 8)
+    r = schedule.simulate(TEST_DMD, p, [frame] * 4, [schedule.ready_cycle(TEST_DMD, p, frame)], max_frames=3)
+    assert r.late == 0
+    for g in range(len(p.group_tables)):
+        firsts = [at for at, h, kind, _, e in r.pulses if h == g and kind == "plane" and e == p.group_tables[g][0]]
+        darks = [at for at, h, kind, fi, _ in r.pulses if h == g and kind == "dark" and fi == 1]
+        assert firsts[2] == darks[-1] + p.dark_gap

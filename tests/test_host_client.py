@@ -783,3 +783,15 @@ def test_cli_configure_group_orders_sends_each_groups_order(projector, capsys):
     assert f"{plan.rate_hz:.1f} frames/s" in out
     assert cli.main(base + setting + ["--depth", "6"]) == 1
     assert "not with --depth" in capsys.readouterr().err
+    # chained: the register set chains frames, and is the chained plan the model plays on time
+    assert cli.main(base + setting + ["--chained"]) == 0
+    assert cli.main(base + ["status"]) == 0
+    assert model.counters["records_sequencer"] == 2 and model.counters["drop_app_value"] == 0
+    taken = registers.unpack(records.registers_bits(model.registers[-1]))
+    assert taken["chain"] and taken["order"] == PlaneOrder.GROUPS
+    tables = [tuple(taken["group_tables"][8 * g:8 * g + 8]) for g in range(TEST_DMD.blocks)]
+    chained = dataclasses.replace(start, params=dataclasses.replace(start.params, chain=True))
+    plan = group_orders.played(TEST_DMD, chained, taken["lsb"], tables, taken["group_offsets"][:TEST_DMD.blocks])
+    assert plan is not None and records.register_wire(plan.params.registers(TEST_DMD)) == model.registers[-1]
+    assert cli.main(base + ["configure", "--dmd", "test", "--chained"]) == 1
+    assert "--chained plans with --group-orders" in capsys.readouterr().err

@@ -7,8 +7,10 @@ strict RST_ACTIVE reading's pin allows it, else the next clear of the oldest dar
 once that group's memory may change (a dark load needs no data, and its deadline is the shortest
 plane's, so it overtakes the loads queued before it), else the next load operation of the ready
 load at the head (a row of an occupied block, ``row_period`` after the last row and with a whole
-row of beats buffered; or a clear of an empty block), if that group's memory may change; each
-only if no loaded group's pulse falls due before the operation would end; else nothing. A load
+row of beats buffered; or a clear of an empty block), if that group's memory may change and the
+oldest dark pulse's group's memory does not free before the operation would end (its clears
+would wait for it: their deadline is the shortest plane's); each only if no loaded group's pulse
+falls due before the operation would end; else nothing. A load
 whose row data has not arrived is counted as an underrun (one per row that waits, however long).
 
 The decision is made from registered flags (the planner's, the bus's own) and registered; the
@@ -80,8 +82,8 @@ class Bus(wiring.Component):
         The frame control takes a frame while waiting: the next load starts afresh.
     rst_active : In(1)
         RST_ACTIVE, synchronised: with ``strict_rst`` no pulse while it is high.
-    due, writable : In(blocks); imminent, imminent_clear : In(1)
-        From the planner (registered).
+    due, writable, frees_soon, frees_soon_clear : In(blocks); imminent, imminent_clear : In(1)
+        From the planner (registered; ``frees_soon`` includes ``writable``).
     due_fours : In(ceil(blocks / 4))
         Bit q: some group of ``due[4q:4q + 4]`` is due (registered with it: the lowest due group
         is found from these without a chain over every flag).
@@ -121,6 +123,8 @@ class Bus(wiring.Component):
             "due": In(dmd.blocks),
             "due_fours": In(-(-dmd.blocks // 4)),
             "writable": In(dmd.blocks),
+            "frees_soon": In(dmd.blocks),
+            "frees_soon_clear": In(dmd.blocks),
             "imminent": In(1),
             "imminent_clear": In(1),
             "loads": In(stream.Signature(ready_load(dmd))),
@@ -189,10 +193,14 @@ class Bus(wiring.Component):
         cur_dark = Mux(d_fresh, dark.first, d_block)
         dark_ready = self.darks.valid & self.writable.bit_select(dark.group, 1)
         do_dark = may_op & dark_ready & ~self.imminent_clear
-        can_load = may_op & ~dark_ready & self.loads.valid & self.writable.bit_select(head.group, 1)
-        wants_row = can_load & ~self.imminent & occupied & pace.done
+        # a load operation waits while the dark's clears go first, or would wait for it (the
+        # ``frees_soon`` flags include ``writable``: one choice by the dark's group, not two)
+        can_load = may_op & self.loads.valid & self.writable.bit_select(head.group, 1)
+        dark_soon = self.darks.valid & self.frees_soon.bit_select(dark.group, 1)
+        dark_soon_clear = self.darks.valid & self.frees_soon_clear.bit_select(dark.group, 1)
+        wants_row = can_load & ~self.imminent & ~dark_soon & occupied & pace.done
         do_row = wants_row & self.row_ready
-        do_clear = (can_load & ~self.imminent_clear & ~occupied) | do_dark
+        do_clear = (can_load & ~self.imminent_clear & ~dark_soon_clear & ~occupied) | do_dark
 
         # ---- the decision, registered ----
         dec = Signal(data.StructLayout({

@@ -69,6 +69,9 @@ class GroupTimes(wiring.Component):
         group g (strict: since any group's pulse; loose: since its own).
     settled : Out(blocks)
         Bit g: the group's memory may change by the next cycle, as far as its last pulse goes.
+    frees_soon, frees_soon_clear : Out(blocks)
+        Bit g: the group's RST_ACTIVE count is over and its memory may change before an
+        operation of ``soon`` (``soon_clear``) cycles decided next cycle would end.
     at_once : Out(blocks)
         Bit g: a trigger obeyed times group g's first pulse at once (two cycles after the
         trigger's), not chained after the group before or offset (registered from ``active``,
@@ -92,6 +95,8 @@ class GroupTimes(wiring.Component):
             "late": Out(groups),
             "rst_over": Out(groups),
             "settled": Out(groups),
+            "frees_soon": Out(groups),
+            "frees_soon_clear": Out(groups),
             "at_once": Out(groups),
         })
 
@@ -126,7 +131,7 @@ class GroupTimes(wiring.Component):
             pulse_cd = Countdown(DURATION_BITS, lag=LAG, slack=1, within=(2, self._soon, self._soon_clear),
                                  flags="given")
             rst_cd = Countdown(16, lag=LAG, slack=1, within=(2,), flags="settled")
-            settle_cd = Countdown(16, lag=LAG, within=(2,), flags="settled")
+            settle_cd = Countdown(16, lag=LAG, within=(2, self._soon, self._soon_clear), flags="settled")
             m.submodules[f"pulse{g}"], m.submodules[f"rst{g}"], m.submodules[f"settle{g}"] = pulse_cd, rst_cd, settle_cd
             pulse_cds.append(pulse_cd)
 
@@ -171,5 +176,7 @@ class GroupTimes(wiring.Component):
                 # the settle countdown is loaded once the RST_ACTIVE one has ended (its flags are
                 # the settle time's from the cycle after)
                 self.settled[g].eq(rst_cd.late & settle_cd.within[0] & ~self.pulse[g]),
+                self.frees_soon[g].eq(rst_cd.late & settle_cd.within[1] & ~self.pulse[g]),
+                self.frees_soon_clear[g].eq(rst_cd.late & settle_cd.within[2] & ~self.pulse[g]),
             ]
         return m

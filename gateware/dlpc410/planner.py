@@ -117,6 +117,10 @@ class Planner(wiring.Component):
     writable : Out(blocks)
         Bit g (registered): group g's memory may change (its settle time is over, counted from
         its pulse and from RST_ACTIVE's fall, and the frame control's lead).
+    frees_soon, frees_soon_clear : Out(blocks)
+        Bit g (registered): group g's memory may change (``writable``), or its RST_ACTIVE count
+        is over and its memory frees within a row, within a clear (and its no-op rows), decided
+        now: a load operation would hold up its dark pulse's clears.
     pending, holds : Out(blocks)
         Bit g: group g plays a frame; is loaded with the plane (or dark) its next pulse shows.
     all_ready : Out(1)
@@ -175,6 +179,8 @@ class Planner(wiring.Component):
             "imminent": Out(1),
             "imminent_clear": Out(1),
             "writable": Out(G),
+            "frees_soon": Out(G),
+            "frees_soon_clear": Out(G),
             "pending": Out(G),
             "holds": Out(G),
             "all_ready": Out(1),
@@ -354,7 +360,7 @@ class Planner(wiring.Component):
 
     def _bus_flags(self, m, times, info, watch, decided):
         """The flags the bus decides from next cycle, registered: ``due``, ``imminent``,
-        ``imminent_clear``, ``writable`` (group by group, each one function of its group's
+        ``imminent_clear``, ``writable``, ``frees_soon`` (group by group, each one function of its group's
         registered state and its ``times``, ``info`` and ``watch`` flags; ``decided``: the pulse
         applied now)."""
         G, active = self._dmd.blocks, self.active
@@ -364,13 +370,17 @@ class Planner(wiring.Component):
         due = Signal(G)
         m.d.comb += due.eq((armed & times.due & ready_now)
                            | Mux(self.trigger, times.at_once & (loaded | ev) & ready_now, 0))
+        # (and none in the cycle a retake is applied: the lead's countdown loads then)
+        writable = times.settled & watch.free & ~decided & Mux(self.lead_over & ~self.retake.valid, (1 << G) - 1, 0)
         m.d.sync += [
             self.due.eq(due), self.due_fours.eq(Cat(due[lo:lo + 4].any() for lo in range(0, G, 4))),
             self.imminent.eq((armed & times.soon).any()),
             self.imminent_clear.eq((armed & times.soon_clear).any()),
-            # (and none in the cycle a retake is applied: the lead's countdown loads then)
-            self.writable.eq(times.settled & watch.free & ~decided
-                             & Mux(self.lead_over & ~self.retake.valid, (1 << G) - 1, 0)),
+            self.writable.eq(writable),
+            # (writable too: the bus then asks one flag whether the dark's clears go first or
+            # are about to)
+            self.frees_soon.eq(writable | (times.frees_soon & ~decided)),
+            self.frees_soon_clear.eq(writable | (times.frees_soon_clear & ~decided)),
         ]
 
     def _outcomes(self, m, info, frames, dark, usable, first):

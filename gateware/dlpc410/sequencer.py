@@ -242,6 +242,7 @@ class Sequencer(wiring.Component):
             bus.hold.eq(control.retake.valid), bus.restart.eq(control.retake.valid),
             bus.rst_active.eq(init.rst_active_synced),
             bus.due.eq(planner.due), bus.due_fours.eq(planner.due_fours), bus.writable.eq(planner.writable),
+            bus.frees_soon.eq(planner.frees_soon), bus.frees_soon_clear.eq(planner.frees_soon_clear),
             bus.imminent.eq(planner.imminent), bus.imminent_clear.eq(planner.imminent_clear),
             planner.choice.eq(bus.choice), planner.pulsing.eq(bus.pulsing),
         ]

@@ -12,7 +12,12 @@ the row cycle, and at the DDR2's pace of ``make sim``):
   the schedule model with no pulse late) measured on the gateware: the sequencer's generated
   Verilog plays the ramp frame back to back (:func:`sim.bench.rates.measured_rate`: the rule
   model on every cycle, the commands the schedule model's cycle for cycle, every grey level of a
-  frame between two others exact), the period between frames' first pulses on the pins.
+  frame between two others exact), the period between frames' first pulses on the pins;
+* the same, chained (``_chained``: a stored sequence played without triggers, each group's
+  next frame after its own; no group waits for the last to be loaded again, so a frame is a
+  group's planes and one reload). Frames then overlap by the spread of the groups' offsets
+  (``_overlap_cycles``: a group starts the next frame while another still shows this one), which
+  the solver keeps as small as it can; the camera's window is one period.
 """
 
 import numpy as np
@@ -52,13 +57,18 @@ def check(plan):
             continue
         times, darks = timeline(order, t.lsb, t.reload, t.reload)
         times = times + o
-        if F < times[-1] + t.reload:
+        # (the next frame's first pulse: the group's own a frame on, chained; else every group's
+        # offset after the next trigger, at the frame)
+        if F + (o if plan.chained else 0) < times[-1] + t.reload:
             bad.append(f"group {g}: not loaded again {t.reload} cycles after its last dark pulse")
         pulses += list(times)
         busy += [(int(p), t.row) for p in times]
         dark_at = [j + 1 for j in range(len(times) - 1) if darks[j]]
         for (j, before), ld in zip(freeing(plan, g), plan.loads[g], strict=True):
-            if ld < before + frozen or ld + t.load + t.slack > times[j]:
+            # (chained, the first plane's load is in the dark gap after the group's frame
+            # before: the slack that gap leaves, not the one a load behind a plane keeps)
+            slack = t.reload - frozen - t.load if plan.chained and j == 0 else t.slack
+            if ld < before + frozen or ld + t.load + slack > times[j]:
                 bad.append(f"group {g}: the load of plane {j} at {ld} outside [{before + frozen}, {times[j]}]")
             busy.append((ld, t.load))
         for j, c in zip(dark_at, plan.clears[g], strict=True):
@@ -122,6 +132,24 @@ def figures(*, seconds=120.0):
         out[name.replace("_group_orders_hz_", "_fraction_of_bound_") + "_group_orders"] = (
             FABRIC_HZ / period / bound(dmd, dclk), "")
         out[f"seq.gray8_group_orders_lsb_cycles_dlp7000_dual_{key}"] = (p.lsb, "cycles")
+        # chained (a stored sequence played without triggers): each group starts its next frame
+        # as it ends this one, so no group waits for the last to be loaded again
+        chained, groups = find(dmd, dclk, ResetMode.DUAL, seconds=seconds, chained=True, **kwargs)
+        period, _, error = measured_rate("dlp7000", "DUAL", True, dclk, plan=chained,
+                                         name=f"group_orders_{key}_chained")
+        assert error == 0, f"{key}, chained: a frame not exact ({error} LSB)"
+        overlap = max(chained.params.group_offsets)
+        print(f"  chained, the plan finder's (LSB {chained.params.lsb}; the solver's frame {groups.frame} cycles, "
+              f"each group's span): {FABRIC_HZ / period:.1f} Hz measured on the gateware "
+              f"({period} cycles), the model's {chained.rate_hz:.1f} Hz, {FABRIC_HZ / period / bound(dmd, dclk):.1%} "
+              f"of the bound; frames overlap by the offsets' spread, {overlap} cycles")
+        for o, order in sorted(zip(chained.params.group_offsets, chained.params.group_tables, strict=True)):
+            print(f"  offset {o:>6}  order {' '.join(map(str, order))}")
+        chained_name = name.replace("_group_orders_hz_", "_rate_hz_") + "_group_orders_chained"
+        out[chained_name] = (FABRIC_HZ / period, "Hz")
+        out[chained_name + "_model"] = (chained.rate_hz, "Hz")
+        out[chained_name.replace("_rate_hz_", "_fraction_of_bound_")] = (FABRIC_HZ / period / bound(dmd, dclk), "")
+        out[f"seq.gray8_group_orders_chained_overlap_cycles_dlp7000_dual_{key}"] = (overlap, "cycles")
     return out
 
 
