@@ -114,8 +114,8 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
     the sequencer's queue serves loads in the order of the pulses that freed them). The search
     is parallel (``workers``): what it finds in a given time may differ from run to run; its
     lower bound is proved. ``chained``: each group's next frame follows its own, a dark gap after
-    its last dark pulse (the frame is a group's span); the solver then keeps the groups' offsets
-    as close as it can (the spread, by which frames overlap)."""
+    its last dark pulse (the frame is a group's span, and the groups' offsets, by which frames
+    overlap, are whatever the first plan found has)."""
     from ortools.sat.python import cp_model
 
     m = cp_model.CpModel()
@@ -212,14 +212,8 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
         keep.append((o, s, loads, clears, c))
     m.add_no_overlap(rst)
     m.add_no_overlap(bus)
-    if chained:
-        # the frame is each group's span (the shortest: the last plane a dark one); then the
-        # spread of the groups' offsets, by which a group's next frame overlaps another's this one
-        spread = var("spread", 0, H)
-        m.add_max_equality(spread, [o for o, *_ in keep])
-        m.minimize(F * (H + 1) + spread)
-    else:
-        m.minimize(F)
+    # (chained, the frame is each group's span: the shortest, the last plane a dark one)
+    m.minimize(F)
     solver = cp_model.CpSolver()
     solver.parameters.max_time_in_seconds = seconds
     solver.parameters.num_workers = workers
@@ -236,9 +230,7 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
         cl = {e: v(ce) for e, ce in clears}
         # clears in dark-pulse order, the frame's last dark pulse's last
         all_clears.append([cl[e] for e in order[:-1] if e in cl] + [cl.get(order[-1], v(c))])
-    # (chained, the objective bounds the frame in its high part)
     lower = math.ceil(solver.best_objective_bound)
-    lower = lower // (H + 1) if chained else lower
     return GroupPlan(t, v(F), offsets, orders, all_loads, all_clears, lower, chained)
 
 

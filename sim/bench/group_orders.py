@@ -16,8 +16,8 @@ the row cycle, and at the DDR2's pace of ``make sim``):
 * the same, chained (``_chained``: a stored sequence played without triggers, each group's
   next frame after its own; no group waits for the last to be loaded again, so a frame is a
   group's planes and one reload). Frames then overlap by the spread of the groups' offsets
-  (``_overlap_cycles``: a group starts the next frame while another still shows this one), which
-  the solver keeps as small as it can; the camera's window is one period.
+  (``_overlap_cycles``: a group starts the next frame while another still shows this one); the
+  camera's window is one period.
 """
 
 import numpy as np
