@@ -230,8 +230,8 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
         cl = {e: v(ce) for e, ce in clears}
         # clears in dark-pulse order, the frame's last dark pulse's last
         all_clears.append([cl[e] for e in order[:-1] if e in cl] + [cl.get(order[-1], v(c))])
-    lower = math.ceil(solver.best_objective_bound)
-    return GroupPlan(t, v(F), offsets, orders, all_loads, all_clears, lower, chained)
+    return GroupPlan(t, v(F), offsets, orders, all_loads, all_clears, math.ceil(solver.best_objective_bound),
+                     chained)
 
 
 def find(dmd, dclk_hz, reset_mode, *, seconds=60.0, workers=2, extra_rows=4, margin=0, chained=False,
@@ -240,9 +240,9 @@ def find(dmd, dclk_hz, reset_mode, *, seconds=60.0, workers=2, extra_rows=4, mar
     under the sequencer's terms (:func:`sequencer_terms`; ``plan_kwargs`` as
     :func:`spec.schedule.plan`'s), that the schedule model's sequencer plays with no pulse late:
     (:class:`spec.schedule.Plan` of :attr:`~spec.registers.PlaneOrder.GROUPS`, its
-    :class:`GroupPlan`), or None. At the settle path's LSB a dark pulse's clears may find no cycle
-    to wait for a row under way (the model loads as soon as it can): the LSB then takes a row
-    cycle more, up to ``extra_rows``. ``margin``: as :func:`sequencer_terms`'s. ``chained``: each
+    :class:`GroupPlan`), or None. The solver places each load anywhere in its window, the model's
+    queue where it comes: should the model make a pulse late, the LSB takes a row cycle more, up
+    to ``extra_rows``. ``margin``: as :func:`sequencer_terms`'s. ``chained``: each
     frame follows the one before without a trigger (:attr:`~spec.schedule.Params.chain`), each
     group its own frame after its own; the solver's loads may be placed where the sequencer's
     queue would not put them, so up to ``attempts`` searches (seeds) at each LSB."""

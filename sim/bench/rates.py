@@ -35,10 +35,9 @@ import numpy as np
 
 from gateware.dlpc410.trigger import PIN_TO_STROBE
 from sim.bench import group_orders
-from sim.models.camera import Camera
 from sim.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
-from sim.tb.seq_sim import CAMERA_DELAY, CAMERA_RAMP, frame_lights
+from sim.tb.seq_sim import frame_lights, period_light
 from spec import ceiling, plan_search, schedule
 from spec.facts import DMDS
 from spec.registers import ResetMode, Source
@@ -90,8 +89,7 @@ def measured_rate(dmd_name, mode, strict, dclk, reading="ti", *, frames=FRAMES, 
     # first pulse to the next's (after the first frames, which start from the trigger), in
     # which every group shows the whole of its frame
     if p.chain:
-        light = Camera(run.model, ramp_cycles=CAMERA_RAMP, delay_cycles=CAMERA_DELAY,
-                       visible=False).image(frame_starts[2], frame_starts[3])
+        light = period_light(run.model, frame_starts[2], frame_starts[3])
     else:
         (light,) = frame_lights(run.model, run.frames()[1:2])
     error = float(np.abs(light / p.lsb - ramp_image(dmd, 0)).max())

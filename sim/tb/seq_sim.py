@@ -25,7 +25,7 @@ from sim.models.dlpc410 import Dlpc410, amaranth_process
 from sim.tb.plane_source import SequencerBench
 from spec.schedule import DECISION_TO_PINS, FABRIC_HZ, RST_MARGIN
 
-__all__ = ["Run", "run_bench", "dlpc410_for", "frame_lights", "INIT_CYCLES", "INIT_GRACE",
+__all__ = ["Run", "run_bench", "dlpc410_for", "frame_lights", "period_light", "INIT_CYCLES", "INIT_GRACE",
            "CAMERA_RAMP", "CAMERA_DELAY"]
 
 #: INIT_ACTIVE high this long after ARSTZ rises (the 220 ms of the facts, shortened).
@@ -76,6 +76,14 @@ def frame_lights(model, frames, *, ramp=CAMERA_RAMP, delay=CAMERA_DELAY):
     first pulse to the end of the last pulse's mirror motion."""
     camera = Camera(model, ramp_cycles=ramp, delay_cycles=delay, visible=False)
     return [camera.image(first, last + delay + ramp) for first, last in frames]
+
+
+def period_light(model, first, end, *, ramp=CAMERA_RAMP, delay=CAMERA_DELAY):
+    """The camera's image over ``[first, end)`` model cycles (light in cycles, every column): one
+    period of chained phased frames, which overlap (a group starts the next while another ends
+    this one), so no window holds one frame alone; over a period every group shows the whole of
+    its frame."""
+    return Camera(model, ramp_cycles=ramp, delay_cycles=delay, visible=False).image(first, end)
 
 
 def run_bench(dmd, params, frames, images=None, *, pins=(), soft=(), cycles, name,
