@@ -193,7 +193,9 @@ def main(argv=None):
     configure.add_argument("--group-orders", type=float, default=0.0, metavar="SECONDS",
                            help="search this long with a constraint solver for a plan of --reset-mode's groups each "
                                 "in a plane order of its own, from an offset of its own (faster than one order "
-                                "for every group; 8-bit frames; needs the 'solver' extra; docs/bounds.md)")
+                                "for every group; 8-bit frames; needs the 'solver' extra; docs/bounds.md); "
+                                "triggered, two searches this long (each load's slack for other groups' pulses, "
+                                "and none)")
     configure.add_argument("--chained", action="store_true",
                            help="with --group-orders: every frame follows the one before without a trigger, each "
                                 "group starting its next frame as it ends its own (a stored sequence played back "

@@ -61,7 +61,8 @@ class GroupPlan:
     frame (frames back to back), the start of each group's loads (one per plane, in display
     order) and of its clears (one per dark pulse but the frame's last), and the solver's proven
     lower bound on the frame; ``chained``: each group's next frame follows its own (else every
-    group's first pulse is its offset after a trigger that comes once every group is loaded)."""
+    group's first pulse is its offset after a trigger that comes once every group has ended its
+    frame and group 0 is loaded)."""
     terms: Terms
     frame: int
     offsets: list
@@ -161,12 +162,13 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
         m.add(final == end - t.reload).only_enforce_if(last_dark)
         m.add(final == end).only_enforce_if(~last_dark)
         # the next frame: triggered, every group's first pulse its offset after the trigger,
-        # which comes once every group is loaded again; chained, each group's own frame after
-        # its own (a frame of every group's span)
+        # which comes once every group has ended its frame (its last dark pulse) and group 0 is
+        # loaded again (the others' first loads, below, by their own offsets: frames never
+        # overlap); chained, each group's own frame after its own (a frame of every group's span)
         if chained:
             m.add(F == final + t.reload - o)
         else:
-            m.add(F >= final + t.reload)
+            m.add(F >= final)
         loads, clears = [], []
         for e in range(N):
             m.add(s[e] == o).only_enforce_if(x[N, e])
@@ -242,39 +244,59 @@ def find(dmd, dclk_hz, reset_mode, *, seconds=60.0, workers=2, extra_rows=4, mar
     (:class:`spec.schedule.Plan` of :attr:`~spec.registers.PlaneOrder.GROUPS`, its
     :class:`GroupPlan`), or None. The solver places each load anywhere in its window, the model's
     queue where it comes: should the model make a pulse late, the LSB takes a row cycle more, up
-    to ``extra_rows``. ``margin``: as :func:`sequencer_terms`'s. ``chained``: each
+    to ``extra_rows``. Triggered, two searches at each LSB: each load done the sequencer terms'
+    slack before its pulse (room for other groups' pulses), and with none but ``margin``
+    (tighter, so the model's queue may make it late); the faster plan that plays is kept.
+    ``margin``: as :func:`sequencer_terms`'s. ``chained``: each
     frame follows the one before without a trigger (:attr:`~spec.schedule.Params.chain`), each
     group its own frame after its own; the solver's loads may be placed where the sequencer's
     queue would not put them, so up to ``attempts`` searches (seeds) at each LSB."""
     seq_terms, base = sequencer_terms(dmd, dclk_hz, reset_mode, margin=margin, **plan_kwargs)
     if chained:
         base = replace(base, params=replace(base.params, chain=True))
+    # triggered, the loads' slack for other groups' pulses both ways: none (the memory's margin
+    # only) and the spread search's; chained, the frame is a group's span whatever the slack
+    slacks = ((seq_terms.slack, attempts),) if chained else ((margin, 1), (seq_terms.slack, 1))
     for extra in range(extra_rows + 1):
-        t = replace(seq_terms, lsb=seq_terms.lsb + extra * seq_terms.row)
-        for seed in range(attempts if chained else 1):
-            found = solve(t, seconds=seconds, workers=workers, seed=seed, chained=chained)
-            if found is None:
-                break
-            plan = played(dmd, base, t.lsb, found.orders, found.offsets)
-            if plan is not None:
-                return plan, found
+        kept = []
+        for slack, seeds in slacks:
+            t = replace(seq_terms, lsb=seq_terms.lsb + extra * seq_terms.row, slack=slack)
+            for seed in range(seeds):
+                found = solve(t, seconds=seconds, workers=workers, seed=seed, chained=chained)
+                if found is None:
+                    break
+                plan = played(dmd, base, t.lsb, found.orders, found.offsets)
+                if plan is not None:
+                    kept.append((plan, found))
+                    if chained:            # (every chained plan has the same frame)
+                        break
+        if kept:
+            return min(kept, key=lambda pair: pair[0].frame_cycles)
     return None
 
 
 #: Frames a chained plan is played for by :func:`played` (the first ones start from a trigger).
 CHAINED_FRAMES = 6
+#: Frames a triggered plan is played for by :func:`played`, back to back.
+TRIGGERED_FRAMES = 4
 
 
 def played(dmd, base, lsb, orders, offsets):
     """``base`` (a :func:`sequencer_terms` plan) with each group's order and offset, at ``lsb``, as
     the schedule model's sequencer plays it from a trigger (chained: :data:`CHAINED_FRAMES`
-    frames, each after the one before): the :class:`spec.schedule.Plan` (its trigger-to-trigger
-    period, or chained its frame period), or None if a pulse comes late."""
+    frames, each after the one before; else :data:`TRIGGERED_FRAMES` triggered back to back):
+    the :class:`spec.schedule.Plan` (its trigger-to-trigger period, or chained its frame period),
+    or None if a pulse comes late."""
     p = replace(base.params, lsb=lsb, order=PlaneOrder.GROUPS, group_tables=tuple(map(tuple, orders)),
                 group_offsets=tuple(offsets))
     frame = schedule.Frame(0, len(orders[0]))
-    n = CHAINED_FRAMES if p.chain else 1
-    if schedule.simulate(dmd, p, [frame] * n, [schedule.ready_cycle(dmd, p, frame)], max_frames=n - 1 or None).late:
+    if p.chain:
+        n, first = CHAINED_FRAMES, schedule.ready_cycle(dmd, p, frame)
+        late = schedule.simulate(dmd, p, [frame] * n, [first], max_frames=n - 1).late
+    else:
+        # (the frames after the first start from triggers that wait for group 0's load only)
+        late = schedule.back_to_back(dmd, p, frame, TRIGGERED_FRAMES).late
+    if late:
         return None
     kind = "the solver's, chained" if p.chain else "the solver's"
     return replace(base, params=p, frame_cycles=schedule.frame_period(dmd, p, frame),

@@ -39,8 +39,13 @@ cannot be made on time is made late and counted (the plan below never lets that 
 
 A trigger strobe at cycle ``s`` is obeyed when every group is loaded and waiting: group ``g``'s
 first pulse falls due at ``s + 2 + g * stagger`` (the frame control's decision takes a cycle);
-otherwise it is counted as an overrun. A pulse due at ``T`` is made on the first free even cycle
-from ``even(T)`` on, and counts as late when made after ``even(T)``.
+otherwise it is counted as an overrun. In GROUPS, where each group's first pulse comes at its own
+offset, once frames follow triggers only group 0 (offset 0) must be loaded, and RST_ACTIVE must
+allow its pulse: the others wait with their first loads under way, each due by its own offset
+(the plan finder's plans make none late; a late one is counted). After a start or a frame taken
+while waiting (every first plane queued at once) the trigger waits for every group again. A
+pulse due at ``T`` is made on the first free even cycle from ``even(T)`` on, and counts as late
+when made after ``even(T)``.
 
 Frames: the first group to move on from a frame takes the next offered frame when it makes its
 last pulse of the frame (else the frame repeats); the others take the same frame when they move
@@ -74,7 +79,7 @@ from .facts import SETTLE_READINGS, TIMING, BlockMode
 from .registers import MAX_GROUPS, MIN_SETTLE, PlaneOrder, ResetMode, Source, TriggerMode, group_size
 
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate", "FABRIC_HZ",
-           "beats_at", "row_cycles", "row_rate_words",
+           "back_to_back", "beats_at", "row_cycles", "row_rate_words",
            "plan", "bound", "paper_eq_rate_hz", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS",
            "flush_rows", "PAPER_SETTLE_CYCLES", "MIN_SETTLE", "RST_MARGIN",
            "FALL_LATENCY", "DECISION_TO_PINS", "PACE_LAG",
@@ -108,6 +113,11 @@ def row_cycles(dmd, beats=1):
 
 #: First load this many cycles after INIT_ACTIVE falls (DLPC910: first DVALID >= 64 clocks).
 INIT_TO_DVALID = int(TIMING["init_to_dvalid_clocks"].value)
+
+#: Cycles from a group's last dark pulse (the decision) to the first a trigger may be obeyed at,
+#: when that pulse is what the trigger waits for (GROUPS): the pulse is applied, then the planner
+#: registers its groups' rest, which the frame control reads.
+END_TO_TRIGGER = 3
 
 #: Default ``reload_lead``: a frame taken while waiting for a trigger has its first row loaded
 #: this many cycles later at the earliest (the requester's occupancy look-up and the store's
@@ -305,6 +315,7 @@ class _Group:
         self.pending = False
         self.pulse_at = 0
         self.loaded_at = None     # cycle from which the group counts as loaded
+        self.ended_at = -math.inf  # cycle of the dark pulse that ended its play
         self.writable = INIT_TO_DVALID
         self.rst_free = 0
         self.pos = None           # ("plane", frame_index, j) or ("dark", frame_index, j)
@@ -395,6 +406,7 @@ class _Model:
         self.t = 0
         self.holding = False                # a trigger held until every group is ready
         self.ended = False                  # a sequence played once has started its last frame
+        self.reloaded = True                # every first plane queued at once since the last trigger
         self.idle_take = not p.chain and p.source != Source.PRNG
         # the trigger's pace (the guard of take_while_waiting): the periodic timer's is known
         # from the start (its first strobe comes ``period - 1`` cycles in), a pin's after two;
@@ -476,10 +488,38 @@ class _Model:
             s.pos = ("plane", nfi, nj)
             if last and not follow:
                 s.pending = False
+                s.ended_at = t
             self.enqueue(g, nfi, nj)
 
     def waiting(self, t):
+        """Every group waits, loaded."""
         return all(not s.pending and s.loaded_at is not None and s.loaded_at <= t for s in self.st)
+
+    def steady(self):
+        """In GROUPS, frames follow a trigger's: each group's first plane was queued at its own
+        last dark pulse (not all at once, by a start or a frame taken while waiting)."""
+        return self.p.order == PlaneOrder.GROUPS and not self.reloaded
+
+    def needs_loaded(self):
+        """The groups that must be loaded for a trigger to be obeyed: every one, or when
+        :meth:`steady` group 0 only (each other group's first pulse comes at its own offset, its
+        load under way)."""
+        return self.st[:1] if self.steady() else self.st
+
+    def trigger_ready(self, t):
+        """A trigger may be obeyed at ``t``: no group plays (each ended its play
+        :data:`END_TO_TRIGGER` cycles ago at least), and :meth:`needs_loaded` are loaded."""
+        return (not self.playing() and all(s.ended_at + END_TO_TRIGGER <= t for s in self.st)
+                and all(s.loaded_at is not None and s.loaded_at <= t for s in self.needs_loaded())
+                and self.first_rst_free() <= t)
+
+    def first_rst_free(self):
+        """When :meth:`steady`, the first cycle a trigger may be obeyed at as far as RST_ACTIVE
+        goes: group 0's first pulse, two cycles on, need not wait for it; else no bound (every
+        group loaded: its last pulse is long past)."""
+        if not self.steady():
+            return -math.inf
+        return self.rst_any if self.p.strict_rst else self.st[0].rst_free
 
     def playing(self):
         return any(s.pending for s in self.st)
@@ -487,6 +527,7 @@ class _Model:
     # -- the frame control -------------------------------------------------------------------
 
     def start(self):
+        self.reloaded = True
         fi = self.next_frame = self.frames.take(self.t)
         self.behind = set()
         for g in range(self.G):
@@ -534,6 +575,7 @@ class _Model:
         fi = self.next_frame = self.frames.take(t, repeat=False)
         self.behind = set()
         self.ended = False
+        self.reloaded = True
         self.queued_at = t + max(wait, 1) + self.G + 1
         self.queue.clear()
         self.darks.clear()
@@ -545,13 +587,14 @@ class _Model:
     def obey(self, t):
         """Every group's first pulse due from ``t + 2``, staggered."""
         self.res.accepted.append(t)
+        self.reloaded = False
         for g, s in enumerate(self.st):
             s.pending = True
             s.pulse_at = t + 2 + (self.p.group_offsets[g] if self.p.order == PlaneOrder.GROUPS else g * self.p.stagger)
 
     def release_held(self, t):
         """A held trigger is obeyed on the first cycle every group is ready."""
-        if self.holding and self.waiting(t):
+        if self.holding and self.trigger_ready(t):
             self.holding = False
             self.obey(t)
 
@@ -564,7 +607,7 @@ class _Model:
         self.paces.append((s_t + PACE_LAG, self.last_strobe, self.interval))
         if self.ended:
             self.res.ended += 1
-        elif self.waiting(s_t):
+        elif self.trigger_ready(s_t):
             self.obey(s_t)
         elif self.p.trigger_hold and not self.holding:
             self.holding = True
@@ -573,10 +616,12 @@ class _Model:
             self.res.overruns += 1
 
     def ready_at(self):
-        """The cycle every group is ready (no group plays, every one loaded), or None."""
-        if any(s.pending or s.loaded_at is None for s in self.st):
+        """The cycle a trigger may be obeyed from (:meth:`trigger_ready`) as things stand, or None."""
+        need = self.needs_loaded()
+        if self.playing() or any(s.loaded_at is None for s in need):
             return None
-        return max(s.loaded_at for s in self.st)
+        return max([s.loaded_at for s in need] + [s.ended_at + END_TO_TRIGGER for s in self.st]
+                   + [self.first_rst_free()])
 
     # -- the bus -----------------------------------------------------------------------------
 
@@ -1009,11 +1054,29 @@ def frame_period(dmd, p, fr):
         n = max(4, _chained(dmd, p, fr))
         r = simulate(dmd, p, [fr] * n, [ready_cycle(dmd, p, fr)], max_frames=n - 1)
         return r.frame_starts[-1] - r.frame_starts[-2]
-    # trigger as soon as ready: a second strobe is obeyed once every group, its frame played,
-    # is loaded again (the last thing each group does)
     first = ready_cycle(dmd, p, fr)
-    r = simulate(dmd, p, [fr], [first])
-    return max(st.loaded_at for st in r.groups) - first
+    if p.order != PlaneOrder.GROUPS:
+        # trigger as soon as ready: a second strobe is obeyed once every group, its frame
+        # played, is loaded again (the last thing each group does)
+        r = simulate(dmd, p, [fr], [first])
+        return max(st.loaded_at for st in r.groups) - first
+    # GROUPS: the trigger after a trigger's frame waits for less than the first one (group 0's
+    # load, not every group's): the period between the second and third
+    accepted = back_to_back(dmd, p, fr, 3).accepted
+    return accepted[2] - accepted[1]
+
+
+def back_to_back(dmd, p, fr, n):
+    """``n`` frames ``fr`` triggered back to back under ``p``, from the first cycle every group
+    is loaded, each strobe after the first held until the groups are ready for it: the
+    :class:`Result` (``accepted``: the ``n`` triggers' cycles)."""
+    held, strobes = replace(p, trigger_hold=True), [ready_cycle(dmd, p, fr)]
+    while True:
+        last = len(strobes) == n
+        r = simulate(dmd, held, [fr], strobes if last else [*strobes, strobes[-1] + 1])
+        if last:
+            return r
+        strobes.append(r.accepted[-1])
 
 
 def bound(dmd, dclk_hz, depth=8, *, t_rst_s=None, t_settle_s=None, reading="ti"):

@@ -261,6 +261,90 @@ def test_a_load_row_waits_for_a_dark_pulses_clears(test_name, monkeypatch):
 
 
 @pytest.mark.verilog
+def test_groups_trigger_waits_for_group_0s_load_only(test_name, monkeypatch):
+    """In GROUPS a trigger is obeyed once every group has made its frame's last dark pulse and
+    group 0 is loaded: the other group's first load is still on the pins after the frame's first
+    pulse, done by its own offset. Triggers faster than frames, held: no pulse late, commands
+    the model's cycle for cycle, every level exact, and the frames come sooner than when the
+    trigger waits for every group to be loaded."""
+    tables, offsets = ((2, 4, 0, 7, 5, 1, 6, 3), (6, 7, 1, 0, 3, 4, 5, 2)), (0, 312)
+    p = replace(fast_plan(reset_mode=ResetMode.DUAL, trigger_hold=True).params, order=PlaneOrder.GROUPS,
+                group_tables=tables, group_offsets=offsets)
+    frames = [(0, 8)]
+    first = next_ready(p, model_frames(frames, None), []) - PIN_TO_STROBE
+    period = schedule.frame_period(DMD, p, schedule.Frame(0, 8))
+    pins = [first + k * period // 3 for k in range(10)]
+    run, model = check(p, frames, None, pins, test_name, extra=period)
+    assert len(model.accepted) >= 3 and model.held >= 2
+    # group 1's rows (its blocks') between a frame's first pulse and group 1's first pulse: its
+    # first plane, loaded after the trigger
+    rpb, size = DMD.rows_per_block, DMD.blocks // len(tables)
+    pulses = [(t, blocks) for t, kind, blocks in run.commands if kind == "pulse"]
+    rows = [t for t, kind, row in run.commands if kind == "row" and row // rpb // size == 1]
+    firsts = {g: [] for g in range(2)}
+    for g, table in enumerate(tables):
+        mine = [t for t, blocks in pulses if g * size in blocks]
+        per_frame = len(table) + sum((p.lsb << e) < p.hide for e in table) + ((p.lsb << table[-1]) >= p.hide)
+        firsts[g] = mine[::per_frame]
+    after_trigger = [sum(a < t < b for t in rows) for a, b in zip(firsts[0][1:], firsts[1][1:], strict=False)]
+    assert after_trigger and all(n > 0 for n in after_trigger), after_trigger
+    # waiting for every group to be loaded, the same triggers start frames later
+    starts = model.frame_starts
+    monkeypatch.setattr(schedule._Model, "needs_loaded", lambda self: self.st)
+    slower = schedule.simulate(DMD, p, model_frames(frames, None), [t + PIN_TO_STROBE for t in pins]).frame_starts
+    assert starts[1] - starts[0] < slower[1] - slower[0]
+
+
+@pytest.mark.verilog
+@pytest.mark.parametrize("strict", [True, False], ids=["rst_active_binds", "last_dark_pulse_binds"])
+def test_groups_trigger_rule_to_the_cycle(strict, test_name):
+    """In GROUPS, the first cycle a trigger is obeyed after a frame: once RST_ACTIVE allows group
+    0's pulse (strict reading: after the other group's last dark pulse), or (loose) once that
+    pulse has reached the frame control. A strobe a cycle sooner is an overrun, at that cycle it
+    is obeyed: the gateware agrees with the model on both, commands cycle for cycle."""
+    tables, offsets = ((2, 4, 0, 7, 5, 1, 6, 3), (6, 7, 1, 0, 3, 4, 5, 2)), (0, 312)
+    p = replace(fast_plan(reset_mode=ResetMode.DUAL).params, strict_rst=strict, order=PlaneOrder.GROUPS,
+                group_tables=tables, group_offsets=offsets)
+    frames = model_frames([(0, 8)], None)
+    first = next_ready(p, frames, []) - PIN_TO_STROBE
+    lone = schedule.simulate(DMD, p, frames, [first + PIN_TO_STROBE])
+    end = max(at for at, g, kind, *_ in lone.pulses if kind == "dark")
+    # the model's first cycle, searched from the last dark pulse on
+    earliest = next(s for s in range(end, end + 200)
+                    if len(schedule.simulate(DMD, p, frames, [first + PIN_TO_STROBE, s]).accepted) == 2)
+    assert earliest == end + (p.t_rst if strict else schedule.END_TO_TRIGGER)
+    for s, obeyed in ((earliest - 1, False), (earliest, True)):
+        pins = [first, s - PIN_TO_STROBE]
+        model = schedule.simulate(DMD, p, frames, [t + PIN_TO_STROBE for t in pins])
+        run = run_rig(DMD, p, [(0, 8)], None, pins=pins, cycles=max(c[0] for c in model.commands) + 100,
+                      name=f"{test_name}_{s - earliest}")
+        assert run.commands == model.decoded()
+        assert run.status["triggers"] == len(model.accepted) == 1 + obeyed
+        assert run.status["overruns"] == model.overruns == 1 - obeyed
+        assert run.status["late"] == 0 == model.late
+
+
+@pytest.mark.verilog
+def test_groups_trigger_after_a_reload_waits_for_every_group(test_name, monkeypatch):
+    """A frame taken while the groups wait queues every group's first plane at once: the next
+    trigger waits for all of them (not only group 0's), so no group's first pulse comes late.
+    Four groups in orders of their own whose steady frames need no such wait: gateware and model
+    agree cycle for cycle, no pulse late, both frames exact; the model waiting for group 0 alone
+    after the reload makes pulses late."""
+    tables = ((0, 3, 7, 2, 1, 6, 5, 4), (5, 2, 0, 1, 4, 3, 7, 6), (4, 3, 5, 2, 6, 1, 0, 7), (4, 3, 2, 6, 1, 7, 0, 5))
+    p = replace(fast_plan(reset_mode=ResetMode.SINGLE, trigger_hold=True).params, order=PlaneOrder.GROUPS,
+                group_tables=tables, group_offsets=(0, 100, 200, 300))
+    first = next_ready(p, model_frames([(0, 8)], None), []) - PIN_TO_STROBE
+    idle = waiting_after(p, [(0, 8)], [first + PIN_TO_STROBE]) + 30
+    offered = [(0, 8, 0), (1, 8, idle)]
+    pins = [first] + [idle + 10 + k * 50 for k in range(4)]
+    run, model = check(p, [(0, 8), (1, 8)], None, pins, test_name, offered=offered)
+    assert [f.slot for f in model.shown] == [0, 1] and len(model.accepted) == 2
+    monkeypatch.setattr(schedule._Model, "steady", lambda self: True)
+    assert schedule.simulate(DMD, p, model_frames(offered, None), [t + PIN_TO_STROBE for t in pins]).late > 0
+
+
+@pytest.mark.verilog
 def test_chained_groups_each_start_their_next_frame_as_they_end_their_own(test_name):
     """Chained frames of groups in orders of their own (the plan finder's, at TI's times): one
     trigger, then each group starts its next frame a dark gap after its own last dark pulse

@@ -9,8 +9,9 @@ schedule model uses the same time). A newer frame does not delay a trigger: whil
 come at a steady pace (the last two an interval apart, the next not yet an eighth of an interval
 overdue), it replaces the waiting frame only if the reload ends before the next trigger is due
 (:func:`spec.schedule.reload_bound`), else it is shown at the trigger after. A trigger is obeyed
-when every group is loaded and waits; otherwise it is an overrun (or early, before the groups
-run).
+when every group is loaded and waits (in ``GROUPS``, once frames follow triggers, group 0 loaded
+and the others waiting, their first loads under way); otherwise it is an overrun (or early, before
+the groups run).
 
 A controller that initialises again (``initialised`` falls: INIT_ACTIVE high again, or
 ECP2_FINISHED low; or the store lost its memory) has lost the DMD's memory: ``RESTART`` stops
@@ -57,6 +58,10 @@ class FrameControl(wiring.Component):
     n_groups : In(range(blocks + 1))
     all_ready : In(1)
         The planner's groups are all loaded and wait (as its state is).
+    trigger_ready : In(1)
+        The planner's groups may take a trigger (as its state is): ``all_ready``, or in
+        ``GROUPS`` group 0 loaded and every group waiting (used once a trigger was obeyed since
+        the last start, take or restart).
     counting : In(1)
         The time base counts (the controller is initialised): the first loads wait
         ``init_to_dvalid`` clocks from its first cycle.
@@ -106,6 +111,7 @@ class FrameControl(wiring.Component):
             "regs": In(Registers),
             "n_groups": In(range(G + 1)),
             "all_ready": In(1),
+            "trigger_ready": In(1),
             "counting": In(1),
             "initialised": In(1),
             "strobe": In(1),
@@ -146,6 +152,7 @@ class FrameControl(wiring.Component):
         # ---- the state the decisions so far leave ----
         settles = did.obey | did.take | did.start | did.restart
         all_ready = self.all_ready & ~settles
+        trigger_ready = self.trigger_ready & ~settles
         playing = self.playing | did.obey
         ended = self.ended & ~did.start & ~(did.take & did.newer)
         holding = Signal()
@@ -214,7 +221,15 @@ class FrameControl(wiring.Component):
         # a trigger is obeyed when every group is ready; one that comes sooner is held (with
         # ``trigger_hold``) and obeyed on the first cycle they are, before any new one (every
         # group ready, none plays: only a newer frame or a reload could be taken instead)
-        ready = self.running & all_ready & ~(run & ((newer & fits) | self.reload))
+        # (in GROUPS the planner's ``trigger_ready`` spares groups whose first loads are under
+        # way, queued each at its own last dark pulse; after a start, take or restart every
+        # first plane was queued at once, and the trigger waits for them all)
+        reloaded = Signal(init=1)
+        with m.If(did.start | did.take | did.restart):
+            m.d.sync += reloaded.eq(1)
+        with m.If(did.obey):
+            m.d.sync += reloaded.eq(0)
+        ready = self.running & Mux(reloaded, all_ready, trigger_ready) & ~(run & ((newer & fits) | self.reload))
         release = holding_now & ready
         holds = regs.trigger_hold & (~holding_now | release)
         m.d.sync += [

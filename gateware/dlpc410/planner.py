@@ -26,7 +26,7 @@ from amaranth.lib.wiring import In, Out
 from spec.schedule import row_cycles
 
 from ..counter import Counter
-from ..registers import LSB_BITS, Registers, Source
+from ..registers import LSB_BITS, PlaneOrder, Registers, Source
 from ..store.layouts import SLOT_BITS, FrameInfo, Showing
 from .bus import lowest_due_has
 from .frame_offer import FrameOffer, Offer
@@ -126,6 +126,11 @@ class Planner(wiring.Component):
     all_ready : Out(1)
         Every group of the reset mode is loaded and waits for a trigger (registered: as this
         cycle's state is; the frame control counts in its own decisions).
+    trigger_ready : Out(1)
+        A trigger may be obeyed (registered, as ``all_ready``): no group of the reset mode plays,
+        and every one is loaded, or in ``GROUPS`` group 0 (offset 0, the first to pulse) with
+        RST_ACTIVE allowing its pulse: each other group's first load is under way and due by its
+        own offset.
     job_due : Out(1)
         A load job is on its way (it is written within three cycles).
     playing : Out(1)
@@ -184,6 +189,7 @@ class Planner(wiring.Component):
             "pending": Out(G),
             "holds": Out(G),
             "all_ready": Out(1),
+            "trigger_ready": Out(1),
             "job_due": Out(1),
             "playing": Out(1),
             "ended": Out(1),
@@ -341,8 +347,14 @@ class Planner(wiring.Component):
         # every group loaded and waiting, registered from this cycle's changes: a trigger or a
         # retake makes it false; else each group of the mode neither playing nor pulsing now
         # (a pulse only changes a group that plays) and loaded (or its load ends now)
-        m.d.sync += self.all_ready.eq(~self.trigger & ~self.retake.valid
-                                      & (~active | (~pending & ~decided & (loaded | ev))).all())
+        waits = ~self.trigger & ~self.retake.valid & (~active | (~pending & ~decided)).all()
+        # (in GROUPS, only group 0 must be loaded for a trigger, and RST_ACTIVE must allow its
+        # pulse: the others' last pulses may be recent)
+        groups = regs.order == PlaneOrder.GROUPS
+        spared = Mux(groups, ((1 << G) - 1) & ~1, 0)
+        m.d.sync += [self.all_ready.eq(waits & (~active | loaded | ev).all()),
+                     self.trigger_ready.eq(waits & (~active | loaded | ev | spared).all()
+                                           & (~groups | times.rst_over[0]))]
 
         # ---- what the bus may do next cycle (registered) ----
         self._bus_flags(m, times, info, watch, decided)

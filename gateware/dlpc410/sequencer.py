@@ -196,7 +196,7 @@ class Sequencer(wiring.Component):
             planner.active.eq(active),
             planner.rst_active.eq(init.rst_active_synced),
             planner.reload.eq(self.reload),
-            control.all_ready.eq(planner.all_ready),
+            control.all_ready.eq(planner.all_ready), control.trigger_ready.eq(planner.trigger_ready),
             control.counting.eq(init.running),
             control.initialised.eq(init.running & ~self.store_lost),
             control.strobe.eq(trig.strobe),

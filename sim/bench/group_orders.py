@@ -57,10 +57,13 @@ def check(plan):
             continue
         times, darks = timeline(order, t.lsb, t.reload, t.reload)
         times = times + o
-        # (the next frame's first pulse: the group's own a frame on, chained; else every group's
-        # offset after the next trigger, at the frame)
-        if F + (o if plan.chained else 0) < times[-1] + t.reload:
+        # (the next frame's first pulse: the group's own a frame on, chained, a reload after its
+        # last dark pulse; else every group's offset after the next trigger, at the frame, which
+        # may come once every group has made its last dark pulse: its load is checked below)
+        if plan.chained and F + o < times[-1] + t.reload:
             bad.append(f"group {g}: not loaded again {t.reload} cycles after its last dark pulse")
+        if not plan.chained and F < times[-1]:
+            bad.append(f"group {g}: its last dark pulse at {times[-1]} after the next trigger at {F}")
         pulses += list(times)
         busy += [(int(p), t.row) for p in times]
         dark_at = [j + 1 for j in range(len(times) - 1) if darks[j]]

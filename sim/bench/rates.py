@@ -84,7 +84,7 @@ def measured_rate(dmd_name, mode, strict, dclk, reading="ti", *, frames=FRAMES, 
     _same_as_model(dmd, p, [schedule.Frame(0, 8)], pins, cycles, run, f"{dmd_name} {mode}")
     # and the frame between two others is exact in every level: the window holds it, from its
     # first pulse to its last group's final dark pulse (the next frame's trigger is obeyed only
-    # once every group is loaded again, after that pulse); chained, frames overlap (a group
+    # after that pulse); chained, frames overlap (a group
     # starts the next while others end this one): the window is one period, from a frame's
     # first pulse to the next's (after the first frames, which start from the trigger), in
     # which every group shows the whole of its frame
