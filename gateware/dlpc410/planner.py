@@ -344,21 +344,26 @@ class Planner(wiring.Component):
             self.ended.eq(ended | ends_seq),
             self.job_due.eq(jobs.due),
         ]
-        # every group loaded and waiting, registered from this cycle's changes: a trigger or a
-        # retake makes it false; else each group of the mode neither playing nor pulsing now
-        # (a pulse only changes a group that plays) and loaded (or its load ends now)
+        self._ready_flags(m, times, decided)
+
+        # ---- what the bus may do next cycle (registered) ----
+        self._bus_flags(m, times, info, watch, decided)
+        return m
+
+    def _ready_flags(self, m, times, decided):
+        """``all_ready`` and ``trigger_ready``, registered from this cycle's changes: a trigger or
+        a retake makes them false; else each group of the mode neither playing nor pulsing now
+        (a pulse only changes a group that plays) and loaded (or its load ends now); for a
+        trigger in GROUPS, group 0 alone loaded, and RST_ACTIVE allowing its pulse (the others'
+        last pulses may be recent). ``decided``: the pulse applied now."""
+        G, active, regs = self._dmd.blocks, self.active, self.regs
+        pending, loaded, ev = self.pending, self.holds, self.loaded
         waits = ~self.trigger & ~self.retake.valid & (~active | (~pending & ~decided)).all()
-        # (in GROUPS, only group 0 must be loaded for a trigger, and RST_ACTIVE must allow its
-        # pulse: the others' last pulses may be recent)
         groups = regs.order == PlaneOrder.GROUPS
         spared = Mux(groups, ((1 << G) - 1) & ~1, 0)
         m.d.sync += [self.all_ready.eq(waits & (~active | loaded | ev).all()),
                      self.trigger_ready.eq(waits & (~active | loaded | ev | spared).all()
                                            & (~groups | times.rst_over[0]))]
-
-        # ---- what the bus may do next cycle (registered) ----
-        self._bus_flags(m, times, info, watch, decided)
-        return m
 
     def _playing(self, m, pending_next, ends_play):
         """Some group plays, as the pulse applied now leaves it, with the OR over the groups
