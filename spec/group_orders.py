@@ -53,6 +53,10 @@ class Terms:
     load: int
     clear: int
     slack: int = 0      # cycles a load must end before its pulse (row cycles others' pulses take)
+    # triggered, cycles from a trigger to group 0's first pulse (:func:`spec.schedule.trigger_lead`:
+    # the bus ends the operation under way when the trigger comes, other groups' first loads
+    # running then, so that no pulse waits for it)
+    guard: int = 0
 
 
 @dataclass
@@ -75,6 +79,12 @@ class GroupPlan:
     @property
     def rate_hz(self):
         return FABRIC_HZ / self.frame
+
+    @property
+    def trigger_offsets(self):
+        """Each group's first pulse after the trigger (the registers' ``group_offsets``): the
+        offsets and, triggered, the terms' ``guard``."""
+        return [o + (0 if self.chained else self.terms.guard) for o in self.offsets]
 
 
 def terms(dmd, dclk_hz, reset_mode, *, depth=8, row_period=None):
@@ -105,7 +115,7 @@ def sequencer_terms(dmd, dclk_hz, reset_mode, *, margin=0, **plan_kwargs):
     t = terms(dmd, dclk_hz, reset_mode, row_period=p.row_period)
     # a load done the slack the spread search leaves it for other groups' pulses taking row cycles
     t = replace(t, lsb=even(base.lsb_min), reload=p.hide + margin, t_rst=p.t_rst, t_settle=p.t_settle,
-                slack=2 * t.row * t.G + margin)
+                slack=2 * t.row * t.G + margin, guard=schedule.trigger_lead(dmd, p.beats))
     return t, base
 
 
@@ -149,8 +159,14 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
         on_bus(at, t.row, name + "/bus", present)
 
     N = t.depth                                             # the circuit's frame-boundary node
+    firsts = []
     for g in range(t.G):
         o = 2 * var(f"o{g}/2", 0, H // 2) if g else m.new_constant(0)     # even: decisions on even cycles
+        # groups but the first are alike: their offsets in rising order, first pulses a
+        # RST_ACTIVE apart as any two pulses (a symmetry the search need not explore)
+        if g > 1:
+            m.add(firsts[-1] + t.t_rst <= o)
+        firsts.append(o)
         s = [var(f"s{g}.{e}", 0, H) for e in range(N)]
         occupied = [n + (t.reload if d else 0) for n, d in zip(lengths, dark, strict=True)]
         end = o + span
@@ -168,7 +184,7 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
         if chained:
             m.add(F == final + t.reload - o)
         else:
-            m.add(F >= final)
+            m.add(F >= final + t.guard)
         loads, clears = [], []
         for e in range(N):
             m.add(s[e] == o).only_enforce_if(x[N, e])
@@ -188,6 +204,9 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
             ld = var(f"l{g}.{e}", -H, H)
             m.add(ld >= before + frozen)
             done = m.add(ld + t.load + t.slack <= s[e])
+            if g == 0 and not chained:
+                # group 0's first plane loaded by the trigger, its guard before the pulse
+                m.add(ld + t.load + t.guard <= s[e]).only_enforce_if(x[N, e])
             if chained:
                 # the first plane's load, in the dark gap after the group's own frame before:
                 # the slack that gap leaves (the sequencer's dark gap covers one load and its
@@ -212,6 +231,12 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
             m.add(c >= s[a] + frozen).only_enforce_if(x[a, N])
         on_bus(c, t.clear, f"cf{g}", ~last_dark)
         keep.append((o, s, loads, clears, c))
+    if not chained and t.guard:
+        # the trigger, its guard before group 0's pulse: RST_ACTIVE over for that pulse by then
+        for k in (0, 1):
+            at = var(f"trigger@{k}")
+            m.add(at == k * F - t.guard)
+            rst.append(m.new_fixed_size_interval_var(at, t.guard, f"trigger@{k}"))
     m.add_no_overlap(rst)
     m.add_no_overlap(bus)
     # (chained, the frame is each group's span: the shortest, the last plane a dark one)
@@ -244,9 +269,10 @@ def find(dmd, dclk_hz, reset_mode, *, seconds=60.0, workers=2, extra_rows=4, mar
     (:class:`spec.schedule.Plan` of :attr:`~spec.registers.PlaneOrder.GROUPS`, its
     :class:`GroupPlan`), or None. The solver places each load anywhere in its window, the model's
     queue where it comes: should the model make a pulse late, the LSB takes a row cycle more, up
-    to ``extra_rows``. Triggered, two searches at each LSB: each load done the sequencer terms'
-    slack before its pulse (room for other groups' pulses), and with none but ``margin``
-    (tighter, so the model's queue may make it late); the faster plan that plays is kept.
+    to ``extra_rows``. Triggered, three searches at each LSB: each load done the sequencer terms'
+    slack before its pulse (room for other groups' pulses), and two (seeds) with none but
+    ``margin`` (tighter, so the model's queue may make it late); the fastest plan that plays is
+    kept, every offset the terms' ``guard`` more (:attr:`GroupPlan.trigger_offsets`).
     ``margin``: as :func:`sequencer_terms`'s. ``chained``: each
     frame follows the one before without a trigger (:attr:`~spec.schedule.Params.chain`), each
     group its own frame after its own; the solver's loads may be placed where the sequencer's
@@ -256,7 +282,7 @@ def find(dmd, dclk_hz, reset_mode, *, seconds=60.0, workers=2, extra_rows=4, mar
         base = replace(base, params=replace(base.params, chain=True))
     # triggered, the loads' slack for other groups' pulses both ways: none (the memory's margin
     # only) and the spread search's; chained, the frame is a group's span whatever the slack
-    slacks = ((seq_terms.slack, attempts),) if chained else ((margin, 1), (seq_terms.slack, 1))
+    slacks = ((seq_terms.slack, attempts),) if chained else ((margin, 2), (seq_terms.slack, 1))
     for extra in range(extra_rows + 1):
         kept = []
         for slack, seeds in slacks:
@@ -265,7 +291,7 @@ def find(dmd, dclk_hz, reset_mode, *, seconds=60.0, workers=2, extra_rows=4, mar
                 found = solve(t, seconds=seconds, workers=workers, seed=seed, chained=chained)
                 if found is None:
                     break
-                plan = played(dmd, base, t.lsb, found.orders, found.offsets)
+                plan = played(dmd, base, t.lsb, found.orders, found.trigger_offsets)
                 if plan is not None:
                     kept.append((plan, found))
                     if chained:            # (every chained plan has the same frame)

@@ -332,11 +332,14 @@ def register_faults(wire, row_cycles, clear_row_cycles):
 
     ``stagger_keepable``: in a phased mode each group's first pulse is timed from the one before
     it, so groups a stagger apart keep their times exactly when the stagger is 0 or at least a
-    block clear's row cycles (no load of a clear's length fits between two first pulses);
+    block clear's row cycles (no load of a clear's length fits between two first pulses), and
+    :data:`spec.registers.MIN_CHAINED` (the notice a timed first pulse needs);
     ``group_offsets_keepable``: likewise each group's offset of :attr:`PlaneOrder.GROUPS
     <spec.registers.PlaneOrder.GROUPS>` (each is timed from the first pulses a trigger times at
-    once), and group 0's is 0: its first pulse starts the frame (the trigger's latency, the
-    camera, ``sync_out``) and no group's comes before it.
+    once, group 0's included), and no group's is below group 0's: its first pulse starts the
+    frame (the trigger's latency, the camera, ``sync_out``). Group 0's offset may leave the bus
+    time to end an operation under way when the trigger comes (in GROUPS, once frames follow
+    triggers, other groups' first loads may still run then: :class:`spec.schedule.Params`).
 
     ``order_table_permutation``, ``group_tables_permutation``: in :attr:`PlaneOrder.TABLE
     <spec.registers.PlaneOrder.TABLE>` the order table, in :attr:`PlaneOrder.GROUPS
@@ -361,11 +364,12 @@ def register_faults(wire, row_cycles, clear_row_cycles):
     width = next(f.width for f in _registers.FIELDS if f.name == "group_offsets")
     offsets = [_bits(wire["group_offsets"], width * g, width) for g in range(_registers.MAX_GROUPS)]
     faults["group_offsets_even"] = _any([(o & 1) != 0 for o in offsets])
+    least = max(clear_row_cycles * row_cycles, _registers.MIN_CHAINED)
     faults["group_offsets_keepable"] = ((wire["order"] == _registers.PlaneOrder.GROUPS.value)
-                                        & ((offsets[0] != 0) | _any([(o != 0) & (o < clear_row_cycles * row_cycles)
-                                                                     for o in offsets[1:]])))
+                                        & (_any([(o != 0) & (o < least) for o in offsets])
+                                           | _any([o < offsets[0] for o in offsets[1:]])))
     faults["stagger_keepable"] = ((wire["reset_mode"] != _registers.ResetMode.GLOBAL.value) & (wire["stagger"] != 0)
-                                  & (wire["stagger"] < clear_row_cycles * row_cycles))
+                                  & (wire["stagger"] < least))
     faults["order_table_permutation"] = ((wire["order"] == _registers.PlaneOrder.TABLE.value)
                                          & (_permutation(wire["order_table"], 0) == 0))
     faults["group_tables_permutation"] = ((wire["order"] == _registers.PlaneOrder.GROUPS.value)

@@ -40,10 +40,13 @@ cannot be made on time is made late and counted (the plan below never lets that 
 A trigger strobe at cycle ``s`` is obeyed when every group is loaded and waiting: group ``g``'s
 first pulse falls due at ``s + 2 + g * stagger`` (the frame control's decision takes a cycle);
 otherwise it is counted as an overrun. In GROUPS, where each group's first pulse comes at its own
-offset, once frames follow triggers only group 0 (offset 0) must be loaded, and RST_ACTIVE must
-allow its pulse: the others wait with their first loads under way, each due by its own offset
-(the plan finder's plans make none late; a late one is counted). After a start or a frame taken
-while waiting (every first plane queued at once) the trigger waits for every group again. A
+offset, once frames follow triggers, and group 0's offset is not 0, only group 0 must be loaded,
+and RST_ACTIVE must allow its pulse: the others wait with their first loads under way, each due
+by its own offset (the plan finder's plans make none late; a late one is counted), and group 0's
+offset gives the bus time to end the operation under way when the trigger comes (a row, or a
+block's clear: no pulse waits for it, whenever the trigger comes). With group 0's offset 0, and
+after a start or a frame taken while waiting (every first plane queued at once), the trigger
+waits for every group. A
 pulse due at ``T`` is made on the first free even cycle from ``even(T)`` on, and counts as late
 when made after ``even(T)``.
 
@@ -76,14 +79,15 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .facts import SETTLE_READINGS, TIMING, BlockMode
-from .registers import MAX_GROUPS, MIN_SETTLE, PlaneOrder, ResetMode, Source, TriggerMode, group_size
+from .registers import MAX_GROUPS, MIN_CHAINED, MIN_SETTLE, PlaneOrder, ResetMode, Source, TriggerMode, group_size
 
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate", "FABRIC_HZ",
            "back_to_back", "beats_at", "row_cycles", "row_rate_words",
            "plan", "bound", "paper_eq_rate_hz", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS",
            "flush_rows", "PAPER_SETTLE_CYCLES", "MIN_SETTLE", "RST_MARGIN",
            "FALL_LATENCY", "DECISION_TO_PINS", "PACE_LAG",
-           "even", "shows_depth", "ready_cycle", "reload_bound", "reload_cycles", "on_time", "frame_period", "timeline"]
+           "even", "trigger_lead", "TIMED_NOTICE",
+           "shows_depth", "ready_cycle", "reload_bound", "reload_cycles", "on_time", "frame_period", "timeline"]
 
 #: The ``dmd`` domain's clock: every cycle count of the model and the sequencer is in its cycles.
 #: DCLK is this (one beat per cycle) or twice this (two beats per cycle: 400 MHz through the
@@ -109,6 +113,21 @@ def row_cycles(dmd, beats=1):
     """``dmd`` cycles of one row cycle: the DMD's DCLK cycles per row over the beats per cycle."""
     assert dmd.dclk_per_row % beats == 0
     return dmd.dclk_per_row // beats
+
+
+#: Cycles after the pulses a trigger times at once (two after it) that the bus may still start an
+#: operation without knowing of a first pulse timed from them (the timer before it has just
+#: ended, and its flags are registered): such an operation must end by that pulse.
+TIMED_NOTICE = 2
+
+
+def trigger_lead(dmd, beats=1):
+    """The least offset of group 0 in GROUPS by which a trigger may come while other groups'
+    loads run (:meth:`_Model.steady`): the bus's longest operation (a row, or a block's clear)
+    under way when the trigger comes, or started before the bus knows of the pulse
+    (:data:`TIMED_NOTICE`), ends within it, and a timed first pulse keeps its time
+    (:data:`spec.registers.MIN_CHAINED`)."""
+    return even(max(max(1, dmd.clear_row_cycles) * row_cycles(dmd, beats) + TIMED_NOTICE, MIN_CHAINED))
 
 
 #: First load this many cycles after INIT_ACTIVE falls (DLPC910: first DVALID >= 64 clocks).
@@ -222,7 +241,8 @@ class Params:
         tables = [list(t) + list(range(len(t), 8)) for t in self.group_tables] + [list(range(8))] * unused
         regs.update(reset_mode=self.reset_mode, order=self.order, order_table=list(self.order_table),
                     group_tables=[e for t in tables for e in t],
-                    group_offsets=list(self.group_offsets) + [0] * unused,
+                    # (the unused groups' as group 0's: none below it)
+                    group_offsets=list(self.group_offsets) + list(self.group_offsets[:1] or [0]) * unused,
                     chain=int(self.chain), strict_rst=int(self.strict_rst), trigger=self.trigger,
                     trigger_hold=int(self.trigger_hold),
                     source=self.source, row_period=self.row_period or row_cycles(dmd, self.beats),
@@ -496,9 +516,12 @@ class _Model:
         return all(not s.pending and s.loaded_at is not None and s.loaded_at <= t for s in self.st)
 
     def steady(self):
-        """In GROUPS, frames follow a trigger's: each group's first plane was queued at its own
-        last dark pulse (not all at once, by a start or a frame taken while waiting)."""
-        return self.p.order == PlaneOrder.GROUPS and not self.reloaded
+        """In GROUPS with group 0 offset (its offset room for the bus to end an operation under
+        way when the trigger comes), frames follow a trigger's: each group's first plane was
+        queued at its own last dark pulse (not all at once, by a start or a frame taken while
+        waiting)."""
+        p = self.p
+        return p.order == PlaneOrder.GROUPS and p.group_offsets[0] != 0 and not self.reloaded
 
     def needs_loaded(self):
         """The groups that must be loaded for a trigger to be obeyed: every one, or when
@@ -714,7 +737,10 @@ class _Model:
         if not cands:
             return None
         nt = max(t + 1, min(cands), self.bus_free)
-        for exact in (take_at, hold_at):
+        # (a strobe, a take or a held trigger's release is seen on its cycle, the bus busy or
+        # not: the bus's next decision knows of the pulses it times)
+        strobe_at = self.strobes[self.si] if self.si < len(self.strobes) else None
+        for exact in (take_at, hold_at, strobe_at):
             if exact is not None and t < exact < nt:
                 nt = exact
         strobe_next = self.si < len(self.strobes) and self.strobes[self.si] == nt

@@ -260,14 +260,21 @@ def test_a_load_row_waits_for_a_dark_pulses_clears(test_name, monkeypatch):
     assert schedule.simulate(dmd, p, model_frames(offered, None, dmd), strobes).late > 0
 
 
+#: Group 0's offset in GROUPS that lets a trigger wait for its load only.
+LEAD = schedule.trigger_lead(DMD)
+
+
 @pytest.mark.verilog
-def test_groups_trigger_waits_for_group_0s_load_only(test_name, monkeypatch):
-    """In GROUPS a trigger is obeyed once every group has made its frame's last dark pulse and
-    group 0 is loaded: the other group's first load is still on the pins after the frame's first
-    pulse, done by its own offset. Triggers faster than frames, held: no pulse late, commands
-    the model's cycle for cycle, every level exact, and the frames come sooner than when the
-    trigger waits for every group to be loaded."""
-    tables, offsets = ((2, 4, 0, 7, 5, 1, 6, 3), (6, 7, 1, 0, 3, 4, 5, 2)), (0, 312)
+@pytest.mark.parametrize("lead", [LEAD, 0], ids=["group_0_offset", "group_0_at_once"])
+def test_groups_trigger_waits_for_group_0s_load_only(lead, test_name, monkeypatch):
+    """In GROUPS, with group 0 offset, a trigger is obeyed once every group has made its frame's
+    last dark pulse and group 0 is loaded: the other group's first load is still on the pins
+    after the frame's first pulse, done by its own offset. Triggers faster than frames, held: no
+    pulse late, commands the model's cycle for cycle, every level exact, and the frames come
+    sooner than when the trigger waits for every group to be loaded. With group 0's offset 0 (no
+    time for the bus to end a row under way) the trigger waits for every group: no group's rows
+    between the frame's first pulses, in gateware and model alike."""
+    tables, offsets = ((2, 4, 0, 7, 5, 1, 6, 3), (6, 7, 1, 0, 3, 4, 5, 2)), (lead, 312)
     p = replace(fast_plan(reset_mode=ResetMode.DUAL, trigger_hold=True).params, order=PlaneOrder.GROUPS,
                 group_tables=tables, group_offsets=offsets)
     frames = [(0, 8)]
@@ -287,12 +294,46 @@ def test_groups_trigger_waits_for_group_0s_load_only(test_name, monkeypatch):
         per_frame = len(table) + sum((p.lsb << e) < p.hide for e in table) + ((p.lsb << table[-1]) >= p.hide)
         firsts[g] = mine[::per_frame]
     after_trigger = [sum(a < t < b for t in rows) for a, b in zip(firsts[0][1:], firsts[1][1:], strict=False)]
-    assert after_trigger and all(n > 0 for n in after_trigger), after_trigger
+    assert after_trigger and all((n > 0) == bool(lead) for n in after_trigger), after_trigger
+    if not lead:
+        return
     # waiting for every group to be loaded, the same triggers start frames later
     starts = model.frame_starts
     monkeypatch.setattr(schedule._Model, "needs_loaded", lambda self: self.st)
     slower = schedule.simulate(DMD, p, model_frames(frames, None), [t + PIN_TO_STROBE for t in pins]).frame_starts
     assert starts[1] - starts[0] < slower[1] - slower[0]
+
+
+@pytest.mark.verilog
+@pytest.mark.parametrize("extra", [0, -2], ids=["trigger_lead", "a_notice_short"])
+def test_groups_trigger_during_a_row(extra, test_name):
+    """In GROUPS with group 0 offset, triggers come while the other group's first load runs, at
+    many phases of its rows (eight triggers, three spacings), on a DMD of four cycles a row, at the
+    settle path's LSB: with
+    group 0's offset the trigger lead, gateware and model agree cycle for cycle and no pulse is
+    late; two cycles less (a row cycle, without the bus's notice of the timed first pulse) the
+    gateware starts a row the model holds back."""
+    dmd = TEST_DMD_400                                          # at 200 MHz: four cycles a row
+    lead = schedule.trigger_lead(dmd) + extra
+    assert schedule.trigger_lead(dmd) == schedule.row_cycles(dmd) + schedule.TIMED_NOTICE
+    p = fast_plan(dmd, reset_mode=ResetMode.DUAL, trigger_hold=True).params
+    settle_path = p.t_rst + p.t_settle + 2 * dmd.clear_row_cycles * schedule.row_cycles(dmd)
+    p = replace(p, lsb=settle_path, dark_gap=p.hide, order=PlaneOrder.GROUPS,
+                group_tables=((2, 4, 3, 7, 1, 5, 0, 6), (7, 5, 3, 1, 4, 6, 2, 0)), group_offsets=(lead, 362 + lead))
+    frames = model_frames([(0, 8)], None, dmd)
+    first = next_ready(p, frames, [], dmd) - PIN_TO_STROBE
+    period = schedule.frame_period(dmd, p, schedule.Frame(0, 8))
+    same = []
+    for k in range(3):
+        pins = [first + j * (period // 3 + k) for j in range(8)]
+        model = schedule.simulate(dmd, p, frames, [t + PIN_TO_STROBE for t in pins])
+        run = run_rig(dmd, p, [(0, 8)], None, pins=pins, cycles=max(c[0] for c in model.commands) + period,
+                      name=f"{test_name}_{k}")
+        assert len(model.accepted) >= 3
+        same.append(run.commands == model.decoded())
+        if extra == 0:
+            assert same[-1] and run.status["late"] == 0 == model.late
+    assert all(same) == (extra == 0)
 
 
 @pytest.mark.verilog
@@ -302,7 +343,7 @@ def test_groups_trigger_rule_to_the_cycle(strict, test_name):
     0's pulse (strict reading: after the other group's last dark pulse), or (loose) once that
     pulse has reached the frame control. A strobe a cycle sooner is an overrun, at that cycle it
     is obeyed: the gateware agrees with the model on both, commands cycle for cycle."""
-    tables, offsets = ((2, 4, 0, 7, 5, 1, 6, 3), (6, 7, 1, 0, 3, 4, 5, 2)), (0, 312)
+    tables, offsets = ((2, 4, 0, 7, 5, 1, 6, 3), (6, 7, 1, 0, 3, 4, 5, 2)), (LEAD, 312)
     p = replace(fast_plan(reset_mode=ResetMode.DUAL).params, strict_rst=strict, order=PlaneOrder.GROUPS,
                 group_tables=tables, group_offsets=offsets)
     frames = model_frames([(0, 8)], None)
@@ -333,7 +374,7 @@ def test_groups_trigger_after_a_reload_waits_for_every_group(test_name, monkeypa
     after the reload makes pulses late."""
     tables = ((0, 3, 7, 2, 1, 6, 5, 4), (5, 2, 0, 1, 4, 3, 7, 6), (4, 3, 5, 2, 6, 1, 0, 7), (4, 3, 2, 6, 1, 7, 0, 5))
     p = replace(fast_plan(reset_mode=ResetMode.SINGLE, trigger_hold=True).params, order=PlaneOrder.GROUPS,
-                group_tables=tables, group_offsets=(0, 100, 200, 300))
+                group_tables=tables, group_offsets=tuple(LEAD + o for o in (0, 100, 200, 300)))
     first = next_ready(p, model_frames([(0, 8)], None), []) - PIN_TO_STROBE
     idle = waiting_after(p, [(0, 8)], [first + PIN_TO_STROBE]) + 30
     offered = [(0, 8, 0), (1, 8, idle)]

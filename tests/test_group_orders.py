@@ -12,7 +12,7 @@ import pytest
 from sim.bench import group_orders as go
 from spec import ceiling, records, schedule
 from spec import group_orders as solver
-from spec.facts import TEST_DMD
+from spec.facts import DMDS, TEST_DMD
 from spec.registers import PlaneOrder, ResetMode
 
 DEPTH = 4
@@ -109,7 +109,11 @@ def test_the_finder_gives_a_register_set_the_projector_takes():
     plan, groups = found
     p = plan.params
     assert p.order == PlaneOrder.GROUPS and go.check(groups) == []
-    assert (p.group_tables, p.group_offsets) == (tuple(groups.orders), tuple(groups.offsets))
+    # (triggered, every offset the terms' guard more than the solver's: group 0's first pulse
+    # leaves the bus time to end a row or a clear under way when the trigger comes)
+    assert groups.terms.guard == schedule.trigger_lead(TEST_DMD) == 4
+    assert (p.group_tables, p.group_offsets) == (tuple(groups.orders),
+                                                 tuple(o + groups.terms.guard for o in groups.offsets))
     frame = schedule.Frame(0, 8)
     assert schedule.simulate(TEST_DMD, p, [frame], [schedule.ready_cycle(TEST_DMD, p, frame)]).late == 0
     assert plan.frame_cycles == schedule.frame_period(TEST_DMD, p, frame)
@@ -158,3 +162,36 @@ def test_chained_plans_end_each_groups_frame_at_its_own():
         firsts = [at for at, h, kind, _, e in r.pulses if h == g and kind == "plane" and e == p.group_tables[g][0]]
         darks = [at for at, h, kind, fi, _ in r.pulses if h == g and kind == "dark" and fi == 1]
         assert firsts[2] == darks[-1] + p.dark_gap
+
+
+def test_a_trigger_at_any_cycle_after_ready_makes_no_pulse_late(monkeypatch):
+    """Once frames follow triggers, a trigger waits for group 0's load only, and other groups'
+    first loads run on: a trigger may come mid-row. Group 0's offset (the terms' guard, a row
+    cycle and the bus's notice on the DLP7000) lets the bus end the row before the first pulse, so a trigger at any
+    cycle of two row cycles from the first it may come at makes no pulse late, in the schedule
+    model on the full DLP7000 at 200 MHz (a plan the finder found there). With group 0 at once
+    under the same rule most of those triggers make its pulse late (so the sequencer waits for
+    every group then)."""
+    dmd = DMDS["dlp7000"]
+    t, base = solver.sequencer_terms(dmd, 200e6, ResetMode.DUAL, trigger_hold=True)
+    orders = ((6, 5, 1, 3, 2, 7, 0, 4), (7, 3, 0, 5, 1, 2, 6, 4), (5, 6, 1, 2, 4, 0, 3, 7), (6, 7, 1, 4, 5, 2, 3, 0),
+              (4, 7, 0, 5, 2, 1, 3, 6), (3, 1, 4, 7, 6, 2, 0, 5), (4, 5, 1, 0, 7, 2, 3, 6), (5, 6, 4, 7, 2, 1, 3, 0))
+    offsets = (0, 2222, 3136, 5028, 5942, 8472, 10088, 11034)
+    frame = schedule.Frame(0, 8)
+    assert t.guard == schedule.trigger_lead(dmd) == t.row + schedule.TIMED_NOTICE == 18
+
+    def lates(guard):
+        p = replace(base.params, lsb=t.lsb, order=PlaneOrder.GROUPS, group_tables=orders,
+                    group_offsets=tuple(o + guard for o in offsets), trigger_hold=False)
+        first = schedule.ready_cycle(dmd, p, frame)
+        ready = schedule.back_to_back(dmd, p, frame, 2).accepted[1]
+        out = []
+        for k in range(2 * t.row):
+            r = schedule.simulate(dmd, p, [frame], [first, ready + k], max_frames=1)
+            assert len(r.accepted) == 2
+            out.append(r.late)
+        return out
+
+    assert lates(t.guard) == [0] * 2 * t.row
+    monkeypatch.setattr(schedule._Model, "steady", lambda self: not self.reloaded)
+    assert sum(n > 0 for n in lates(0)) > t.row

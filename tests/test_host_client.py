@@ -20,7 +20,7 @@ from sim.models.net import Model
 from sim.models.slots import SlotPolicy
 from spec import records
 from spec.facts import DMDS, TEST_DMD
-from spec.registers import PlaneOrder, ResetMode, TriggerMode
+from spec.registers import MAX_GROUPS, MIN_CHAINED, PlaneOrder, ResetMode, TriggerMode
 
 #: The store's refusals, summed into the status reply's ``store_rows_refused``.
 REFUSALS = ("rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot", "rows_no_base")
@@ -415,8 +415,20 @@ def test_sequencer_record_refuses_what_the_projector_would_drop():
     with pytest.raises(ValueError, match="group_offsets_keepable"):
         codec.sequencer_record({**groups, "group_offsets": 14 << 24}, dmd=DMDS["dlp7000"])
     assert not records.register_faults({**groups, "group_offsets": 16 << 24}, 16, 1)["group_offsets_keepable"]
-    # group 0 starts the frame: its offset is 0
+    # group 0 starts the frame: no group's offset below its own; its own, if not 0, a clear's
+    # row cycles at least too
     assert records.register_faults({**groups, "group_offsets": 16}, 16, 1)["group_offsets_keepable"]
+    assert not records.register_faults({**groups, "group_offsets": sum(16 << 24 * g for g in range(MAX_GROUPS))},
+                                       16, 1)["group_offsets_keepable"]
+    assert records.register_faults({**groups, "group_offsets": sum(14 << 24 * g for g in range(MAX_GROUPS))},
+                                   16, 1)["group_offsets_keepable"]
+    # where a clear is shorter than MIN_CHAINED (2 cycles), an offset or a stagger of 2 is refused:
+    # the sequencer's timed first pulse needs that much notice
+    assert records.register_faults({**groups, "group_offsets": 2 << 24}, 2, 1)["group_offsets_keepable"]
+    assert not records.register_faults({**groups, "group_offsets": MIN_CHAINED << 24}, 2, 1)["group_offsets_keepable"]
+    phased = {**wire, "reset_mode": ResetMode.DUAL.value}
+    assert records.register_faults({**phased, "stagger": 2}, 2, 1)["stagger_keepable"]
+    assert not records.register_faults({**phased, "stagger": MIN_CHAINED}, 2, 1)["stagger_keepable"]
     with pytest.raises(ValueError, match="group_offsets_even"):
         codec.sequencer_record({**groups, "group_offsets": 4001 << 24}, dmd=TEST_DMD)
     codec.sequencer_record({**groups, "group_offsets": 4000 << 24}, dmd=TEST_DMD)

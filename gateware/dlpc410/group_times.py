@@ -12,14 +12,14 @@ bus's flags (:class:`~gateware.dlpc410.planner.Planner`) from them with little l
 * a trigger obeyed: group 0's first pulse falls due two cycles after the trigger's cycle, and
   group ``g``'s ``stagger`` after group ``g - 1``'s (each loaded as the one before ends; with
   ``stagger`` 0 all at once). In :attr:`~spec.registers.PlaneOrder.GROUPS` each group's first
-  pulse is its own offset after group 0's instead (loaded as a timer of that time, ``start``,
-  ends; offset 0: at once). A group waiting in that chain has no time yet: its flags say not
-  due, and not soon (``stagger`` and each offset are 0 or at least a clear's row cycles, so no
-  load that a first pulse could cut short can start meanwhile:
-  :func:`spec.records.register_faults`).
+  pulse is its own offset after the trigger's two cycles instead, group 0's included (loaded
+  as a timer of that time, ``start``, ends; offset 0: at once). A group waiting in that chain
+  has no time yet: its flags say not due, and not soon (``stagger`` and each offset are 0 or at
+  least a clear's row cycles, so no load that a first pulse could cut short can start
+  meanwhile: :func:`spec.records.register_faults`).
 """
 
-from amaranth import Cat, Const, Module, Mux, Signal
+from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -107,14 +107,14 @@ class GroupTimes(wiring.Component):
         # its offset (registered: the registers, and so ``active``, hold still long before a
         # trigger is obeyed)
         offsets, stagger_zero = Signal(), Signal()
-        firsts = [Signal(24, name=f"first{g}") for g in range(G)]      # (group 0's unused)
+        firsts = [Signal(24, name=f"first{g}") for g in range(G)]      # (group 0's: its offset)
         m.d.sync += [offsets.eq(regs.order == PlaneOrder.GROUPS), stagger_zero.eq(regs.stagger == 0)]
         m.d.sync += [first.eq(Mux(offsets, regs.group_offsets[g], regs.stagger)) for g, first in enumerate(firsts)]
         # the groups a trigger obeyed times at once, and those it chains
         at_once, chains = self.at_once, Signal(G)
-        # (group 0 always at once: its offset is 0, :func:`spec.records.register_faults`)
-        unchained = Cat(Const(1) if g == 0 else Mux(offsets, first == 0, stagger_zero)
-                        for g, first in enumerate(firsts))
+        # (group 0 at once unless GROUPS offsets it: its offset is the least,
+        # :func:`spec.records.register_faults`)
+        unchained = Cat(Mux(offsets, first == 0, stagger_zero if g else 1) for g, first in enumerate(firsts))
         m.d.sync += [at_once.eq(self.active & unchained), chains.eq(self.active & ~unchained)]
         # the time of the pulses at once, for the offsets
         m.submodules.start = start = Countdown(3, lag=LAG)
@@ -143,12 +143,11 @@ class GroupTimes(wiring.Component):
             delay_flags = pulse_cd.flags_registered(m, self.delay[g], f"delay_flags{g}")
             first_flags = pulse_cd.flags_registered(m, firsts[g], f"first_flags{g}")
             first = self.obey & at_once[g]
-            if g:
-                after = Mux(offsets, start.ends, pulse_cds[g - 1].ends & (~chained[g - 1] if g > 1 else 1))
-                chain = chained[g] & after
-                m.d.sync += chained[g].eq(Mux(self.abandon | chain, 0, chained[g] | (self.obey & chains[g])))
-            else:
-                chain = Const(0)
+            # (group 0 waits only for its offset: in the other orders it is never chained)
+            after = (Mux(offsets, start.ends, pulse_cds[g - 1].ends & (~chained[g - 1] if g > 1 else 1))
+                     if g else start.ends)
+            chain = chained[g] & after
+            m.d.sync += chained[g].eq(Mux(self.abandon | chain, 0, chained[g] | (self.obey & chains[g])))
             # (one of the three at most: a group pulses only loaded, never waiting for a trigger)
             m.d.comb += [
                 pulse_cd.load.eq(self.pulse[g] | first | chain),

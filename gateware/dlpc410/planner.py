@@ -128,9 +128,9 @@ class Planner(wiring.Component):
         cycle's state is; the frame control counts in its own decisions).
     trigger_ready : Out(1)
         A trigger may be obeyed (registered, as ``all_ready``): no group of the reset mode plays,
-        and every one is loaded, or in ``GROUPS`` group 0 (offset 0, the first to pulse) with
-        RST_ACTIVE allowing its pulse: each other group's first load is under way and due by its
-        own offset.
+        and every one is loaded, or in ``GROUPS`` with group 0 offset (the first to pulse, its
+        offset room for the bus to end an operation under way) group 0 with RST_ACTIVE allowing
+        its pulse: each other group's first load is under way and due by its own offset.
     job_due : Out(1)
         A load job is on its way (it is written within three cycles).
     playing : Out(1)
@@ -355,11 +355,13 @@ class Planner(wiring.Component):
         a retake makes them false; else each group of the mode neither playing nor pulsing now
         (a pulse only changes a group that plays) and loaded (or its load ends now); for a
         trigger in GROUPS, group 0 alone loaded, and RST_ACTIVE allowing its pulse (the others'
-        last pulses may be recent). ``decided``: the pulse applied now."""
+        last pulses may be recent), if its offset leaves the bus time to end what it does when
+        the trigger comes (else every group, the bus idle). ``decided``: the pulse applied now."""
         G, active, regs = self._dmd.blocks, self.active, self.regs
         pending, loaded, ev = self.pending, self.holds, self.loaded
         waits = ~self.trigger & ~self.retake.valid & (~active | (~pending & ~decided)).all()
-        groups = regs.order == PlaneOrder.GROUPS
+        groups = Signal()               # (the registers hold still long before a trigger)
+        m.d.sync += groups.eq((regs.order == PlaneOrder.GROUPS) & (regs.group_offsets[0] != 0))
         spared = Mux(groups, ((1 << G) - 1) & ~1, 0)
         m.d.sync += [self.all_ready.eq(waits & (~active | loaded | ev).all()),
                      self.trigger_ready.eq(waits & (~active | loaded | ev | spared).all()

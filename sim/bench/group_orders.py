@@ -47,7 +47,9 @@ def check(plan):
     pulses from :func:`spec.schedule.timeline`, then over two frames back to back: every two
     pulses of the DMD ``t_rst`` apart, each load after its group's pulse before it plus ``t_rst +
     t_settle`` and done by its own pulse, each clear likewise before its dark pulse, the bus (a
-    row cycle a pulse, the loads, the clears) never doing two things at once, every plane once."""
+    row cycle a pulse, the loads, the clears) never doing two things at once, every plane once;
+    triggered, the trigger (the terms' ``guard`` before group 0's first pulse) after every
+    group's last dark pulse and every pulse's RST_ACTIVE, and after group 0's first load."""
     t, F, bad = plan.terms, plan.frame, []
     frozen = t.t_rst + t.t_settle
     pulses, busy = [], []
@@ -62,8 +64,11 @@ def check(plan):
         # may come once every group has made its last dark pulse: its load is checked below)
         if plan.chained and F + o < times[-1] + t.reload:
             bad.append(f"group {g}: not loaded again {t.reload} cycles after its last dark pulse")
-        if not plan.chained and F < times[-1]:
-            bad.append(f"group {g}: its last dark pulse at {times[-1]} after the next trigger at {F}")
+        trigger = F - (0 if plan.chained else t.guard)
+        if not plan.chained and trigger < times[-1]:
+            bad.append(f"group {g}: its last dark pulse at {times[-1]} after the next trigger at {trigger}")
+        if not plan.chained and t.guard and times.max() + t.t_rst > trigger:
+            bad.append(f"group {g}: a pulse's RST_ACTIVE not over by the next trigger at {trigger}")
         pulses += list(times)
         busy += [(int(p), t.row) for p in times]
         dark_at = [j + 1 for j in range(len(times) - 1) if darks[j]]
@@ -71,6 +76,8 @@ def check(plan):
             # (chained, the first plane's load is in the dark gap after the group's frame
             # before: the slack that gap leaves, not the one a load behind a plane keeps)
             slack = t.reload - frozen - t.load if plan.chained and j == 0 else t.slack
+            if g == 0 and j == 0 and not plan.chained:
+                slack = max(slack, t.guard)         # (loaded by the trigger)
             if ld < before + frozen or ld + t.load + slack > times[j]:
                 bad.append(f"group {g}: the load of plane {j} at {ld} outside [{before + frozen}, {times[j]}]")
             busy.append((ld, t.load))
@@ -118,7 +125,7 @@ def figures(*, seconds=120.0):
         print(f"DLP7000, dual, {dclk / 1e6:g} MHz, rows every {pace} cycles: {found.rate_hz:.1f} Hz "
               f"({found.frame} cycles, {found.rate_hz / bound(dmd, dclk):.1%} of the bound; one timeline's ceiling "
               f"{top.rate_hz:.1f} Hz); no such plan beats {found.lower} cycles = {FABRIC_HZ / found.lower:.1f} Hz")
-        for o, order in sorted(zip(found.offsets, found.orders, strict=True)):
+        for o, order in sorted(zip(found.trigger_offsets, found.orders, strict=True)):
             print(f"  offset {o:>6}  order {' '.join(map(str, order))}")
         # the plan finder's, on the gateware (the store stand-in at the row cycle; the sequencer
         # paces rows at the plan's row period)
