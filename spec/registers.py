@@ -13,8 +13,8 @@ binds.
 import enum
 
 __all__ = ["ResetMode", "PlaneOrder", "TriggerMode", "Source", "FIELDS", "Field",
-           "TIME_BITS", "LSB_BITS", "DURATION_BITS", "MIN_SETTLE", "MIN_CHAINED", "MAX_GROUPS", "group_size",
-           "layout_bits", "pack", "unpack"]
+           "TIME_BITS", "LSB_BITS", "DURATION_BITS", "MIN_SETTLE", "MIN_CHAINED", "TIMED_NOTICE", "MAX_GROUPS",
+           "group_size", "layout_bits", "pack", "unpack"]
 
 #: Width of the free-running time base. Comparisons are made on differences, so the base may
 #: wrap (every 8 days at 400 MHz) without harm; every wait is shorter than 2**(TIME_BITS-1).
@@ -32,6 +32,10 @@ MIN_SETTLE = 3
 #: The shortest ``stagger`` or group offset (not 0) the sequencer keeps exactly: a first pulse
 #: timed from the timer before it is known as due two registered stages after that timer ends.
 MIN_CHAINED = 4
+#: Cycles after the pulses a trigger times at once (two after it) that the bus may still start an
+#: operation without knowing of a first pulse timed from them (the timer before it has just
+#: ended, and its flags are registered): such an operation must end by that pulse.
+TIMED_NOTICE = 2
 
 
 class ResetMode(enum.IntEnum):

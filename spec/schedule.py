@@ -79,14 +79,24 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .facts import SETTLE_READINGS, TIMING, BlockMode
-from .registers import MAX_GROUPS, MIN_CHAINED, MIN_SETTLE, PlaneOrder, ResetMode, Source, TriggerMode, group_size
+from .registers import (
+    MAX_GROUPS,
+    MIN_CHAINED,
+    MIN_SETTLE,
+    TIMED_NOTICE,
+    PlaneOrder,
+    ResetMode,
+    Source,
+    TriggerMode,
+    group_size,
+)
 
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate", "FABRIC_HZ",
            "back_to_back", "beats_at", "row_cycles", "row_rate_words",
            "plan", "bound", "paper_eq_rate_hz", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS",
            "flush_rows", "PAPER_SETTLE_CYCLES", "MIN_SETTLE", "RST_MARGIN",
            "FALL_LATENCY", "DECISION_TO_PINS", "PACE_LAG",
-           "even", "trigger_lead", "TIMED_NOTICE",
+           "even", "trigger_lead",
            "shows_depth", "ready_cycle", "reload_bound", "reload_cycles", "on_time", "frame_period", "timeline"]
 
 #: The ``dmd`` domain's clock: every cycle count of the model and the sequencer is in its cycles.
@@ -115,17 +125,11 @@ def row_cycles(dmd, beats=1):
     return dmd.dclk_per_row // beats
 
 
-#: Cycles after the pulses a trigger times at once (two after it) that the bus may still start an
-#: operation without knowing of a first pulse timed from them (the timer before it has just
-#: ended, and its flags are registered): such an operation must end by that pulse.
-TIMED_NOTICE = 2
-
-
 def trigger_lead(dmd, beats=1):
     """The least offset of group 0 in GROUPS by which a trigger may come while other groups'
     loads run (:meth:`_Model.steady`): the bus's longest operation (a row, or a block's clear)
     under way when the trigger comes, or started before the bus knows of the pulse
-    (:data:`TIMED_NOTICE`), ends within it, and a timed first pulse keeps its time
+    (:data:`spec.registers.TIMED_NOTICE`), ends within it, and a timed first pulse keeps its time
     (:data:`spec.registers.MIN_CHAINED`)."""
     return even(max(max(1, dmd.clear_row_cycles) * row_cycles(dmd, beats) + TIMED_NOTICE, MIN_CHAINED))
 

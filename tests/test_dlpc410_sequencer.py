@@ -18,7 +18,7 @@ from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import INIT_CYCLES, dlpc410_for, frame_lights, period_light, run_bench
 from spec import group_orders, prng, schedule
 from spec.facts import TEST_DMD, TEST_DMD4, TEST_DMD4_400, TEST_DMD_400
-from spec.registers import PlaneOrder, ResetMode, Source, TriggerMode
+from spec.registers import TIMED_NOTICE, PlaneOrder, ResetMode, Source, TriggerMode
 
 DMD = TEST_DMD
 #: RST_ACTIVE and settle scaled down (run-time parameters) so that frames simulate quickly.
@@ -315,7 +315,7 @@ def test_groups_trigger_during_a_row(extra, test_name):
     gateware starts a row the model holds back."""
     dmd = TEST_DMD_400                                          # at 200 MHz: four cycles a row
     lead = schedule.trigger_lead(dmd) + extra
-    assert schedule.trigger_lead(dmd) == schedule.row_cycles(dmd) + schedule.TIMED_NOTICE
+    assert schedule.trigger_lead(dmd) == schedule.row_cycles(dmd) + TIMED_NOTICE
     p = fast_plan(dmd, reset_mode=ResetMode.DUAL, trigger_hold=True).params
     settle_path = p.t_rst + p.t_settle + 2 * dmd.clear_row_cycles * schedule.row_cycles(dmd)
     p = replace(p, lsb=settle_path, dark_gap=p.hide, order=PlaneOrder.GROUPS,

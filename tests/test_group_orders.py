@@ -13,7 +13,7 @@ from sim.bench import group_orders as go
 from spec import ceiling, records, schedule
 from spec import group_orders as solver
 from spec.facts import DMDS, TEST_DMD
-from spec.registers import PlaneOrder, ResetMode
+from spec.registers import TIMED_NOTICE, PlaneOrder, ResetMode
 
 DEPTH = 4
 
@@ -178,7 +178,7 @@ def test_a_trigger_at_any_cycle_after_ready_makes_no_pulse_late(monkeypatch):
               (4, 7, 0, 5, 2, 1, 3, 6), (3, 1, 4, 7, 6, 2, 0, 5), (4, 5, 1, 0, 7, 2, 3, 6), (5, 6, 4, 7, 2, 1, 3, 0))
     offsets = (0, 2222, 3136, 5028, 5942, 8472, 10088, 11034)
     frame = schedule.Frame(0, 8)
-    assert t.guard == schedule.trigger_lead(dmd) == t.row + schedule.TIMED_NOTICE == 18
+    assert t.guard == schedule.trigger_lead(dmd) == t.row + TIMED_NOTICE == 18
 
     def lates(guard):
         p = replace(base.params, lsb=t.lsb, order=PlaneOrder.GROUPS, group_tables=orders,

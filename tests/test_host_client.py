@@ -418,8 +418,11 @@ def test_sequencer_record_refuses_what_the_projector_would_drop():
     # group 0 starts the frame: no group's offset below its own; its own, if not 0, a clear's
     # row cycles at least too
     assert records.register_faults({**groups, "group_offsets": 16}, 16, 1)["group_offsets_keepable"]
-    assert not records.register_faults({**groups, "group_offsets": sum(16 << 24 * g for g in range(MAX_GROUPS))},
+    assert not records.register_faults({**groups, "group_offsets": sum(18 << 24 * g for g in range(MAX_GROUPS))},
                                        16, 1)["group_offsets_keepable"]
+    # (group 0's, not 0, a row under way and the bus's notice of the pulse at least: 16 + 2)
+    assert records.register_faults({**groups, "group_offsets": sum(16 << 24 * g for g in range(MAX_GROUPS))},
+                                   16, 1)["group_offsets_keepable"]
     assert records.register_faults({**groups, "group_offsets": sum(14 << 24 * g for g in range(MAX_GROUPS))},
                                    16, 1)["group_offsets_keepable"]
     # where a clear is shorter than MIN_CHAINED (2 cycles), an offset or a stagger of 2 is refused:

@@ -15,8 +15,10 @@ bus's flags (:class:`~gateware.dlpc410.planner.Planner`) from them with little l
   pulse is its own offset after the trigger's two cycles instead, group 0's included (loaded
   as a timer of that time, ``start``, ends; offset 0: at once). A group waiting in that chain
   has no time yet: its flags say not due, and not soon (``stagger`` and each offset are 0 or at
-  least a clear's row cycles, so no load that a first pulse could cut short can start
-  meanwhile: :func:`spec.records.register_faults`).
+  least a clear's row cycles and :data:`~spec.registers.MIN_CHAINED`, so no load that a first
+  pulse could cut short can start meanwhile: :func:`spec.records.register_faults`; when a
+  trigger comes while loads run, group 0's offset is at least
+  :func:`spec.schedule.trigger_lead`, which covers the row under way too).
 """
 
 from amaranth import Cat, Module, Mux, Signal
