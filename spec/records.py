@@ -336,11 +336,11 @@ def register_faults(wire, row_cycles, clear_row_cycles):
     :data:`spec.registers.MIN_CHAINED` (the notice a timed first pulse needs);
     ``group_offsets_keepable``: likewise each group's offset of :attr:`PlaneOrder.GROUPS
     <spec.registers.PlaneOrder.GROUPS>` (each is timed from the first pulses a trigger times at
-    once, group 0's included; group 0's, if not 0, a clear and
-    :data:`spec.registers.TIMED_NOTICE` at least), and no group's is below group 0's: its first pulse starts the
-    frame (the trigger's latency, the camera, ``sync_out``). Group 0's offset may leave the bus
-    time to end an operation under way when the trigger comes (in GROUPS, once frames follow
-    triggers, other groups' first loads may still run then: :class:`spec.schedule.Params`).
+    once, group 0's included; group 0's, if not 0, :func:`spec.registers.lead_cycles` at least),
+    and no group's is below group 0's: its first pulse starts the frame (the trigger's latency,
+    the camera, ``sync_out``). Group 0's offset leaves the bus time to end an operation under
+    way when the trigger comes (in GROUPS, once frames follow triggers, other groups' first loads
+    may still run then: :mod:`spec.schedule`).
 
     ``order_table_permutation``, ``group_tables_permutation``: in :attr:`PlaneOrder.TABLE
     <spec.registers.PlaneOrder.TABLE>` the order table, in :attr:`PlaneOrder.GROUPS
@@ -366,9 +366,8 @@ def register_faults(wire, row_cycles, clear_row_cycles):
     offsets = [_bits(wire["group_offsets"], width * g, width) for g in range(_registers.MAX_GROUPS)]
     faults["group_offsets_even"] = _any([(o & 1) != 0 for o in offsets])
     least = max(clear_row_cycles * row_cycles, _registers.MIN_CHAINED)
-    # (group 0's, not 0, lets a trigger come while loads run: the row under way and the bus's
-    # notice end by its pulse, :func:`spec.schedule.trigger_lead`)
-    lead = max(clear_row_cycles * row_cycles + _registers.TIMED_NOTICE, _registers.MIN_CHAINED)
+    # (group 0's, not 0, lets a trigger come while loads run)
+    lead = _registers.lead_cycles(row_cycles, clear_row_cycles)
     faults["group_offsets_keepable"] = ((wire["order"] == _registers.PlaneOrder.GROUPS.value)
                                         & (_any([(o != 0) & (o < least) for o in offsets])
                                            | ((offsets[0] != 0) & (offsets[0] < lead))

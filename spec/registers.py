@@ -14,7 +14,7 @@ import enum
 
 __all__ = ["ResetMode", "PlaneOrder", "TriggerMode", "Source", "FIELDS", "Field",
            "TIME_BITS", "LSB_BITS", "DURATION_BITS", "MIN_SETTLE", "MIN_CHAINED", "TIMED_NOTICE", "MAX_GROUPS",
-           "group_size", "layout_bits", "pack", "unpack"]
+           "lead_cycles", "group_size", "layout_bits", "pack", "unpack"]
 
 #: Width of the free-running time base. Comparisons are made on differences, so the base may
 #: wrap (every 8 days at 400 MHz) without harm; every wait is shorter than 2**(TIME_BITS-1).
@@ -36,6 +36,15 @@ MIN_CHAINED = 4
 #: operation without knowing of a first pulse timed from them (the timer before it has just
 #: ended, and its flags are registered): such an operation must end by that pulse.
 TIMED_NOTICE = 2
+
+
+def lead_cycles(row_cycles, clear_row_cycles):
+    """The least offset of group 0 (not 0) by which a trigger may come while other groups' loads
+    run: the bus's longest operation (a row, or a block's clear) under way when it comes, or
+    started before the bus knows of the pulse (:data:`TIMED_NOTICE`), ends by the pulse, which
+    keeps its time (:data:`MIN_CHAINED`); even."""
+    lead = max(max(1, clear_row_cycles) * row_cycles + TIMED_NOTICE, MIN_CHAINED)
+    return lead + (lead & 1)
 
 
 class ResetMode(enum.IntEnum):

@@ -46,9 +46,8 @@ by its own offset (the plan finder's plans make none late; a late one is counted
 offset gives the bus time to end the operation under way when the trigger comes (a row, or a
 block's clear: no pulse waits for it, whenever the trigger comes). With group 0's offset 0, and
 after a start or a frame taken while waiting (every first plane queued at once), the trigger
-waits for every group. A
-pulse due at ``T`` is made on the first free even cycle from ``even(T)`` on, and counts as late
-when made after ``even(T)``.
+waits for every group. A pulse due at ``T`` is made on the first free even cycle from
+``even(T)`` on, and counts as late when made after ``even(T)``.
 
 Frames: the first group to move on from a frame takes the next offered frame when it makes its
 last pulse of the frame (else the frame repeats); the others take the same frame when they move
@@ -81,14 +80,13 @@ import numpy as np
 from .facts import SETTLE_READINGS, TIMING, BlockMode
 from .registers import (
     MAX_GROUPS,
-    MIN_CHAINED,
     MIN_SETTLE,
-    TIMED_NOTICE,
     PlaneOrder,
     ResetMode,
     Source,
     TriggerMode,
     group_size,
+    lead_cycles,
 )
 
 __all__ = ["Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate", "FABRIC_HZ",
@@ -127,11 +125,8 @@ def row_cycles(dmd, beats=1):
 
 def trigger_lead(dmd, beats=1):
     """The least offset of group 0 in GROUPS by which a trigger may come while other groups'
-    loads run (:meth:`_Model.steady`): the bus's longest operation (a row, or a block's clear)
-    under way when the trigger comes, or started before the bus knows of the pulse
-    (:data:`spec.registers.TIMED_NOTICE`), ends within it, and a timed first pulse keeps its time
-    (:data:`spec.registers.MIN_CHAINED`)."""
-    return even(max(max(1, dmd.clear_row_cycles) * row_cycles(dmd, beats) + TIMED_NOTICE, MIN_CHAINED))
+    loads run (:meth:`_Model.steady`): :func:`spec.registers.lead_cycles` of ``dmd``."""
+    return lead_cycles(row_cycles(dmd, beats), dmd.clear_row_cycles)
 
 
 #: First load this many cycles after INIT_ACTIVE falls (DLPC910: first DVALID >= 64 clocks).
@@ -542,7 +537,7 @@ class _Model:
 
     def first_rst_free(self):
         """When :meth:`steady`, the first cycle a trigger may be obeyed at as far as RST_ACTIVE
-        goes: group 0's first pulse, two cycles on, need not wait for it; else no bound (every
+        goes: group 0's first pulse, its offset on, need not wait for it; else no bound (every
         group loaded: its last pulse is long past)."""
         if not self.steady():
             return -math.inf
