@@ -181,8 +181,8 @@ CLEAR_HOLD_AFTER_RST = 4
 
 #: A trigger's pace reaches the frame control's newer-frame guard this many cycles after the
 #: trigger (the guard's thresholds, the interval plus an eighth and the interval less
-#: :func:`reload_bound`, are summed in a pipeline of the gateware).
-PACE_LAG = 6
+#: :func:`reload_bound`, are summed in a pipeline of the gateware, the trigger registered first).
+PACE_LAG = 7
 #: Cycles from the store's offer of a frame to the sequencer's decisions seeing it (the planner
 #: registers the offer).
 OFFER_LAG = 1

@@ -36,16 +36,18 @@ class CameraTrigger(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         regs = self.regs
-        m.submodules.offset = offset = Countdown(DURATION_BITS, flags="settled")
+        m.submodules.offset = offset = Countdown(DURATION_BITS, flags="given")
         m.submodules.width = width = Countdown(16, flags="settled")
         none = Signal()                        # a pulse of no cycles: nothing to send
         m.d.sync += none.eq(regs.camera_width == 0)
-        at_once = Signal()
-        m.d.sync += at_once.eq(regs.camera_offset == 0)
+        # (the values hold still: their countdowns' flags are worked out ahead, the offset's in
+        # two stages, and whether it is 0 from its limbs' zero flags)
+        offset_flags = offset.flags_registered(m, regs.camera_offset, "offset_flags")
+        at_once = offset_flags.zero.all()
         waiting, pulsing = Signal(), Signal()
         starts = waiting & offset.ends
-        # (the values hold still: their countdowns' flags are worked out ahead)
-        m.d.comb += [offset.value.eq(regs.camera_offset), width.value.eq(regs.camera_width)]
+        m.d.comb += [offset.value.eq(regs.camera_offset), offset.load_flags.eq(offset_flags),
+                     width.value.eq(regs.camera_width)]
         with m.If(self.frame_start):
             m.d.comb += [offset.load.eq(~at_once), width.load.eq(at_once)]
             m.d.sync += [waiting.eq(~at_once), pulsing.eq(at_once & ~none), self.out.eq(at_once & ~none)]

@@ -150,7 +150,8 @@ class FrameControl(wiring.Component):
         restarting = Signal()                  # RESTART: the controller is ready again
 
         # ---- the state the decisions so far leave ----
-        settles = did.obey | did.take | did.start | did.restart
+        retakes = Signal()                     # a frame taken or a restart (registered apart)
+        settles = did.obey | did.start | retakes
         all_ready = self.all_ready & ~settles
         trigger_ready = self.trigger_ready & ~settles
         playing = self.playing | did.obey
@@ -163,17 +164,20 @@ class FrameControl(wiring.Component):
         m.d.sync += last_group.eq(self.n_groups - 1)
         # the state's flags, registered with it (set on each change of state)
         run = Signal()
+        queueing = Signal()                    # QUEUE or RELOAD: a first plane queued each cycle
+        waiting = Signal(init=1)               # WAIT
 
         def goto(state):
             m.next = state
             m.d.sync += [self.running.eq(state in ("RUN", "FLUSH", "RELOAD")), run.eq(state == "RUN"),
-                         self.flushing.eq(state in ("FLUSH", "RESTART"))]
+                         self.flushing.eq(state in ("FLUSH", "RESTART")),
+                         queueing.eq(state in ("QUEUE", "RELOAD")), waiting.eq(state == "WAIT")]
 
         def restart_on_init():
             with m.If(~self.initialised):
                 goto("RESTART")
 
-        with m.FSM(name="start") as fsm:
+        with m.FSM(name="start"):
             with m.State("WAIT"):
                 with m.If(did.start):
                     goto("QUEUE")
@@ -202,6 +206,9 @@ class FrameControl(wiring.Component):
                 with m.If(did.restart):
                     goto("RELOAD")
 
+        # (from the state's flag, not its decode)
+        m.d.comb += [self.queue_first.valid.eq(queueing), self.queue_first.payload.eq(start_group)]
+
         # ---- decisions ----
         # a newer streamed frame offered while no group plays replaces the preloaded first planes
         # (the next frame of a stored sequence waits for its turn; once a sequence played once has
@@ -217,7 +224,7 @@ class FrameControl(wiring.Component):
         newer = ~use_prng & ~regs.chain & self.offer.valid & (~self.offer.sequence | self.ended)
         fits = self._fits(m)
         takes = run & ~(did.take & did.newer) & ((~playing & newer & fits) | (all_ready & self.reload))
-        starts = fsm.ongoing("WAIT") & self.initialised & (self.offer.valid | use_prng) & ~did.start
+        starts = waiting & self.initialised & (self.offer.valid | use_prng) & ~did.start
         # a trigger is obeyed when every group is ready; one that comes sooner is held (with
         # ``trigger_hold``) and obeyed on the first cycle they are, before any new one (every
         # group ready, none plays: only a newer frame or a reload could be taken instead)
@@ -225,7 +232,7 @@ class FrameControl(wiring.Component):
         # way, queued each at its own last dark pulse; after a start, take or restart every
         # first plane was queued at once, and the trigger waits for them all)
         reloaded = Signal(init=1)
-        with m.If(did.start | did.take | did.restart):
+        with m.If(did.start | retakes):
             m.d.sync += reloaded.eq(1)
         with m.If(did.obey):
             m.d.sync += reloaded.eq(0)
@@ -236,6 +243,7 @@ class FrameControl(wiring.Component):
             did.start.eq(starts), did.take.eq(takes), did.newer.eq(newer), did.flush.eq(~all_ready),
             did.restart.eq(restarting), did.release.eq(release),
             did.obey.eq(ready & (holding_now | (self.strobe & ~ended))),
+            retakes.eq(takes | restarting),
             did.early.eq(self.strobe & ~self.running),
             did.after_end.eq(self.strobe & self.running & ended),
             did.hold.eq(self.strobe & self.running & ~ended & ~(ready & ~holding_now) & holds),
@@ -247,10 +255,10 @@ class FrameControl(wiring.Component):
 
         # ---- applied ----
         m.d.comb += [self.start.valid.eq(did.start), self.start.payload.eq(begun),
-                     self.retake.valid.eq(did.take | did.restart),
+                     self.retake.valid.eq(retakes),
                      self.retake.payload.newer.eq(did.newer), self.retake.payload.abandon.eq(did.restart),
                      self.trigger.eq(did.obey)]
-        with m.If(did.start | did.take | did.restart):
+        with m.If(did.start | retakes):
             m.d.sync += start_group.eq(0)
         with m.If(did.release | (self.flushing & ~self.running)):      # (RESTART)
             m.d.sync += holding.eq(0)
@@ -264,13 +272,12 @@ class FrameControl(wiring.Component):
         # ---- what the crossing and the sync master read (registered, less this cycle's
         # decisions applied now) ----
         rest = Signal(init=1)                  # (it starts in WAIT)
-        m.d.sync += [rest.eq((fsm.ongoing("WAIT") & ~did.start) | (run & all_ready)),
+        m.d.sync += [rest.eq((waiting & ~did.start) | (run & all_ready)),
                      self.ready.eq(ready & ~holding_now & ~ended)]
         m.d.comb += self.at_rest.eq(rest & ~settles)
         return m
 
     def _queue_first_planes(self, m, start_group, goto, last_group):
-        m.d.comb += [self.queue_first.valid.eq(1), self.queue_first.payload.eq(start_group)]
         m.d.sync += start_group.eq(start_group + 1)
         with m.If(start_group == last_group):
             goto("RUN")
@@ -342,7 +349,10 @@ class FrameControl(wiring.Component):
 
         # the interval of each trigger counted
         m.submodules.since = since = Counter(DURATION_BITS, restart_value=1)
-        counted = self.strobe & self.running
+        # (registered first, a cycle after the strobe: its source's choice is off the counter's
+        # restart; the interval between two is the same)
+        counted = Signal()
+        m.d.sync += counted.eq(self.strobe & self.running)
         seen = Signal()
         with m.If(counted):
             m.d.sync += seen.eq(1)
@@ -362,7 +372,7 @@ class FrameControl(wiring.Component):
         m.d.sync += zero.eq(Cat(interval[0] == 0, zero[:-1]))
 
         # the limits and their countdowns' flags, registered; loaded a stage later
-        assert stages + 2 == PACE_LAG            # the countdowns' flags follow their load
+        assert stages + 3 == PACE_LAG            # counted a cycle late; the flags follow their load
         m.submodules.overdue = overdue = Countdown(DURATION_BITS + 1, lag=stages + 1, flags="given")
         m.submodules.too_soon = too_soon = Countdown(DURATION_BITS, lag=stages + 1, flags="given")
         early = Mux(reaches, early_at[:DURATION_BITS], 0)

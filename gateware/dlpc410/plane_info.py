@@ -145,8 +145,10 @@ class PlaneInfo(wiring.Component):
         last3, dark3, nodark3 = Signal(), Signal(), Signal()
         m.d.sync += [plane3.eq(plane), edark3.eq(edark2), last3.eq(last2), dark3.eq(dark2), nodark3.eq(nodark2)]
 
-        # 5: the answers
+        # 5: the answers (and the group they are for, one-hot: each group's keep is one LUT)
         advance(5)
+        hot = Signal(G)
+        m.d.sync += hot.eq(1 << tags[4])
         big, last4, nodark4 = Signal(), Signal(), Signal()
         delay = Signal(DURATION_BITS)
         m.d.sync += [big.eq(greater(big_above, big_same, or_equal=True)), last4.eq(last3), nodark4.eq(nodark3),
@@ -154,9 +156,8 @@ class PlaneInfo(wiring.Component):
                                   plane3))]
 
         # kept per group
-        done = valid[-1] & ~changed[tags[-1]]
         for g in range(G):
-            with m.If(done & (tags[-1] == g)):
+            with m.If(valid[-1] & hot[g] & ~changed[g]):
                 m.d.sync += [self.last[g].eq(last4), self.big[g].eq(big), self.keeps_dark[g].eq(nodark4),
                              self.delay[g].eq(delay), self.fresh[g].eq(1)]
             with m.If(self.changed[g]):

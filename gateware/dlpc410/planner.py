@@ -19,7 +19,7 @@ is applied on its cycle.
 counted in), for the frame control, which counts in its own.
 """
 
-from amaranth import Cat, Const, Module, Mux, Signal
+from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -38,18 +38,6 @@ from .plane_info import PlaneInfo
 from .reset_watch import ResetWatch
 
 __all__ = ["Planner", "START"]
-
-
-def at_least_two(bits):
-    """Two bits or more of ``bits`` are set (a tree of halves: each says whether it has one,
-    and whether it has two)."""
-    def tree(part):
-        if len(part) == 1:
-            return part[0], Const(0)
-        one_a, two_a = tree(part[:len(part) // 2])
-        one_b, two_b = tree(part[len(part) // 2:])
-        return one_a | one_b, two_a | two_b | (one_a & one_b)
-    return tree(list(bits))[1]
 
 
 #: What the frame control's ``start`` begins: a frame, and whether it is the one offered.
@@ -250,23 +238,25 @@ class Planner(wiring.Component):
         P = self.choice
         usable = offers.offer.valid & ~use_prng
         # (the first group to move on to a new frame takes the one offered: ``frames.first``)
-        hidden, final, (takes_at_dark, takes_hiding, takes_followed) = self._outcomes(
+        hidden, final, takes = self._outcomes(
             m, info, frames, dark, usable, frames.first)
         decided = Signal(G)                    # the pulse decided last cycle, applied now
         decided_any = Signal()
         moves, ends_play, take, starts, camera, ends_seq, late_now = (
             Signal(G), Signal(G), Signal(), Signal(), Signal(), Signal(), Signal(G))
+        ends_fours = Signal(-(-G // 4))        # bit q: some bit of ``ends_play[4q:4q + 4]``
+        ends_any = ends_fours.any()
         first_plane = ~dark[0] & (pos[0] == 0)
         m.d.sync += [
             decided.eq(P), decided_any.eq(self.pulsing),
             # (read only with ``decided``: no need to wait for the choice)
             moves.eq(dark | hidden),
             ends_play.eq(P & final),
+            # (by fours: whether the pulse applied ends a play is then no OR over every group)
+            ends_fours.eq(Cat((P & final)[lo:lo + 4].any() for lo in range(0, G, 4))),
             # (the bus pulses the lowest due group: whether that group takes is asked of the due
             # flags themselves, the bus's gating added last, a shallower path than through P)
-            take.eq(self.pulsing & usable & (lowest_due_has(self.due, self.due_fours, takes_at_dark)
-                                             | (lowest_due_has(self.due, self.due_fours, takes_hiding)
-                                                & takes_followed))),
+            take.eq(self.pulsing & usable & lowest_due_has(self.due, self.due_fours, takes)),
             starts.eq(P[0] & first_plane),
             camera.eq(P[0] & first_plane & ~first.showing.camera_off),
             ends_seq.eq(P[0] & first_plane & first.showing.last),
@@ -301,7 +291,7 @@ class Planner(wiring.Component):
             m.d.sync += self.sync_out.eq(1)
         # (the last group to end its play: in GROUPS, whichever it is; ``playing`` is worked out
         # from the groups that played the cycle before)
-        with m.If(ends_play.any() & ~self.playing):
+        with m.If(ends_any & ~self.playing):
             m.d.sync += self.sync_out.eq(0)
         with m.If(ends_seq):
             m.d.sync += ended.eq(1)
@@ -340,7 +330,7 @@ class Planner(wiring.Component):
 
         # ---- as the decisions so far leave them ----
         m.d.comb += [
-            self.playing.eq(self._playing(m, pending_next, ends_play)),
+            self.playing.eq(self._playing(m, abandon, ends_any)),
             self.ended.eq(ended | ends_seq),
             self.job_due.eq(jobs.due),
         ]
@@ -367,15 +357,18 @@ class Planner(wiring.Component):
                      self.trigger_ready.eq(waits & (~active | loaded | ev | spared).all()
                                            & (~groups | times.rst_over[0]))]
 
-    def _playing(self, m, pending_next, ends_play):
-        """Some group plays, as the pulse applied now leaves it, with the OR over the groups
-        registered the cycle before (off the frame control's decision): at most one group
-        pulses at a time, and only one that plays, so some group plays if two do, or if one
-        does and the pulse applied now does not end its play (``pending_next``: the groups that
-        play next cycle; ``ends_play``: the pulse applied now ends its group's play)."""
-        some, two = Signal(), Signal()
-        m.d.sync += [some.eq(pending_next.any()), two.eq(at_least_two(pending_next))]
-        return two | (some & ~ends_play.any())
+    def _playing(self, m, abandon, ends_any):
+        """Some group plays, as the pulse applied now leaves it, from a count of the groups that
+        play (``pending``'s bits) kept as a thermometer code, so that no sum or OR runs over the
+        groups: a trigger sets every group of the mode playing (none did: it is obeyed only
+        then; ``active`` is itself the thermometer code of their number), ``abandon`` none, and
+        a pulse that ends its group's play (``ends_any``; one pulse at a time, of a group that
+        plays) one fewer. Some group plays if two do, or if one does and the pulse applied now
+        does not end its play."""
+        G = self._dmd.blocks
+        plays = Signal(G)                      # bit i: more than i groups play
+        m.d.sync += plays.eq(Mux(self.trigger, self.active, Mux(abandon, 0, Mux(ends_any, plays >> 1, plays))))
+        return (plays[1] if G > 1 else 0) | (plays[0] & ~ends_any)
 
     def _bus_flags(self, m, times, info, watch, decided):
         """The flags the bus decides from next cycle, registered: ``due``, ``imminent``,
@@ -406,12 +399,13 @@ class Planner(wiring.Component):
         """What each group's next pulse does: ``hidden`` (bit g: it shows a plane and the next
         one is loaded behind it), ``final`` (bit g: its dark pulse ends the group's play), and
         whether it takes the frame offered, if ``usable`` (it is the ``first`` group to move on
-        to a new frame): bit g of the first of ``(at_dark, hiding, followed)`` at its frame's
-        last dark pulse, of the second at a last plane that hides the next frame's first if the
-        frame offered follows (the third, one bit: it does)."""
+        to a new frame): bit g of ``takes``, at its frame's last dark pulse, or at a last plane
+        that hides the next frame's first if the frame offered follows (one lookup by the
+        lowest due group, not two)."""
         regs, G = self.regs, self._dmd.blocks
         offered_follow = self.offer.showing.follow
-        hidden, final, takes_at_dark, takes_hiding = Signal(G), Signal(G), Signal(G), Signal(G)
+        hidden, final, takes = Signal(G), Signal(G), Signal(G)
+        followed = regs.chain | offered_follow
         for g in range(G):
             # the frame after this one starts without a trigger: chained, or it follows (the
             # first group to move on takes the one offered, if any); never after a sequence's
@@ -435,5 +429,5 @@ class Planner(wiring.Component):
             at_dark, may_hide = Signal(name=f"takes_dark{g}"), Signal(name=f"takes_hiding{g}")
             m.d.sync += [at_dark.eq(info.last[g] & dark[g]),
                          may_hide.eq(info.last[g] & info.big[g] & info.keeps_dark[g] & ~ends_sequence)]
-            m.d.comb += [takes_at_dark[g].eq(first[g] & at_dark), takes_hiding[g].eq(first[g] & may_hide)]
-        return hidden, final, (takes_at_dark, takes_hiding, regs.chain | offered_follow)
+            m.d.comb += takes[g].eq(first[g] & (at_dark | (may_hide & followed)))
+        return hidden, final, takes
