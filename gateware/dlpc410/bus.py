@@ -33,7 +33,13 @@ from ..registers import Registers, ResetMode
 from .interface import BlockMode, RowMode
 from .layouts import COUNTER_BITS, Command, dark_load, group_bits, ready_load
 
-__all__ = ["Bus", "DECISION_TO_PINS", "lowest_due", "lowest_due_has"]
+__all__ = ["Bus", "DECISION_TO_PINS", "fours_of", "lowest_due", "lowest_due_has"]
+
+
+def fours_of(bits):
+    """Bit q: some bit of ``bits[4q:4q + 4]`` is set (registered beside ``bits``, so that a
+    question over every bit is a LUT or two of these, not a chain)."""
+    return Cat(bits[lo:lo + 4].any() for lo in range(0, len(bits), 4))
 
 
 def lowest_due(due, fours):

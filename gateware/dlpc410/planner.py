@@ -19,7 +19,7 @@ is applied on its cycle.
 counted in), for the frame control, which counts in its own.
 """
 
-from amaranth import Cat, Module, Mux, Signal
+from amaranth import Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -28,7 +28,7 @@ from spec.schedule import row_cycles
 from ..counter import Counter
 from ..registers import LSB_BITS, PlaneOrder, Registers, Source
 from ..store.layouts import SLOT_BITS, FrameInfo, Showing
-from .bus import lowest_due_has
+from .bus import fours_of, lowest_due_has
 from .frame_offer import FrameOffer, Offer
 from .group_frames import GroupFrames
 from .group_times import GroupTimes
@@ -247,13 +247,14 @@ class Planner(wiring.Component):
         ends_fours = Signal(-(-G // 4))        # bit q: some bit of ``ends_play[4q:4q + 4]``
         ends_any = ends_fours.any()
         first_plane = ~dark[0] & (pos[0] == 0)
+        ending = P & final                     # the pulse decided ends its group's play
         m.d.sync += [
             decided.eq(P), decided_any.eq(self.pulsing),
             # (read only with ``decided``: no need to wait for the choice)
             moves.eq(dark | hidden),
-            ends_play.eq(P & final),
+            ends_play.eq(ending),
             # (by fours: whether the pulse applied ends a play is then no OR over every group)
-            ends_fours.eq(Cat((P & final)[lo:lo + 4].any() for lo in range(0, G, 4))),
+            ends_fours.eq(fours_of(ending)),
             # (the bus pulses the lowest due group: whether that group takes is asked of the due
             # flags themselves, the bus's gating added last, a shallower path than through P)
             take.eq(self.pulsing & usable & lowest_due_has(self.due, self.due_fours, takes)),
@@ -385,7 +386,7 @@ class Planner(wiring.Component):
         # (and none in the cycle a retake is applied: the lead's countdown loads then)
         writable = times.settled & watch.free & ~decided & Mux(self.lead_over & ~self.retake.valid, (1 << G) - 1, 0)
         m.d.sync += [
-            self.due.eq(due), self.due_fours.eq(Cat(due[lo:lo + 4].any() for lo in range(0, G, 4))),
+            self.due.eq(due), self.due_fours.eq(fours_of(due)),
             self.imminent.eq((armed & times.soon).any()),
             self.imminent_clear.eq((armed & times.soon_clear).any()),
             self.writable.eq(writable),
