@@ -9,6 +9,15 @@ path is made of.
 * **Carry chain**: the longest CARRY4 chain on the path, in bits (4 per CARRY4), and how many
   separate chains the path goes through.
 
+How the LUTs are mapped (:func:`netlist`): ``synth_xilinx`` as it is, up to its LUT mapping;
+then each clock domain's logic is mapped on its own, with every input of a LUT given the same
+delay. Both choices keep the mapper's area recovery from making paths deeper than they need to
+be: Yosys has no Spartan-6 delays and maps with Artix-7's per-input delays (a LUT's fastest
+input 127 ps, its slowest 642 ps), so a chain of 2-input LUTs on fast inputs costs it little;
+and it stretches every path up to the slowest one in what it maps, which for the whole design is
+the ``sync`` domain's. Mapped this way, a level counted is a level the logic needs in a mapping
+working to its own domain's deepest path.
+
 A path starts at a flip-flop output, a block RAM or DSP output, a shift-register LUT or a top
 input, and ends at a flip-flop, block RAM, DSP or shift-register input, or at a LUT-RAM's write
 side (data, write enable, write address: written on the clock edge); a LUT-RAM read is one LUT
@@ -22,6 +31,7 @@ each cell reads (the LUTs' own names are the mapper's), to read it against the s
 """
 
 import json
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -71,18 +81,74 @@ class Depth:
     via: int | None = None      # the input net of the deepest LUT path's last cell
 
 
+#: Yosys' ABC9 delays for Xilinx LUTs are Artix-7's, per input (from 642 ps on ``I0`` down to
+#: 127 ps on ``I5``); it has none of Spartan-6's. With them the mapper trades levels for fast
+#: inputs (a chain of 2-input LUTs on ``I4``/``I5`` costs it little), so a depth it reports is
+#: not the depth the logic needs. The depth here is mapped with every input of a LUT as slow as
+#: the slowest (Yosys' areas; a LUT7/LUT8 is a LUT6 and the MUXF7/MUXF8 after it, delays as
+#: Yosys gives them), so that fewer levels are always faster to the mapper.
+_LUT_LIBRARY = {1: (1, 642), 2: (2, 642), 3: (3, 642), 4: (3, 642), 5: (3, 642), 6: (5, 642),
+                7: (10, 642 + 223 + 174), 8: (20, 642 + 223 + 104 + 192)}
+#: Yosys' wire delay for its Xilinx mapping (``synth_xilinx.abc9.xc7.W``).
+_WIRE_DELAY = 300
+#: Where a path ends at a cell before LUT mapping: the inputs of its flip-flops, block RAMs, a
+#: LUT-RAM's write side and a shift register's data (a cone is followed back no further).
+_CONE_STOPS = ("-FDRE,FDSE,FDCE,FDPE[D,CE,R,S,CLR,PRE]:-RAMB16BWER,RAMB8BWER"
+               ":-RAM32M,RAM64M[DIA,DIB,DIC,DID,WE]:-RAM32X1D,RAM64X1D,RAM128X1D,RAM32X1S,RAM64X1S,RAM128X1S"
+               "[D,WE]:-SRLC32E,SRL16E[D,CE]")
+
+
+def _clocks(verilog, top):
+    """The clock inputs of ``top`` in Amaranth's names: ``clk`` and ``<domain>_clk``."""
+    body = verilog[verilog.index(f"module {top}("):]
+    body = body[:body.index("endmodule")]
+    return [name for name in re.findall(r"^\s*input\s+(?:\[[^\]]*\]\s*)?(\w+)\s*;", body, re.M)
+            if name == "clk" or name.endswith("_clk")]
+
+
 def netlist(verilog, top, *, workdir):
-    """Synthesise ``verilog`` for XC6S and return the flattened module's JSON netlist."""
+    """Synthesise ``verilog`` for XC6S: ``{clock net: flattened module's JSON netlist}``, one
+    netlist per clock domain.
+
+    ``synth_xilinx -family xc6s`` runs once up to its LUT mapping; then each domain's logic (the
+    cone of the registers on its clock, back to the registers it starts from) is mapped alone, as
+    ``synth_xilinx`` maps it but with :data:`_LUT_LIBRARY`. Mapped together, the mapper's area
+    recovery would stretch every path up to the slowest in the netlist, whichever clock it is
+    on; a mapper working to a period per clock does not."""
     from flow.resources import run_yosys
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     source = workdir / f"{top}.v"
     source.write_text(verilog)
-    out = workdir / f"{top}.netlist.json"
-    script = (f"read_verilog {source.name}; synth_xilinx -family xc6s -top {top} -flatten -noiopad -noclkbuf; "
-              f"write_json {out.name}")
-    run_yosys(script, top, workdir)
-    return json.loads(out.read_text())["modules"][top]
+    library = workdir / "levels.lut"
+    library.write_text("".join(f"{k} {area}.00 {delay}\n" for k, (area, delay) in _LUT_LIBRARY.items()))
+    flags = f"-family xc6s -top {top} -flatten -noiopad -noclkbuf"
+    clocks = _clocks(verilog, top)
+    script = [f"read_verilog {source.name}", f"synth_xilinx {flags} -run :map_luts", "design -save premap"]
+    outs = {}
+    for clock in clocks:
+        outs[clock] = workdir / f"{top}.{clock}.netlist.json"
+        script += [
+            "design -load premap",
+            f"select -set ends w:{clock} %co1 w:{clock} %d",
+            # (the domain's registers stay, though what reads them is not mapped here)
+            "setattr -set keep 1 @ends",
+            f"select -set cone @ends %ci1 %ci*:{_CONE_STOPS}",
+            "delete c:* @cone %d",
+            # ``synth_xilinx``'s map_luts, with the LUT library
+            "opt_expr -mux_undef -noclkinv",
+            "read_verilog -icells -lib -specify +/xilinx/abc9_model.v",
+            f"abc9 -W {_WIRE_DELAY} -lut {library.name}",
+            "clean",
+            "xilinx_srl -fixed -minlen 3",
+            "techmap -map +/xilinx/lut_map.v -map +/xilinx/cells_map.v -D LUT_WIDTH=6",
+            "xilinx_dffopt",
+            "opt_lut_ins -tech xilinx",
+            f"synth_xilinx {flags} -run finalize:",
+            f"write_json {outs[clock].name}",
+        ]
+    run_yosys("; ".join(script), top, workdir)
+    return {clock: json.loads(out.read_text())["modules"][top] for clock, out in outs.items()}
 
 
 def _registered_dsp(cell):
@@ -290,7 +356,7 @@ def _domain_of(net):
 
 
 def _synthesise(component=None, *, name="projector", workdir="build/timing"):
-    """The flattened netlist of the projector's core (or ``component``)."""
+    """The netlists of the projector's core (or ``component``), one per clock domain."""
     from amaranth.back import verilog
     if component is None:
         from flow.blocks import core
@@ -299,8 +365,14 @@ def _synthesise(component=None, *, name="projector", workdir="build/timing"):
     return netlist(text, name, workdir=workdir)
 
 
-def _by_domain(module):
-    return {_domain_of(domain): entry for domain, entry in analyse(module).items()}
+def _by_domain(netlists):
+    """Each domain's figures, from the netlist it was mapped in."""
+    out = {}
+    for clock, module in netlists.items():
+        entry = analyse(module).get(clock)
+        if entry is not None:
+            out[_domain_of(clock)] = entry
+    return out
 
 
 def report(component=None, *, name="projector", workdir="build/timing"):
@@ -338,13 +410,22 @@ def main(*, block=None, over=(), path=()):
     """``block``: one block of :data:`flow.blocks.BLOCKS` instead of the projector's core;
     ``path``: print the deepest path to each register named like these, step by step."""
     if block is None:
-        module = _synthesise()
+        netlists = _synthesise()
     else:
         from flow.blocks import BLOCKS
-        module = _synthesise(BLOCKS[block](), name=block, workdir=f"build/timing/{block}")
-    print_report(_by_domain(module), over=over)
+        netlists = _synthesise(BLOCKS[block](), name=block, workdir=f"build/timing/{block}")
+    print_report(_by_domain(netlists), over=over)
     for end in path:
-        name, steps = deepest_path(module, end)
+        # (a register of another domain is in a netlist too, where its cone is not mapped)
+        found = []
+        for module in netlists.values():
+            try:
+                found.append(deepest_path(module, end))
+            except ValueError:
+                pass
+        if not found:
+            raise ValueError(f"no register named like {end!r}")
+        name, steps = max(found, key=lambda f: f[1][-1][0])
         print(f"deepest path to {name}: {steps[-1][0]} LUT levels")
         for luts, kind, read in steps:
             print(f"  {luts:3d} {kind:8} {', '.join(read)}")

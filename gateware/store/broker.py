@@ -119,11 +119,13 @@ class FrameBroker(wiring.Component):
                     m.d.comb += row_done.eq(1)
                     m.next = "OFFER"
             with m.State("OFFER"):
-                m.d.comb += [self.frames.valid.eq(1), self.frames.payload.eq(info)]
+                m.d.comb += self.frames.valid.eq(1)
                 with m.If(self.frames.ready):
                     m.next = "ASK"
 
+        # (the payload is the frame's register in every state, no decode of the state after it)
         m.d.comb += [
+            self.frames.payload.eq(info),
             write.en.eq(zeroing | row_done),
             write.addr.eq(Mux(zeroing, Mux(self.store_lost, 0, sweep), info.slot)),
             write.data.eq(Mux(zeroing, 0, row)),
