@@ -23,6 +23,10 @@ def main(argv=None):
     timing.add_argument("--path", action="append", default=[], metavar="REGISTER",
                         help="the deepest path to the register named like this, cell by cell, with the named "
                              "signals each cell reads (repeatable)")
+    timing.add_argument("--lut-delay", type=int, default=None, metavar="PS",
+                        help="every LUT input's delay to the mapper (default 5000 ps, far above a 16-bit carry "
+                             "chain's: levels count as the budget counts them; 642, Yosys' slowest input: a "
+                             "16-bit chain weighs more than a level)")
     formal = sub.add_parser("formal", help="prove or check every formal property (SymbiYosys)")
     formal.add_argument("--quick", action="store_true", help="BMC to the test suite's depths, no proofs")
     formal.add_argument("--only", action="append", help="only this block (repeatable)")
@@ -56,8 +60,9 @@ def main(argv=None):
         from flow.resources import main as run
         return run(blocks=args.block, jobs=args.jobs)
     if args.command == "timing":
+        from flow.timing import LUT_DELAY
         from flow.timing import main as run
-        return run(block=args.block, over=args.over, path=args.path)
+        return run(block=args.block, over=args.over, path=args.path, lut_delay=args.lut_delay or LUT_DELAY)
     if args.command == "formal":
         from flow.formal import main as run
         return run(quick=args.quick, only=args.only)

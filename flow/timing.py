@@ -11,12 +11,13 @@ path is made of.
 
 How the LUTs are mapped (:func:`netlist`): ``synth_xilinx`` as it is, up to its LUT mapping;
 then each clock domain's logic is mapped on its own, with every input of a LUT given the same
-delay. Both choices keep the mapper's area recovery from making paths deeper than they need to
-be: Yosys has no Spartan-6 delays and maps with Artix-7's per-input delays (a LUT's fastest
-input 127 ps, its slowest 642 ps), so a chain of 2-input LUTs on fast inputs costs it little;
-and it stretches every path up to the slowest one in what it maps, which for the whole design is
-the ``sync`` domain's. Mapped this way, a level counted is a level the logic needs in a mapping
-working to its own domain's deepest path.
+delay, far above a carry chain's. This keeps the mapper's area recovery from making paths deeper
+than they need to be: Yosys has no Spartan-6 delays and maps with Artix-7's per-input delays (a
+LUT's fastest input 127 ps, its slowest 642 ps), so a chain of 2-input LUTs on fast inputs costs
+it little and a 16-bit carry chain weighs more than a level; and it stretches every path up to
+the slowest one in what it maps, which for the whole design is the ``sync`` domain's. Mapped this
+way, the mapper minimises LUT levels, as the budget counts them, each domain against its own
+deepest path.
 
 A path starts at a flip-flop output, a block RAM or DSP output, a shift-register LUT or a top
 input, and ends at a flip-flop, block RAM, DSP or shift-register input, or at a LUT-RAM's write
@@ -81,14 +82,26 @@ class Depth:
     via: int | None = None      # the input net of the deepest LUT path's last cell
 
 
-#: Yosys' ABC9 delays for Xilinx LUTs are Artix-7's, per input (from 642 ps on ``I0`` down to
-#: 127 ps on ``I5``); it has none of Spartan-6's. With them the mapper trades levels for fast
-#: inputs (a chain of 2-input LUTs on ``I4``/``I5`` costs it little), so a depth it reports is
-#: not the depth the logic needs. The depth here is mapped with every input of a LUT as slow as
-#: the slowest (Yosys' areas; a LUT7/LUT8 is a LUT6 and the MUXF7/MUXF8 after it, delays as
-#: Yosys gives them), so that fewer levels are always faster to the mapper.
-_LUT_LIBRARY = {1: (1, 642), 2: (2, 642), 3: (3, 642), 4: (3, 642), 5: (3, 642), 6: (5, 642),
-                7: (10, 642 + 223 + 174), 8: (20, 642 + 223 + 104 + 192)}
+# Yosys' ABC9 delays for Xilinx LUTs are Artix-7's, per input (from 642 ps on ``I0`` down to
+# 127 ps on ``I5``); it has none of Spartan-6's. With them the mapper trades levels for fast
+# inputs (a chain of 2-input LUTs on ``I4``/``I5`` costs it little), and a 16-bit carry chain
+# weighs more than a LUT level, so a path with one leads the mapping and LUT-only paths are
+# relaxed towards it. The budget counts LUT levels and allows one 16-bit chain on top: the depth
+# here is mapped with every input of every LUT the same delay, far above a chain's (Yosys' areas;
+# a LUT7/LUT8 is a LUT6 and the MUXF7/MUXF8 after it), so that the mapper minimises levels as
+# the budget counts them. ``--lut-delay 642`` (Yosys' slowest input) maps with a carry chain
+# weighing more than a level.
+
+#: Every LUT input's delay (ps) to the mapper: a level outweighs a 16-bit carry chain (about
+#: 1 ns in Yosys' model) several times over.
+LUT_DELAY = 5000
+def _lut_library(delay):
+    """``{inputs: (area, delay)}``: Yosys' areas; a LUT7/LUT8 is a LUT6 and the MUXF7/MUXF8
+    after it, their delays as Yosys gives them."""
+    return {1: (1, delay), 2: (2, delay), 3: (3, delay), 4: (3, delay), 5: (3, delay), 6: (5, delay),
+            7: (10, delay + 223 + 174), 8: (20, delay + 223 + 104 + 192)}
+
+
 #: Yosys' wire delay for its Xilinx mapping (``synth_xilinx.abc9.xc7.W``).
 _WIRE_DELAY = 300
 #: Where a path ends at a cell before LUT mapping: the inputs of its flip-flops, block RAMs, a
@@ -106,13 +119,13 @@ def _clocks(verilog, top):
             if name == "clk" or name.endswith("_clk")]
 
 
-def netlist(verilog, top, *, workdir):
+def netlist(verilog, top, *, workdir, lut_delay=LUT_DELAY):
     """Synthesise ``verilog`` for XC6S: ``{clock net: flattened module's JSON netlist}``, one
     netlist per clock domain.
 
     ``synth_xilinx -family xc6s`` runs once up to its LUT mapping; then each domain's logic (the
     cone of the registers on its clock, back to the registers it starts from) is mapped alone, as
-    ``synth_xilinx`` maps it but with :data:`_LUT_LIBRARY`. Mapped together, the mapper's area
+    ``synth_xilinx`` maps it but with every LUT input ``lut_delay`` ps. Mapped together, the mapper's area
     recovery would stretch every path up to the slowest in the netlist, whichever clock it is
     on; a mapper working to a period per clock does not."""
     from flow.resources import run_yosys
@@ -121,7 +134,7 @@ def netlist(verilog, top, *, workdir):
     source = workdir / f"{top}.v"
     source.write_text(verilog)
     library = workdir / "levels.lut"
-    library.write_text("".join(f"{k} {area}.00 {delay}\n" for k, (area, delay) in _LUT_LIBRARY.items()))
+    library.write_text("".join(f"{k} {area}.00 {delay}\n" for k, (area, delay) in _lut_library(lut_delay).items()))
     flags = f"-family xc6s -top {top} -flatten -noiopad -noclkbuf"
     clocks = _clocks(verilog, top)
     script = [f"read_verilog {source.name}", f"synth_xilinx {flags} -run :map_luts", "design -save premap"]
@@ -355,14 +368,14 @@ def _domain_of(net):
     return "sync" if net == "clk" else net[:-len("_clk")] if net.endswith("_clk") else net
 
 
-def _synthesise(component=None, *, name="projector", workdir="build/timing"):
+def _synthesise(component=None, *, name="projector", workdir="build/timing", lut_delay=LUT_DELAY):
     """The netlists of the projector's core (or ``component``), one per clock domain."""
     from amaranth.back import verilog
     if component is None:
         from flow.blocks import core
         component = core()
     text = verilog.convert(component, name=name, emit_src=False, strip_internal_attrs=True)
-    return netlist(text, name, workdir=workdir)
+    return netlist(text, name, workdir=workdir, lut_delay=lut_delay)
 
 
 def _by_domain(netlists):
@@ -406,14 +419,14 @@ def print_report(result, *, over=()):
                 print(f"    {luts:3d} LUT {carry:3d} bits {chains} chain(s) {count:5d} path(s): {name} <- {start}")
 
 
-def main(*, block=None, over=(), path=()):
+def main(*, block=None, over=(), path=(), lut_delay=LUT_DELAY):
     """``block``: one block of :data:`flow.blocks.BLOCKS` instead of the projector's core;
     ``path``: print the deepest path to each register named like these, step by step."""
     if block is None:
-        netlists = _synthesise()
+        netlists = _synthesise(lut_delay=lut_delay)
     else:
         from flow.blocks import BLOCKS
-        netlists = _synthesise(BLOCKS[block](), name=block, workdir=f"build/timing/{block}")
+        netlists = _synthesise(BLOCKS[block](), name=block, workdir=f"build/timing/{block}", lut_delay=lut_delay)
     print_report(_by_domain(netlists), over=over)
     for end in path:
         # (a register of another domain is in a netlist too, where its cone is not mapped)
