@@ -95,6 +95,8 @@ class Depth:
 #: Every LUT input's delay (ps) to the mapper: a level outweighs a 16-bit carry chain (about
 #: 1 ns in Yosys' model) several times over.
 LUT_DELAY = 5000
+
+
 def _lut_library(delay):
     """``{inputs: (area, delay)}``: Yosys' areas; a LUT7/LUT8 is a LUT6 and the MUXF7/MUXF8
     after it, their delays as Yosys gives them."""
@@ -125,9 +127,9 @@ def netlist(verilog, top, *, workdir, lut_delay=LUT_DELAY):
 
     ``synth_xilinx -family xc6s`` runs once up to its LUT mapping; then each domain's logic (the
     cone of the registers on its clock, back to the registers it starts from) is mapped alone, as
-    ``synth_xilinx`` maps it but with every LUT input ``lut_delay`` ps. Mapped together, the mapper's area
-    recovery would stretch every path up to the slowest in the netlist, whichever clock it is
-    on; a mapper working to a period per clock does not."""
+    ``synth_xilinx`` maps it but with every LUT input ``lut_delay`` ps. Mapped together, the
+    mapper's area recovery would stretch every path up to the slowest in the netlist, whichever
+    clock it is on; a mapper working to a period per clock does not."""
     from flow.resources import run_yosys
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
