@@ -82,18 +82,9 @@ class Depth:
     via: int | None = None      # the input net of the deepest LUT path's last cell
 
 
-# Yosys' ABC9 delays for Xilinx LUTs are Artix-7's, per input (from 642 ps on ``I0`` down to
-# 127 ps on ``I5``); it has none of Spartan-6's. With them the mapper trades levels for fast
-# inputs (a chain of 2-input LUTs on ``I4``/``I5`` costs it little), and a 16-bit carry chain
-# weighs more than a LUT level, so a path with one leads the mapping and LUT-only paths are
-# relaxed towards it. The budget counts LUT levels and allows one 16-bit chain on top: the depth
-# here is mapped with every input of every LUT the same delay, far above a chain's (Yosys' areas;
-# a LUT7/LUT8 is a LUT6 and the MUXF7/MUXF8 after it), so that the mapper minimises levels as
-# the budget counts them. ``--lut-delay 642`` (Yosys' slowest input) maps with a carry chain
-# weighing more than a level.
-
-#: Every LUT input's delay (ps) to the mapper: a level outweighs a 16-bit carry chain (about
-#: 1 ns in Yosys' model) several times over.
+#: Every LUT input's delay (ps) to the mapper (why: the module's docstring): a level outweighs a
+#: 16-bit carry chain (about 1 ns in Yosys' model) several times over; ``--lut-delay 642``, Yosys'
+#: slowest input, maps with a chain weighing more than a level.
 LUT_DELAY = 5000
 
 
