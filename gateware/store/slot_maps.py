@@ -10,9 +10,12 @@ logic (as one memory with two read ports it took distributed RAM and several LUT
 multiplexers); ``stored`` keeps 64 rows a word and picks the row's bit after the read.
 Occupancy map: per slot and DMD block, 8 bits, plane ``k`` has a bit set somewhere in the block
 (a delta starts from its base's, a superset of what its rows from the base hold: a block it says
-has bits is loaded, never wrongly cleared). Every map is written in ``sync`` through one stream
-of writes; the ``dmd`` read ports are safe because a slot reaches the sequencer only after it is
-complete, and a base is never written while a delta uses it (see :mod:`gateware.store.layouts`).
+has bits is loaded, never wrongly cleared). It is read in ``sync`` by the row ingest (for a
+delta's start) and in ``dmd`` by the sequencer, each from a copy of its own in block RAM, so that
+neither read has logic between its address registers and its output. Every map is written in
+``sync`` through one stream of writes; the ``dmd`` read ports are safe because a slot reaches the
+sequencer only after it is complete, and a base is never written while a delta uses it (see
+:mod:`gateware.store.layouts`).
 """
 
 from amaranth import Cat, Module, Mux, Signal
@@ -167,14 +170,19 @@ class SlotMaps(wiring.Component):
             self.sources.delta.eq(kinds_r.data),
         ]
 
-        m.submodules.occupancy = occ = Memory(shape=PLANES, depth=self._slots << BLOCK_BITS, init=[])
-        occ_w = occ.write_port(granularity=1)
-        m.d.comb += [
-            occ_w.addr.eq(Cat(write.block, write.slot)),
-            occ_w.data.eq(write.occupancy),
-            occ_w.en.eq(Cat(self.writes.valid & bit for bit in write.occupancy_mask)),
-        ]
-        for port, domain in ((self.base_occupancy, "sync"), (self.occupancy, "dmd")):
-            occ_r = occ.read_port(domain=domain)
-            m.d.comb += [occ_r.addr.eq(Cat(port.block, port.slot)), port.planes.eq(occ_r.data)]
+        # a copy of the occupancy map per read port: as one memory with two read ports it took
+        # distributed RAM, and the ``dmd`` read was a tree of LUT-RAM outputs and multiplexers
+        # 5 LUT levels deep
+        for name, port, domain in (("base_occupancy", self.base_occupancy, "sync"),
+                                   ("occupancy", self.occupancy, "dmd")):
+            m.submodules[name] = occ = Memory(shape=PLANES, depth=self._slots << BLOCK_BITS, init=[],
+                                              attrs={"ram_style": "block"})
+            occ_w, occ_r = occ.write_port(granularity=1), occ.read_port(domain=domain)
+            m.d.comb += [
+                occ_w.addr.eq(Cat(write.block, write.slot)),
+                occ_w.data.eq(write.occupancy),
+                occ_w.en.eq(Cat(self.writes.valid & bit for bit in write.occupancy_mask)),
+                occ_r.addr.eq(Cat(port.block, port.slot)),
+                port.planes.eq(occ_r.data),
+            ]
         return m
