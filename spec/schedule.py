@@ -74,6 +74,7 @@ sequencer sees an offer :data:`OFFER_LAG` cycles after the store makes it.
 
 import math
 from dataclasses import dataclass, field, replace
+from itertools import islice
 
 import numpy as np
 
@@ -994,46 +995,62 @@ def _spread(dmd, p, fr, lsb_min, sep, load_g, clear_g, beat):
         cap = ((beat if best is None else best[1]) - int(pulses[-1])) // (G - 1)
         if cap <= sep:
             break
-        diffs = np.unique(pulses[:, None] - pulses[None, :])
+        diffs = np.unique(pulses[:, None] - pulses[None, :])      # sorted
         stag = np.arange(even(sep), min(cap, int(pulses[-1])), 2)
         ok = np.ones(len(stag), bool)
         for k in range(1, G):
-            near = np.abs(diffs[None, :] + k * stag[:, None]).min(axis=1)
-            ok &= near >= sep
+            ok &= _distance_to_nearest(diffs, -k * stag) >= sep
         stag = stag[ok]
-        # the loads in queue (pulse) order, for every candidate stagger at once; the last
-        # pulse's load (the next frame's first plane) has no deadline but takes the bus
-        offsets = np.repeat(np.arange(G), len(pulses))
-        starts = np.tile(pulses, G)[None, :] + offsets[None, :] * stag[:, None]
-        order = np.argsort(starts, axis=1, kind="stable")
-        starts = np.take_along_axis(starts, order, axis=1)
-        deadlines = np.take_along_axis(
-            np.tile(np.append(pulses[1:], 1 << 62), G)[None, :] + offsets[None, :] * stag[:, None],
-            order, axis=1)
-        lengths = np.tile(np.array(jobs), G)[order]
-        dark = np.tile(np.array(darks), G)[order]
-        end = np.zeros(len(stag), np.int64)
-        fits = np.ones(len(stag), bool)
-        for i in range(starts.shape[1]):
-            # a dark pulse's clears go before the loads once the memory may change (a row
-            # under way, or another group's clear, first)
-            done = np.maximum(end, starts[:, i] + frozen) + lengths[:, i]
-            cleared = starts[:, i] + frozen + clear_g + 2 * row_cycles(dmd, p.beats)
-            fits &= np.where(dark[:, i], cleared, done + margin) <= deadlines[:, i]
-            end = np.where(dark[:, i], end, done)
-        tries = 0
-        for s in stag[fits]:
-            s = int(s)
-            q = replace(p, lsb=lsb, stagger=s)
+        for stagger in islice(_staggers_whose_loads_fit(dmd, p, pulses, darks, jobs, G, stag, frozen, clear_g,
+                                                        margin), 4):
+            q = replace(p, lsb=lsb, stagger=int(stagger))
             if on_time(dmd, q, fr):
                 cycles = frame_period(dmd, q, fr)
                 if cycles < (beat if best is None else best[1]):
                     best = (q, cycles)
                 break
-            tries += 1
-            if tries == 4:
-                break
     return best
+
+
+def _distance_to_nearest(values, points):
+    """For each of ``points``, its distance to the nearest of ``values`` (sorted, not empty):
+    the nearer of its two neighbours in order."""
+    i = np.searchsorted(values, points)
+    return np.minimum(np.abs(values[np.minimum(i, len(values) - 1)] - points),
+                      np.abs(values[np.maximum(i - 1, 0)] - points))
+
+
+def _staggers_whose_loads_fit(dmd, p, pulses, darks, jobs, G, stag, frozen, clear_g, margin):
+    """The staggers of ``stag`` (increasing) at which every load of the groups spread that far
+    apart, served in queue (pulse) order, ends inside its deadline (:func:`_spread`), in order.
+    Worked out a slice of staggers at a time, as the search wants only the first few."""
+    for first in range(0, len(stag), 2048):
+        part = stag[first:first + 2048]
+        yield from part[_loads_fit(dmd, p, pulses, darks, jobs, G, part, frozen, clear_g, margin)]
+
+
+def _loads_fit(dmd, p, pulses, darks, jobs, G, stag, frozen, clear_g, margin):
+    """For each stagger of ``stag``: whether every load fits (:func:`_staggers_whose_loads_fit`)."""
+    # the last pulse's load (the next frame's first plane) has no deadline but takes the bus
+    offsets = np.repeat(np.arange(G), len(pulses))
+    starts = np.tile(pulses, G)[None, :] + offsets[None, :] * stag[:, None]
+    order = np.argsort(starts, axis=1, kind="stable")
+    starts = np.take_along_axis(starts, order, axis=1)
+    deadlines = np.take_along_axis(
+        np.tile(np.append(pulses[1:], 1 << 62), G)[None, :] + offsets[None, :] * stag[:, None],
+        order, axis=1)
+    lengths = np.tile(np.array(jobs), G)[order]
+    dark = np.tile(np.array(darks), G)[order]
+    end = np.zeros(len(stag), np.int64)
+    fits = np.ones(len(stag), bool)
+    for i in range(starts.shape[1]):
+        # a dark pulse's clears go before the loads once the memory may change (a row under
+        # way, or another group's clear, first)
+        done = np.maximum(end, starts[:, i] + frozen) + lengths[:, i]
+        cleared = starts[:, i] + frozen + clear_g + 2 * row_cycles(dmd, p.beats)
+        fits &= np.where(dark[:, i], cleared, done + margin) <= deadlines[:, i]
+        end = np.where(dark[:, i], end, done)
+    return fits
 
 
 def reload_bound(dmd, p):

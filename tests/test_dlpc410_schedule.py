@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from gateware.registers import Registers
 from sim.tb.plane_source import ramp_image
@@ -187,6 +189,16 @@ def played_exactly(dmd, p):
     camera = Camera(model)
     seen = to_lsb(camera.image(pulses[0], pulses[-1] + camera.ramp), p.lsb)
     assert np.array_equal(seen[:, :dmd.visible_columns], image[:, :dmd.visible_columns])
+
+
+@given(st.lists(st.integers(-10**6, 10**6), min_size=1, max_size=40),
+       st.lists(st.integers(-2 * 10**6, 2 * 10**6), max_size=40))
+def test_distance_to_nearest_equals_every_pair_compared(values, points):
+    """The spread search's pulse spacing test: the distance from each stagger to the nearest
+    pulse difference, from its neighbours in order, equals the least over every difference."""
+    values, points = np.unique(values), np.array(points, np.int64)
+    brute = np.abs(values[None, :] - points[:, None]).min(axis=1) if len(points) else points
+    assert np.array_equal(schedule._distance_to_nearest(values, points), brute)
 
 
 @pytest.mark.parametrize("mode", [ResetMode.QUAD, ResetMode.DUAL])
