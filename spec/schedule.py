@@ -1022,15 +1022,16 @@ def _distance_to_nearest(values, points):
 
 def _staggers_whose_loads_fit(dmd, p, pulses, darks, jobs, G, stag, frozen, clear_g, margin):
     """The staggers of ``stag`` (increasing) at which every load of the groups spread that far
-    apart, served in queue (pulse) order, ends inside its deadline (:func:`_spread`), in order.
-    Worked out a slice of staggers at a time, as the search wants only the first few."""
+    apart, served in queue (pulse) order, ends inside its deadline (:func:`_spread`), smallest
+    first: worked out 2,048 staggers at a time, as the search wants only the first few."""
     for first in range(0, len(stag), 2048):
         part = stag[first:first + 2048]
         yield from part[_loads_fit(dmd, p, pulses, darks, jobs, G, part, frozen, clear_g, margin)]
 
 
 def _loads_fit(dmd, p, pulses, darks, jobs, G, stag, frozen, clear_g, margin):
-    """For each stagger of ``stag``: whether every load fits (:func:`_staggers_whose_loads_fit`)."""
+    """For each stagger of ``stag``: whether every load ends inside its deadline, the loads in
+    queue (pulse) order (:func:`_staggers_whose_loads_fit`)."""
     # the last pulse's load (the next frame's first plane) has no deadline but takes the bus
     offsets = np.repeat(np.arange(G), len(pulses))
     starts = np.tile(pulses, G)[None, :] + offsets[None, :] * stag[:, None]

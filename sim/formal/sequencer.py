@@ -321,7 +321,7 @@ def sequencer_checks():
             Check("no clocking pulse while RST_ACTIVE is high", "Sequencer", rst_top, depth=12, induction=4,
                   quick=4),
             Check("no load within the settle time after a pulse and after RST_ACTIVE fell", "Sequencer",
-                  settle_top, depth=40, quick=32),
+                  settle_top, depth=40, quick=30),
             Check("no load of a pulsed group within its settle time, phased modes", "Sequencer",
                   phased_settle_top, depth=40, quick=24),
             Check("no clear overlapping a row load", "Sequencer", clear_top, depth=24, induction=4, quick=4),
