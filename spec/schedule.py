@@ -1024,34 +1024,27 @@ def _staggers_whose_loads_fit(dmd, p, pulses, darks, jobs, G, stag, frozen, clea
     """The staggers of ``stag`` (increasing) at which every load of the groups spread that far
     apart, served in queue (pulse) order, ends inside its deadline (:func:`_spread`), smallest
     first: worked out 2,048 staggers at a time, as the search wants only the first few."""
-    for first in range(0, len(stag), 2048):
-        part = stag[first:first + 2048]
-        yield from part[_loads_fit(dmd, p, pulses, darks, jobs, G, part, frozen, clear_g, margin)]
-
-
-def _loads_fit(dmd, p, pulses, darks, jobs, G, stag, frozen, clear_g, margin):
-    """For each stagger of ``stag``: whether every load ends inside its deadline, the loads in
-    queue (pulse) order (:func:`_staggers_whose_loads_fit`)."""
     # the last pulse's load (the next frame's first plane) has no deadline but takes the bus
     offsets = np.repeat(np.arange(G), len(pulses))
-    starts = np.tile(pulses, G)[None, :] + offsets[None, :] * stag[:, None]
-    order = np.argsort(starts, axis=1, kind="stable")
-    starts = np.take_along_axis(starts, order, axis=1)
-    deadlines = np.take_along_axis(
-        np.tile(np.append(pulses[1:], 1 << 62), G)[None, :] + offsets[None, :] * stag[:, None],
-        order, axis=1)
-    lengths = np.tile(np.array(jobs), G)[order]
-    dark = np.tile(np.array(darks), G)[order]
-    end = np.zeros(len(stag), np.int64)
-    fits = np.ones(len(stag), bool)
-    for i in range(starts.shape[1]):
-        # a dark pulse's clears go before the loads once the memory may change (a row under
-        # way, or another group's clear, first)
-        done = np.maximum(end, starts[:, i] + frozen) + lengths[:, i]
-        cleared = starts[:, i] + frozen + clear_g + 2 * row_cycles(dmd, p.beats)
-        fits &= np.where(dark[:, i], cleared, done + margin) <= deadlines[:, i]
-        end = np.where(dark[:, i], end, done)
-    return fits
+    deadline = np.tile(np.append(pulses[1:], 1 << 62), G)
+    for first in range(0, len(stag), 2048):
+        part = stag[first:first + 2048]
+        starts = np.tile(pulses, G)[None, :] + offsets[None, :] * part[:, None]
+        order = np.argsort(starts, axis=1, kind="stable")
+        starts = np.take_along_axis(starts, order, axis=1)
+        deadlines = np.take_along_axis(deadline[None, :] + offsets[None, :] * part[:, None], order, axis=1)
+        lengths = np.tile(np.array(jobs), G)[order]
+        dark = np.tile(np.array(darks), G)[order]
+        end = np.zeros(len(part), np.int64)
+        fits = np.ones(len(part), bool)
+        for i in range(starts.shape[1]):
+            # a dark pulse's clears go before the loads once the memory may change (a row under
+            # way, or another group's clear, first)
+            done = np.maximum(end, starts[:, i] + frozen) + lengths[:, i]
+            cleared = starts[:, i] + frozen + clear_g + 2 * row_cycles(dmd, p.beats)
+            fits &= np.where(dark[:, i], cleared, done + margin) <= deadlines[:, i]
+            end = np.where(dark[:, i], end, done)
+        yield from part[fits]
 
 
 def reload_bound(dmd, p):
