@@ -1,22 +1,80 @@
 """Reference model of the endpoint (network stack + application protocol), in plain Python.
 
-It reads frames byte by byte with its own parsing (only the application field tables are shared
-with the gateware, as the protocol's single definition) and predicts, frame by frame, every
-counter, every image row handed on, every configuration change and every reply. Rows are
-assembled from the image records' pixels as ``docs/protocol.md`` says (:class:`Rows`): a row goes
-on once all of it has come in consecutive records of one frame.
+It reads frames byte by byte with its own parsing and predicts, frame by frame, every counter,
+every image row handed on, every configuration change and every reply. It is an oracle apart
+from the gateware: only the application field tables are shared, as the protocol's single
+definition; every rule that decides what a record does (the values refused, the power-up
+configuration, frame id order) is written here from ``docs/protocol.md`` and the DMD's numbers
+from :mod:`spec.facts`, not taken from the functions the parser is built from. Rows are
+assembled from the image records' pixels as the page says (:class:`Rows`): a row goes on once
+all of it has come in consecutive records of one frame.
 """
 
 from dataclasses import dataclass, field
 
-from spec import records, wire
+from spec import facts, records, wire
 from spec.records import RecordType
-from spec.schedule import row_cycles
 
-__all__ = ["Model", "Rows", "ones_sum", "BROADCAST"]
+__all__ = ["Model", "Rows", "ones_sum", "sequencer_refusals", "newer", "REGISTER_LARGEST", "BROADCAST"]
 
 BROADCAST = b"\xff" * 6
 VLAN_TPIDS = (0x8100, 0x88A8, 0x9100)
+
+#: The sequencer record's registers narrower than their bytes on the wire, with the largest value
+#: each holds; every other register fills its bytes (the page: a value wider than its register
+#: is refused).
+REGISTER_LARGEST = {"reset_mode": 3, "order": 3, "trigger": 3, "anchor": 7, "chain": 1, "strict_rst": 1,
+                    "source": 1, "ns_flip": 1, "park": 1, "trigger_hold": 1}
+#: Register values the page's rules name: the global reset mode, the plane orders by
+#: ``order_table`` and by group, the periodic trigger.
+GLOBAL, BY_TABLE, BY_GROUP, PERIODIC = 0, 2, 3, 1
+#: Pulse groups, their offsets' width and the entries of one plane order table (the page's
+#: ``group_offsets`` and ``group_tables``).
+GROUPS, OFFSET_BITS, PLANES = 16, 24, 8
+
+
+def newer(frame, than):
+    """Frame id order, as the page says: ``frame`` is newer than ``than`` when it is 1 to 32,767
+    ahead of it, modulo 65,536."""
+    return 1 <= (frame - than) % 65536 <= 32767
+
+
+def sequencer_refusals(registers, dmd, beats=1):
+    """Why the sequencer could not obey a register set (the record's fields as ints), each
+    reason as the page lists it; empty for a set it takes. Written from the page alone, apart
+    from the checks the parser is built from, so that a test can hold the two to agree."""
+    r = registers
+    row_cycle = dmd.dclk_per_row // beats       # the DMD's DCLK cycles per row over the beats
+    clear = dmd.clear_row_cycles * row_cycle    # a block clear
+    shortest = max(clear, 4)                    # a stagger or offset that is not 0
+    lead = max(clear, row_cycle) + 2            # group 0's offset that is not 0, rounded up to even
+    lead += lead % 2
+    offsets = [r["group_offsets"] >> OFFSET_BITS * g & ((1 << OFFSET_BITS) - 1) for g in range(GROUPS)]
+
+    def names_each_plane_once(tables, table):
+        entries = {tables >> 3 * (PLANES * table + j) & 7 for j in range(PLANES)}
+        return entries == set(range(PLANES))
+
+    reasons = [f"{name} over {largest}" for name, largest in REGISTER_LARGEST.items() if r[name] > largest]
+    checks = [
+        ("lsb zero or odd", r["lsb"] == 0 or r["lsb"] % 2),
+        ("dark_gap odd", r["dark_gap"] % 2),
+        ("stagger odd", r["stagger"] % 2),
+        ("a group's offset odd", any(offset % 2 for offset in offsets)),
+        ("row_period under a row cycle", r["row_period"] < row_cycle),
+        ("period shorter than lsb in periodic mode", r["trigger"] == PERIODIC and r["period"] < r["lsb"]),
+        ("lsb shorter than t_rst + t_settle and a block clear", r["lsb"] < r["t_rst"] + r["t_settle"] + clear),
+        ("t_settle under 3 cycles", r["t_settle"] < 3),
+        ("a phased stagger not 0 but too short", r["reset_mode"] != GLOBAL and 0 < r["stagger"] < shortest),
+        ("a group offset not 0 but too short", r["order"] == BY_GROUP
+         and any(0 < offset < shortest for offset in offsets)),
+        ("a group offset below group 0's", r["order"] == BY_GROUP and min(offsets) < offsets[0]),
+        ("group 0's offset not 0 but under its lead", r["order"] == BY_GROUP and 0 < offsets[0] < lead),
+        ("order_table not each plane once", r["order"] == BY_TABLE and not names_each_plane_once(r["order_table"], 0)),
+        ("a group table not each plane once", r["order"] == BY_GROUP
+         and not all(names_each_plane_once(r["group_tables"], g) for g in range(GROUPS))),
+    ]
+    return reasons + [reason for reason, failed in checks if failed]
 
 
 def ones_sum(raw):
@@ -37,6 +95,7 @@ class Model:
     port: int
     frame_bits: int = 4
     beats: int = 1                  # DCLK beats per dmd cycle of the sequencer
+    armed: int = 0                  # power-up arming: the build's (the endpoint's own is disarmed)
     counters: dict = field(default_factory=dict)
     rows: list = field(default_factory=list)        # (frame tag, row, bytes) handed on
     replies: list = field(default_factory=list)     # ("arp"|"icmp"|"status", details)
@@ -52,8 +111,9 @@ class Model:
             self.counters.setdefault(name, 0)
         self.counters.update(dmd_columns=self.dmd.columns, dmd_rows=self.dmd.rows)
         self.assembler = Rows(self.dmd)
-        from gateware.protocol.parser import config_init
-        self.config = {k: int(v) for k, v in config_init(mac=self.mac, ip=self.ip, port=self.port).items()}
+        # the page's power-up configuration
+        self.config = {"bit_depth": 8, "armed": int(self.armed), "sequence_length": 1, "entries": 0, "loop": 1,
+                       "mac": int(self.mac), "ip": int(self.ip), "port": int(self.port)}
 
     def count(self, name, by=1):
         self.counters[name] += by
@@ -176,14 +236,14 @@ class Model:
         if kind == RecordType.CONTROL:
             control = wire.unpack(records.CONTROL, data[header_size:])
             names = [name for name, _ in records.CONFIG]
+            # every whole 8-bit frame the memory holds, 256 at most
+            frames = min(256, int(facts.MEMORY["bytes"].value) // (self.dmd.rows * self.dmd.columns))
 
             def applies(name):
                 return control["apply"] >> names.index(name) & 1
             if ((applies("bit_depth") and not 1 <= control["bit_depth"] <= 8)
                     or (applies("armed") and control["armed"] > 1)
-                    or (applies("sequence_length")
-                        and not 1 <= control["sequence_length"] <= min(256, (128 << 20) // (self.dmd.rows
-                                                                                           * self.dmd.columns)))
+                    or (applies("sequence_length") and not 1 <= control["sequence_length"] <= frames)
                     or (applies("entries") and control["entries"] > 2048)
                     or (applies("loop") and control["loop"] > 1)):
                 return "drop_app_value"
@@ -196,8 +256,7 @@ class Model:
                 return "drop_app_value"
         if kind == RecordType.SEQUENCER:
             registers = wire.unpack(records.SEQUENCER, data[header_size:])
-            if any(records.register_faults(registers, row_cycles(self.dmd, self.beats),
-                                          self.dmd.clear_row_cycles).values()):
+            if sequencer_refusals(registers, self.dmd, self.beats):
                 return "drop_app_value"
         mask = (1 << dict(records.HEADER)["sequence"]) - 1
         if self._sequence is not None and head["sequence"] != (self._sequence + 1) & mask:
@@ -266,6 +325,6 @@ class Rows:
         c["rows"] += 1
         c["payload_bytes"] += size
         c["last_frame"], c["last_row"] = frame, row
-        if not self._seen or records.frame_newer(frame, c["newest_frame"]):
+        if not self._seen or newer(frame, c["newest_frame"]):
             c["newest_frame"] = frame
         self._seen = True
