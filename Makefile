@@ -7,7 +7,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 JOBS   ?= 2
 
-.PHONY: setup test sim verilog resources timing formal bench waves lint clean
+.PHONY: setup test sim verilog resources timing formal bench figures waves lint clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -62,6 +62,10 @@ formal: $(STAMP)
 # Every benchmark; writes build/bench.json and prints the figures.
 bench: $(STAMP)
 	$(PY) -m flow bench
+
+# docs/figures.md from build/bench.json (make bench first): a table per figure prefix, with sources.
+figures: $(STAMP)
+	$(PY) -m flow figures
 
 waves: $(STAMP)
 	$(PY) -m flow waves

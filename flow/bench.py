@@ -1,16 +1,94 @@
 """``make bench``: run every benchmark, add the resource figures, write ``build/bench.json``.
 
-``build/bench.json`` is one flat JSON object: ``{"<figure>": {"value": number, "unit": "..."}}``.
-The same figures are printed as a table.
+``build/bench.json`` is one flat JSON object:
+``{"<figure>": {"value": number, "unit": "...", "source": "..."}}``. The same figures are printed
+as a table (``python -m flow figures`` writes them to ``docs/figures.md``).
+
+Every figure records where it comes from. A benchmark's ``run()`` gives ``{figure: (value, unit,
+source)}``, or ``(value, unit)`` where the module's ``SOURCE`` (or :data:`SOURCES`) holds the
+source all its figures share. A source is a short text whose first word is its kind
+(:data:`KINDS`): ``gateware`` (a simulation of the design or its generated Verilog), ``synthesis``
+(Yosys on the gateware), ``formal`` (SymbiYosys on the gateware), ``host`` (host code measured in
+Python), ``document`` (a data sheet's number), ``model`` (a Python model: the schedule model, the
+camera model on model output, ...) or ``arithmetic`` (derived from the figures it names; its kind
+is the weakest of theirs, so arithmetic on a model figure is a model figure; a name ending in
+``_model`` counts as a model figure's even when this run did not collect it).
+
+A figure without ``_model`` in its name is measured on the gateware: :func:`collect` adds
+``bench.figures_without_source`` (figures with no source, or one of no known kind) and
+``bench.measured_figures_from_model`` (figures without ``_model`` whose kind is ``model``); both
+must be 0, and ``python -m flow bench`` exits 1 if either is not.
 """
 
 import importlib
 import json
 import math
+import re
 import time
 from pathlib import Path
 
-__all__ = ["collect", "write", "print_table", "main"]
+__all__ = ["collect", "write", "print_table", "main", "kind", "kinds", "KINDS", "SOURCES", "CHECKS"]
+
+#: The kinds of source, strongest first: arithmetic takes the weakest of its inputs'.
+KINDS = ("gateware", "synthesis", "formal", "host", "document", "model")
+ARITHMETIC = "arithmetic"
+#: Sources of benchmark modules that give ``(value, unit)`` and have no ``SOURCE`` of their own.
+SOURCES = {
+    "sim.bench.formal": "formal: SymbiYosys on the gateware, every property of sim.formal.suite at its full "
+                        "depth (as make formal)",
+}
+#: The figures :func:`collect` adds about the others' sources (both must be 0).
+CHECKS = ("bench.figures_without_source", "bench.measured_figures_from_model")
+_NAME = re.compile(r"[A-Za-z_][\w]*(?:\.\w+)+")
+RESOURCES_SOURCE = "synthesis: Yosys synth_xilinx -family xc6s, per block and board build (flow.resources)"
+TIMING_SOURCE = "synthesis: Yosys synth_xilinx -family xc6s, logic depth per clock domain (flow.timing)"
+
+
+def kind(source):
+    """The kind a source names (its first word), or None when it names none of :data:`KINDS` or
+    ``arithmetic``."""
+    if not isinstance(source, str) or not source.split():
+        return None
+    word = source.split()[0].rstrip(":,;").lower()
+    return word if word in KINDS or word == ARITHMETIC else None
+
+
+def _inputs(source, figures):
+    """The figures an arithmetic source names: those collected, and names ending in ``_model``."""
+    return [n for n in _NAME.findall(source.split(None, 1)[1] if len(source.split()) > 1 else "")
+            if n in figures or n.endswith("_model")]
+
+
+def kinds(figures):
+    """Each figure's kind: its source's, arithmetic resolved to the weakest kind of the figures it
+    names (``arithmetic`` if it names none this run knows; None: no source of a known kind)."""
+    out = {}
+
+    def resolve(name, seen):
+        if name in out:
+            return out[name]
+        if name not in figures:               # a _model figure another run collects
+            return "model"
+        source = figures[name].get("source")
+        k = kind(source)
+        if k == ARITHMETIC:
+            ranks = [resolve(n, seen | {name}) for n in _inputs(source, figures) if n not in seen | {name}]
+            ranks = [r for r in ranks if r in KINDS]
+            k = max(ranks, key=KINDS.index) if ranks else ARITHMETIC
+        out[name] = k
+        return k
+
+    for name in figures:
+        resolve(name, frozenset())
+    return out
+
+
+def _check(figures):
+    """The figures with no source, and those without ``_model`` whose kind is ``model``."""
+    k = kinds(figures)
+    missing = sorted(n for n in figures if k[n] is None)
+    from_model = sorted(n for n in figures if k[n] == "model" and "_model" not in n)
+    return missing, from_model
 
 
 def collect(modules=None, *, resources=True, log=print):
@@ -19,21 +97,30 @@ def collect(modules=None, *, resources=True, log=print):
     for name in modules or MODULES:
         start = time.monotonic()
         log(f"bench: {name} ...")
-        result = importlib.import_module(name).run()
-        for key, (value, unit) in result.items():
+        module = importlib.import_module(name)
+        default = getattr(module, "SOURCE", SOURCES.get(name))
+        for key, figure in module.run().items():
+            value, unit, source = (*figure, default) if len(figure) == 2 else figure
             if not isinstance(value, (int, float)) or (isinstance(value, float) and not math.isfinite(value)):
                 raise ValueError(f"{name}: figure {key} is not a finite number: {value!r}")
-            figures[key] = {"value": value, "unit": unit}
+            figures[key] = {"value": value, "unit": unit, "source": source}
         log(f"bench: {name} done in {time.monotonic() - start:.1f} s")
     if resources:
         from flow import resources as res
         log("bench: resources (yosys synth_xilinx -family xc6s) ...")
         for key, (value, unit) in res.figures(res.report()).items():
-            figures[key] = {"value": value, "unit": unit}
+            figures[key] = {"value": value, "unit": unit, "source": RESOURCES_SOURCE}
         from flow import timing
         log("bench: logic depth per clock domain (yosys synth_xilinx -family xc6s) ...")
         for key, (value, unit) in timing.figures(timing.report()).items():
-            figures[key] = {"value": value, "unit": unit}
+            figures[key] = {"value": value, "unit": unit, "source": TIMING_SOURCE}
+    missing, from_model = _check(figures)
+    for what, names in (("no source", missing), ("a model's, without _model in its name", from_model)):
+        for key in names:
+            log(f"bench: {key}: source {what}")
+    counted = "arithmetic: counted by flow.bench.collect over this run's figures' names and sources"
+    figures[CHECKS[0]] = {"value": len(missing), "unit": "figures", "source": counted}
+    figures[CHECKS[1]] = {"value": len(from_model), "unit": "figures", "source": counted}
     return figures
 
 
@@ -46,15 +133,24 @@ def write(figures, path="build/bench.json"):
 
 def print_table(figures):
     width = max(len(k) for k in figures)
+    units = min(24, max(len(str(f["unit"])) for f in figures.values()))
     for key in sorted(figures):
         value, unit = figures[key]["value"], figures[key]["unit"]
         text = f"{value:.6g}" if isinstance(value, float) else str(value)
-        print(f"{key:<{width}}  {text:>14}  {unit}")
+        print(f"{key:<{width}}  {text:>14}  {unit:<{units}}  {figures[key].get('source') or '(no source)'}")
 
 
-def main(modules=None, resources=True):
+def main(modules=None, resources=True, path="build/bench.json"):
+    """Collect, write and print the figures; 1 if a figure has no source or a model's figure
+    lacks ``_model`` in its name (:data:`CHECKS`), else 0."""
     figures = collect(modules, resources=resources)
-    path = write(figures)
+    path = write(figures, path)
     print_table(figures)
     print(f"wrote {path}")
+    bad = {key: figures[key]["value"] for key in CHECKS if figures[key]["value"]}
+    if bad:
+        missing, from_model = _check({k: v for k, v in figures.items() if k not in CHECKS})
+        print("bench: " + ", ".join(f"{key} = {n}" for key, n in bad.items()) + " (must be 0): "
+              + ", ".join(missing + from_model))
+        return 1
     return 0

@@ -1,4 +1,4 @@
-"""Command line: ``python -m flow <verilog|resources|timing|formal|bench|sim|waves>``."""
+"""Command line: ``python -m flow <verilog|resources|timing|formal|bench|figures|sim|waves>``."""
 
 import argparse
 import sys
@@ -33,6 +33,7 @@ def main(argv=None):
     bench = sub.add_parser("bench", help="run the benchmarks and write build/bench.json")
     bench.add_argument("--only", action="append", help="run only this benchmark module (repeatable)")
     bench.add_argument("--no-resources", action="store_true", help="skip the synthesis figures")
+    sub.add_parser("figures", help="write docs/figures.md from build/bench.json (make bench's figures)")
     sim = sub.add_parser("sim", help="the system simulation on the default scene")
     sim.add_argument("--frames", type=int, default=None, help="number of frames to store and show")
     sim.add_argument("--dclk", type=float, default=400, choices=(200, 400), help="DCLK in MHz (default 400)")
@@ -69,6 +70,13 @@ def main(argv=None):
     if args.command == "bench":
         from flow.bench import main as run
         return run(args.only, resources=not args.no_resources)
+    if args.command == "figures":
+        from flow.figures import main as run
+        try:
+            return run()
+        except FileNotFoundError as error:
+            print(error, file=sys.stderr)
+            return 2
     if args.command == "sim" and args.virtual:
         from sim import virtual
         if args.virtual != "demo":

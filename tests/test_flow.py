@@ -156,5 +156,5 @@ def test_bench_json_is_flat_name_value_unit(tmp_path):
     data = json.loads(path.read_text())
     assert "serialiser.pixels_per_cycle" in data
     for key, entry in data.items():
-        assert set(entry) == {"value", "unit"}, key
+        assert set(entry) == {"value", "unit", "source"}, key
         assert isinstance(entry["value"], (int, float)) and isinstance(entry["unit"], str)

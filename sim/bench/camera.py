@@ -79,27 +79,34 @@ def _write(curves):
     save_figure(plt, fig, "camera_misalignment")
 
 
+#: Where the camera figures come from (:mod:`flow.bench`).
+SOURCE_RIG = ("gateware: sequencer Verilog (sim.seq_rig), test DMD, three frames triggered at the frame rate; "
+              "pins through the DLPC410 rule model, light through the camera model")
+
+
 def run():
     curves = {name.lower(): misalignment(order, name=f"camera_{name.lower()}")
               for name, order in plan_search.ORDER_NAMES.items()}
     _write(curves)
     figures = {}
     for order, by_shift in curves.items():
-        figures[f"cam.aligned_error_lsb_max_{order}"] = (float(np.abs(by_shift[0]).max()), "LSB")
+        figures[f"cam.aligned_error_lsb_max_{order}"] = (float(np.abs(by_shift[0]).max()), "LSB", SOURCE_RIG)
         for pct in SHOWN_PCT:
             when = f"lag_{pct}pct" if pct > 0 else f"lead_{-pct}pct"
             errors = by_shift[pct]
-            figures[f"cam.{when}_error_lsb_max_{order}"] = (float(np.abs(errors).max()), "LSB")
-            figures[f"cam.{when}_jump_at_128_lsb_{order}"] = (float(errors[128] - errors[127]), "LSB")
+            figures[f"cam.{when}_error_lsb_max_{order}"] = (float(np.abs(errors).max()), "LSB", SOURCE_RIG)
+            figures[f"cam.{when}_jump_at_128_lsb_{order}"] = (float(errors[128] - errors[127]), "LSB", SOURCE_RIG)
     # the plane order with the smallest worst error a 1 % misalignment either way leaves:
     # 0 MSB first, 1 LSB first, 2 interleaved
-    worst = {order: max(figures[f"cam.{w}_1pct_error_lsb_max_{order}"][0] for w in ("lag", "lead"))
-             for order in curves}
+    inputs = {order: [f"cam.{w}_1pct_error_lsb_max_{order}" for w in ("lag", "lead")] for order in curves}
+    worst = {order: max(figures[name][0] for name in names) for order, names in inputs.items()}
     figures["cam.best_order_1pct"] = (list(curves).index(min(worst, key=worst.get)),
-                                      "0 msb_first, 1 lsb_first, 2 interleaved")
+                                      "0 msb_first, 1 lsb_first, 2 interleaved",
+                                      "arithmetic: the order of the least of the larger of "
+                                      + ", ".join(" and ".join(names) for names in inputs.values()))
     return figures
 
 
 if __name__ == "__main__":
-    for figure, (value, unit) in run().items():
+    for figure, (value, unit, *_source) in run().items():
         print(f"{figure:50s} {value:10.3f} {unit}")

@@ -14,6 +14,11 @@ from sim.models.dlpc410 import Dlpc410
 from sim.models.dlpc410_driver import Driver, expand
 from spec.facts import DMDS
 
+#: Where every figure here comes from (:mod:`flow.bench`): Python code timed on the host, not a
+#: figure the models predict.
+SOURCE = ("host: wall-clock speed of the Python DLPC410 model (sim.models.dlpc410) and camera model "
+          "(sim.models.camera) on full XGA, on the machine running the bench")
+
 
 def _rate(count, func):
     start = time.perf_counter()

@@ -8,6 +8,7 @@ the row cycle, and at the DDR2's pace of ``make sim``):
 
 * the solver's plan under the facts table's terms, checked, against the bound, one timeline's
   ceiling and the frame the solver proved no plan of that kind beats (``_model``: arithmetic);
+  the plan finder's LSB and, chained, its overlap (``_model``: the plan's);
 * the plan finder's (:func:`spec.group_orders.find`: under the sequencer's own terms, played by
   the schedule model with no pulse late) measured on the gateware: the sequencer's generated
   Verilog plays the ramp frame back to back (:func:`sim.bench.rates.measured_rate`: the rule
@@ -104,7 +105,8 @@ def figures(*, seconds=120.0):
     that kind beats; then the plan finder's, under the sequencer's terms, measured on the
     gateware beside the model's period."""
     from sim import xga
-    from sim.bench.rates import measured_rate
+    from sim.bench.rates import RIG_SOURCE, measured_rate
+    from sim.bench.seq import bound_figure
 
     out, dmd = {}, DMDS["dlp7000"]
     # the store's words a cycle: a row every row cycle (as the rates bench's store stand-in), or
@@ -119,9 +121,12 @@ def figures(*, seconds=120.0):
         bad = check(found)
         assert not bad, bad
         name = f"seq.gray8_group_orders_hz_dlp7000_dual_{key}"
-        out[name + "_model"] = (found.rate_hz, "Hz")
-        out[name.replace("_hz_", "_fraction_of_bound_") + "_model"] = (found.rate_hz / bound(dmd, dclk), "")
-        out[name.replace("_hz_", "_hz_limit_") + "_model"] = (FABRIC_HZ / found.lower, "Hz")
+        out[name + "_model"] = (found.rate_hz, "Hz", "model: the constraint solver's plan (spec.group_orders.solve) "
+                                                     "under the facts table's terms, checked by check()")
+        out[name.replace("_hz_", "_fraction_of_bound_") + "_model"] = (
+            found.rate_hz / bound(dmd, dclk), "", f"arithmetic: {name}_model / {bound_figure(dclk)}")
+        out[name.replace("_hz_", "_hz_limit_") + "_model"] = (
+            FABRIC_HZ / found.lower, "Hz", "model: the frame the constraint solver proved no such plan beats")
         print(f"DLP7000, dual, {dclk / 1e6:g} MHz, rows every {pace} cycles: {found.rate_hz:.1f} Hz "
               f"({found.frame} cycles, {found.rate_hz / bound(dmd, dclk):.1%} of the bound; one timeline's ceiling "
               f"{top.rate_hz:.1f} Hz); no such plan beats {found.lower} cycles = {FABRIC_HZ / found.lower:.1f} Hz")
@@ -137,11 +142,14 @@ def figures(*, seconds=120.0):
               f"{chosen.rate_hz:.1f} Hz, {FABRIC_HZ / period / bound(dmd, dclk):.1%} of the bound")
         for o, order in sorted(zip(p.group_offsets, p.group_tables, strict=True)):
             print(f"  offset {o:>6}  order {' '.join(map(str, order))}")
-        out[name.replace("_group_orders_hz_", "_rate_hz_") + "_group_orders"] = (FABRIC_HZ / period, "Hz")
-        out[name.replace("_group_orders_hz_", "_rate_hz_") + "_group_orders_model"] = (chosen.rate_hz, "Hz")
-        out[name.replace("_group_orders_hz_", "_fraction_of_bound_") + "_group_orders"] = (
-            FABRIC_HZ / period / bound(dmd, dclk), "")
-        out[f"seq.gray8_group_orders_lsb_cycles_dlp7000_dual_{key}"] = (p.lsb, "cycles")
+        what = f"the plan finder's dual plan of group orders (spec.group_orders.find) at {dclk / 1e6:g} MHz"
+        rate_name = name.replace("_group_orders_hz_", "_rate_hz_") + "_group_orders"
+        out[rate_name] = (FABRIC_HZ / period, "Hz", RIG_SOURCE.format(what=what, name=f"group_orders_{key}"))
+        out[rate_name + "_model"] = (chosen.rate_hz, "Hz", f"model: {what}, schedule model")
+        out[name.replace("_group_orders_hz_", "_fraction_of_bound_") + "_group_orders_model"] = (
+            FABRIC_HZ / period / bound(dmd, dclk), "", f"arithmetic: {rate_name} / {bound_figure(dclk)}")
+        out[f"seq.gray8_group_orders_lsb_cycles_dlp7000_dual_{key}_model"] = (p.lsb, "cycles",
+                                                                            f"model: {what}: its LSB")
         # chained (a stored sequence played without triggers): each group starts its next frame
         # as it ends this one, so no group waits for the last to be loaded again
         chained, groups = find(dmd, dclk, ResetMode.DUAL, seconds=seconds, chained=True, **kwargs)
@@ -156,10 +164,14 @@ def figures(*, seconds=120.0):
         for o, order in sorted(zip(chained.params.group_offsets, chained.params.group_tables, strict=True)):
             print(f"  offset {o:>6}  order {' '.join(map(str, order))}")
         chained_name = name.replace("_group_orders_hz_", "_rate_hz_") + "_group_orders_chained"
-        out[chained_name] = (FABRIC_HZ / period, "Hz")
-        out[chained_name + "_model"] = (chained.rate_hz, "Hz")
-        out[chained_name.replace("_rate_hz_", "_fraction_of_bound_")] = (FABRIC_HZ / period / bound(dmd, dclk), "")
-        out[f"seq.gray8_group_orders_chained_overlap_cycles_dlp7000_dual_{key}"] = (overlap, "cycles")
+        what = f"the plan finder's chained dual plan of group orders (spec.group_orders.find) at {dclk / 1e6:g} MHz"
+        out[chained_name] = (FABRIC_HZ / period, "Hz",
+                             RIG_SOURCE.format(what=what, name=f"group_orders_{key}_chained"))
+        out[chained_name + "_model"] = (chained.rate_hz, "Hz", f"model: {what}, schedule model")
+        out[chained_name.replace("_rate_hz_", "_fraction_of_bound_") + "_model"] = (
+            FABRIC_HZ / period / bound(dmd, dclk), "", f"arithmetic: {chained_name} / {bound_figure(dclk)}")
+        out[f"seq.gray8_group_orders_chained_overlap_cycles_dlp7000_dual_{key}_model"] = (
+            overlap, "cycles", f"model: {what}: its largest group offset")
     return out
 
 
@@ -169,5 +181,5 @@ def run():
 
 
 if __name__ == "__main__":
-    for figure, (value, unit) in run().items():
+    for figure, (value, unit, *_source) in run().items():
         print(f"{figure:60s} {value:10.3f} {unit}")

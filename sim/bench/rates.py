@@ -35,6 +35,7 @@ import numpy as np
 
 from gateware.dlpc410.trigger import PIN_TO_STROBE
 from sim.bench import group_orders
+from sim.bench.seq import BOUND_SOURCE, PLAN_SOURCE, bound_figure
 from sim.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import frame_lights, period_light
@@ -56,6 +57,20 @@ CASES = [
 ]
 #: Frames played back to back (the period is the median of the last ones).
 FRAMES = 4
+#: Where a rate measured by :func:`measured_rate` comes from (:mod:`flow.bench`), run ``name``.
+RIG_SOURCE = ("gateware: sequencer Verilog (sim.seq_rig), rates rig: {what}, the ramp frame back to back, pins "
+              "through the DLPC410 rule model, commands equal to the schedule model's, camera model on a frame "
+              "between two others; run {name}")
+
+
+def _alias(figures, name):
+    """The figure ``name`` again under another name: its value and unit, arithmetic."""
+    return figures[name][0], figures[name][1], f"arithmetic: equal to {name}"
+
+
+def _larger(figures, a, b):
+    """The larger of the figures ``a`` and ``b``, arithmetic."""
+    return max(figures[a][0], figures[b][0]), figures[a][1], f"arithmetic: the larger of {a} and {b}"
 
 
 def measured_rate(dmd_name, mode, strict, dclk, reading="ti", *, frames=FRAMES, name=None, plan=None):
@@ -124,9 +139,10 @@ def run():
     # (the plan finder's) or of groups in orders of their own (the solver's), frames that do not
     # overlap (a window holds each whole frame); chained phased frames overlap (a group starts
     # the next while another ends this one), so they are beside it, not in it
-    figures["seq.gray8_rate_hz_dlp7000"] = max(figures["seq.gray8_rate_hz_dlp7000_best_200mhz"],
-                                               figures["seq.gray8_rate_hz_dlp7000_dual_200mhz_group_orders"])
-    figures["seq.gray8_rate_hz_dlp7000_chained"] = figures["seq.gray8_rate_hz_dlp7000_dual_200mhz_group_orders_chained"]
+    figures["seq.gray8_rate_hz_dlp7000"] = _larger(figures, "seq.gray8_rate_hz_dlp7000_best_200mhz",
+                                                   "seq.gray8_rate_hz_dlp7000_dual_200mhz_group_orders")
+    figures["seq.gray8_rate_hz_dlp7000_chained"] = _alias(figures,
+                                                          "seq.gray8_rate_hz_dlp7000_dual_200mhz_group_orders_chained")
     figures.update(binary())
     return figures
 
@@ -141,7 +157,9 @@ def ceilings(measured=None):
         for strict in (True, False):
             key = f"{int(dclk / 1e6)}mhz" + ("" if strict else "_loose")
             top, each = ceiling.ceiling(dmd, dclk, strict_rst=strict)
-            figures[f"seq.gray8_ceiling_hz_dlp7000_{key}_model"] = (top.rate_hz, "Hz")
+            ceiling_name = f"seq.gray8_ceiling_hz_dlp7000_{key}_model"
+            figures[ceiling_name] = (top.rate_hz, "Hz", "model: the ceiling of one-timeline plans (spec.ceiling), "
+                                     f"{'strict' if strict else 'loose'} RST_ACTIVE reading")
             print(f"ceiling, DLP7000 at {dclk / 1e6:g} MHz, {'strict' if strict else 'loose'} RST_ACTIVE: "
                   f"{top.rate_hz:.1f} Hz, {top.rate_hz / schedule.bound(dmd, dclk):.1%} of the bound")
             for mode, c in each.items():
@@ -150,7 +168,8 @@ def ceilings(measured=None):
                       f"LSB {c.lsb}  stagger {c.stagger}"))
             rate = (measured or {}).get(f"seq.gray8_rate_hz_dlp7000_best_{key}")
             if rate is not None:
-                figures[f"seq.gray8_fraction_of_ceiling_dlp7000_best_{key}"] = (rate[0] / top.rate_hz, "")
+                figures[f"seq.gray8_fraction_of_ceiling_dlp7000_best_{key}_model"] = (
+                    rate[0] / top.rate_hz, "", f"arithmetic: seq.gray8_rate_hz_dlp7000_best_{key} / {ceiling_name}")
     return figures
 
 
@@ -163,19 +182,26 @@ def cases(measured):
         period, plan, error = measured_rate(dmd_name, mode, strict, dclk, reading, name=f"rates_{key}")
         assert error == 0, f"{key}: a frame not exact ({error} LSB)"
         measured[dmd_name, mode, strict, dclk, reading] = period, plan, error
-        figures[f"seq.gray8_rate_hz_{key}"] = (schedule.FABRIC_HZ / period, "Hz")
-        figures[f"seq.gray8_rate_hz_{key}_model"] = (plan.rate_hz, "Hz")
+        what = (f"{dmd_name} {mode.lower()}{'' if strict else ' loose'} at {dclk / 1e6:g} MHz, "
+                f"{reading} settle reading")
+        figures[f"seq.gray8_rate_hz_{key}"] = (schedule.FABRIC_HZ / period, "Hz",
+                                              RIG_SOURCE.format(what=what, name=f"rates_{key}"))
+        figures[f"seq.gray8_rate_hz_{key}_model"] = (plan.rate_hz, "Hz", f"{PLAN_SOURCE}, {what}")
         print(f"{key}: {schedule.FABRIC_HZ / period:.1f} Hz measured; binds: {plan.binds}")
     # the DLP9500 under TI's rules (its fastest reset mode) and under the paper's reading, with
     # the bounds and the paper's own arithmetic beside them
     dlp9500, clock = DMDS["dlp9500"], 400e6
-    figures["seq.gray8_rate_hz_dlp9500"] = max(figures["seq.gray8_rate_hz_dlp9500_global_400mhz"],
-                                               figures["seq.gray8_rate_hz_dlp9500_quad_400mhz"])
-    figures["seq.gray8_bound_hz_dlp9500_400mhz"] = (schedule.bound(dlp9500, clock), "Hz")
-    figures["seq.gray8_rate_hz_dlp9500_paper_timing"] = figures["seq.gray8_rate_hz_dlp9500_global_400mhz_paper_timing"]
-    figures["seq.gray8_bound_hz_dlp9500_400mhz_paper_reading"] = (
-        schedule.bound(dlp9500, clock, reading="paper"), "Hz")
-    figures["seq.gray8_rate_hz_dlp9500_paper_eq_model"] = (schedule.paper_eq_rate_hz(dlp9500, clock), "Hz")
+    figures["seq.gray8_rate_hz_dlp9500"] = _larger(figures, "seq.gray8_rate_hz_dlp9500_global_400mhz",
+                                                   "seq.gray8_rate_hz_dlp9500_quad_400mhz")
+    figures[bound_figure(clock, "dlp9500")] = (schedule.bound(dlp9500, clock), "Hz", BOUND_SOURCE)
+    figures["seq.gray8_rate_hz_dlp9500_paper_timing"] = _alias(figures,
+                                                               "seq.gray8_rate_hz_dlp9500_global_400mhz_paper_timing")
+    figures["seq.gray8_bound_hz_dlp9500_400mhz_paper_reading_model"] = (
+        schedule.bound(dlp9500, clock, reading="paper"), "Hz",
+        "model: the rate bound (spec.schedule.bound, docs/bounds.md) under the four-DMD paper's settle reading")
+    figures["seq.gray8_rate_hz_dlp9500_paper_eq_model"] = (
+        schedule.paper_eq_rate_hz(dlp9500, clock), "Hz",
+        "model: the four-DMD paper's equations 6-7 (spec.schedule.paper_eq_rate_hz), the facts table's timing")
     return figures
 
 
@@ -199,11 +225,20 @@ def best(measured=None):
             print(f"plan finder, DLP7000 at {dclk / 1e6:g} MHz, {'strict' if strict else 'loose'} "
                   f"RST_ACTIVE: {found.binds}\n{found.table()}")
             rate = schedule.FABRIC_HZ / period
-            figures[f"seq.gray8_rate_hz_dlp7000_best_{key}"] = (rate, "Hz")
-            figures[f"seq.gray8_rate_hz_dlp7000_best_{key}_model"] = (plan.rate_hz, "Hz")
-            figures[f"seq.gray8_fraction_of_bound_dlp7000_best_{key}"] = (rate / schedule.bound(dmd, dclk), "")
+            what = (f"the plan finder's choice for the DLP7000 at {dclk / 1e6:g} MHz, "
+                    f"{'strict' if strict else 'loose'} RST_ACTIVE reading ({mode.lower()})")
+            run_name = (f"rates_dlp7000_{mode.lower()}{'' if strict else '_loose'}_{int(dclk / 1e6)}mhz"
+                        if known is not None and known.params == plan.params else f"rates_dlp7000_best_{key}")
+            figures[f"seq.gray8_rate_hz_dlp7000_best_{key}"] = (rate, "Hz", RIG_SOURCE.format(what=what, name=run_name))
+            figures[f"seq.gray8_rate_hz_dlp7000_best_{key}_model"] = (
+                plan.rate_hz, "Hz", f"model: {what} (spec.plan_search.find), schedule model")
+            figures[f"seq.gray8_fraction_of_bound_dlp7000_best_{key}_model"] = (
+                rate / schedule.bound(dmd, dclk), "",
+                f"arithmetic: seq.gray8_rate_hz_dlp7000_best_{key} / {bound_figure(dclk)}")
     # the camera's error over a frame played back to back at each best plan
-    figures["seq.gray_error_lsb_max_at_best_rate"] = (max(errors), "LSB")
+    figures["seq.gray_error_lsb_max_at_best_rate"] = (
+        max(errors), "LSB", "gateware: the camera model's largest error on a frame between two others in each "
+                            "seq.gray8_rate_hz_dlp7000_best_* run (rates rig)")
     return figures
 
 
@@ -247,24 +282,35 @@ def binary():
     }
     row_period = xga_plan(dclk).params.row_period
     allowed = schedule.FABRIC_HZ / (dmd.rows * row_period)
-    figures = {"seq.binary_row_period_cycles_memory": (row_period, "cycle"),
-               "seq.binary_rate_hz_memory_400mhz_allowed": (allowed, "Hz")}
+    figures = {
+        "seq.binary_row_period_cycles_memory_model": (
+            row_period, "cycle", "model: the system run's plan (sim.xga.plan) at DCLK 400 MHz, its row period from "
+                                 "the MCB timing model's read rate under GigE ingest (sim.fast_top.read_rate)"),
+        "seq.binary_rate_hz_memory_400mhz_allowed_model": (
+            allowed, "Hz", "arithmetic: 200 MHz / (DLP7000 rows x seq.binary_row_period_cycles_memory_model)"),
+    }
     for key, kwargs in plans.items():
         plan = schedule.plan(dmd, dclk, depth=1, chain=True, **kwargs)
         assert key.startswith("prng") or plan.params.row_period == row_period
         rate = schedule.FABRIC_HZ / binary_period(plan, f"rates_binary_{key}_400")
-        figures[f"seq.binary_rate_hz_{key}_400mhz"] = (rate, "Hz")
-        figures[f"seq.binary_rate_hz_{key}_400mhz_model"] = (plan.rate_hz, "Hz")
+        figures[f"seq.binary_rate_hz_{key}_400mhz"] = (
+            rate, "Hz", f"gateware: sequencer Verilog (sim.seq_rig), full DLP7000 at DCLK 400 MHz, 1-bit patterns "
+                        f"chained from one trigger, block 0's pulses on the pins, commands equal to the schedule "
+                        f"model's; run rates_binary_{key}_400")
+        figures[f"seq.binary_rate_hz_{key}_400mhz_model"] = (plan.rate_hz, "Hz",
+                                                             f"{PLAN_SOURCE}, {key.replace('_', ' ')}")
         if key.startswith("memory"):
-            figures[f"seq.binary_rate_{key}_fraction_of_allowed"] = (rate / allowed, "")
+            figures[f"seq.binary_rate_{key}_fraction_of_allowed_model"] = (
+                rate / allowed, "",
+                f"arithmetic: seq.binary_rate_hz_{key}_400mhz / seq.binary_rate_hz_memory_400mhz_allowed_model")
     # the headline figures: phased under TI's rules
-    figures["seq.binary_rate_hz_prng_400mhz"] = figures["seq.binary_rate_hz_prng_quad_400mhz"]
-    figures["seq.binary_rate_hz_memory"] = figures["seq.binary_rate_hz_memory_quad_400mhz"]
+    figures["seq.binary_rate_hz_prng_400mhz"] = _alias(figures, "seq.binary_rate_hz_prng_quad_400mhz")
+    figures["seq.binary_rate_hz_memory"] = _alias(figures, "seq.binary_rate_hz_memory_quad_400mhz")
     return figures
 
 
 if __name__ == "__main__":
     import sys
     only = {"binary": binary, "ceiling": ceilings, "best": best, "group_orders": group_orders.figures}
-    for figure, (value, unit) in (only[sys.argv[1]]() if sys.argv[1:] else run()).items():
+    for figure, (value, unit, *_source) in (only[sys.argv[1]]() if sys.argv[1:] else run()).items():
         print(f"{figure:50s} {value:10.1f} {unit}")

@@ -6,9 +6,10 @@ schedule model's plans for the DLP7000; the tests prove the gateware's command s
 the model's cycle for cycle (``tests/test_dlpc410_sequencer.py`` on the test DMD in every reset
 mode, ``tests/test_dlpc410_sequencer_verilog.py`` on full XGA, global and single-block), and
 :func:`gateware_binary_period` re-measures one rate on the gateware here.
-Each figure is given in cycles or Hz at 200 MHz DCLK, and again at 400 MHz (``_400mhz``). Rates
-that come from the schedule model's plans end in ``_model``; the measured rate of frames played
-back to back on the gateware is ``sys.xga_rate_hz_measured`` (:mod:`sim.bench.system_xga`).
+Each figure is given in cycles or Hz at 200 MHz DCLK, and again at 400 MHz (``_400mhz``). Figures
+that come from the schedule model (its plans' rates, frames, LSBs and staggers, the bound, the
+newer frame on XGA and its reload on the test DMD) end in ``_model``; the measured rate of frames
+played back to back on the gateware is ``sys.xga_rate_hz_measured`` (:mod:`sim.bench.system_xga`).
 
 Grey error (:func:`gray_error_table`): a global MSB-first 8-bit frame of the ramp image on the
 DLP7000, played by the sequencer's generated Verilog (:mod:`sim.seq_rig`), its pins replayed
@@ -38,6 +39,21 @@ XGA = DMDS["dlp7000"]
 #: DDR2 read bandwidth assumed to feed row loads in the model figures (the seed design's 1.3 GB/s).
 DDR2_BYTES_PER_S = 1.3e9
 FAST = {"t_rst_s": 20 / 200e6, "t_settle_s": 30 / 200e6}
+#: Where the figures come from (:mod:`flow.bench`).
+PLAN_SOURCE = "model: the schedule model's plan (spec.schedule.plan)"
+BOUND_SOURCE = "model: the rate bound (spec.schedule.bound, docs/bounds.md), the facts table's timing"
+LATENCY_SOURCE = ("gateware: sequencer, Amaranth simulator (sim.tb.seq_sim), test DMD, pins through the DLPC410 "
+                  "rule model")
+#: When the newer frame completes, by ``late``.
+NEWER = {False: "while every group waits", True: "just after group 0's last pulse"}
+GRAY_SOURCE = ("gateware: sequencer Verilog (sim.seq_rig), one triggered 8-bit frame of the ramp on the DLP7000 "
+               "at the fastest legal {what} plan, pins through the DLPC410 rule model, light through the camera "
+               "model; run {name}")
+
+
+def bound_figure(dclk_hz, dmd="dlp7000"):
+    """The name of the 8-bit rate bound's figure for ``dmd`` at DCLK ``dclk_hz``."""
+    return f"seq.gray8_bound_hz_{dmd}{'' if dclk_hz == 200e6 else f'_{int(dclk_hz / 1e6)}mhz'}_model"
 
 
 def trigger_latencies():
@@ -94,19 +110,19 @@ def dlp9500_figures(f, sfx):
     gray = schedule.plan(d, f)
     mem = schedule.plan(d, f, depth=1, chain=True)
     return {
-        f"seq.row_period_cycles_dlp9500_store{sfx}": (gray.params.row_period, "cycle"),
-        f"seq.gray8_rate_hz_dlp9500_global{sfx}_model": (gray.rate_hz, "Hz"),
+        f"seq.row_period_cycles_dlp9500_store{sfx}_model": (gray.params.row_period, "cycle", PLAN_SOURCE),
+        f"seq.gray8_rate_hz_dlp9500_global{sfx}_model": (gray.rate_hz, "Hz", PLAN_SOURCE),
         f"seq.gray8_rate_hz_dlp9500_global_at_row_rate{sfx}_model": (
-            schedule.plan(d, f, words_per_cycle=row_rate).rate_hz, "Hz"),
-        f"seq.gray8_bound_hz_dlp9500{sfx}": (schedule.bound(d, f), "Hz"),
-        f"seq.binary_rate_hz_memory_dlp9500{sfx}_model": (mem.rate_hz, "Hz"),
+            schedule.plan(d, f, words_per_cycle=row_rate).rate_hz, "Hz", PLAN_SOURCE),
+        bound_figure(f, "dlp9500"): (schedule.bound(d, f), "Hz", BOUND_SOURCE),
+        f"seq.binary_rate_hz_memory_dlp9500{sfx}_model": (mem.rate_hz, "Hz", PLAN_SOURCE),
         f"seq.binary_rate_hz_memory_dlp9500_at_row_rate{sfx}_model": (
-            schedule.plan(d, f, depth=1, chain=True, words_per_cycle=row_rate).rate_hz, "Hz"),
+            schedule.plan(d, f, depth=1, chain=True, words_per_cycle=row_rate).rate_hz, "Hz", PLAN_SOURCE),
         f"seq.binary_rate_hz_prng_dlp9500{sfx}_model": (
-            schedule.plan(d, f, depth=1, chain=True, source=Source.PRNG).rate_hz, "Hz"),
+            schedule.plan(d, f, depth=1, chain=True, source=Source.PRNG).rate_hz, "Hz", PLAN_SOURCE),
         f"seq.binary_rate_hz_prng_dlp9500_phased_loose{sfx}_model": (
             schedule.plan(d, f, depth=1, chain=True, source=Source.PRNG, reset_mode=ResetMode.SINGLE,
-                          strict_rst=False).rate_hz, "Hz"),
+                          strict_rst=False).rate_hz, "Hz", PLAN_SOURCE),
     }
 
 
@@ -206,13 +222,18 @@ def gray_error_figures():
     model, first, last, image = played_frame(phased, 200e6, "bench_gray_error_phased")
     camera = Camera(model)
     seen = to_lsb(camera.image(first, last + camera.delay + camera.ramp), phased.params.lsb)
+    fastest = GRAY_SOURCE.format(what="global", name="bench_gray_error_1")
     return {
-        "seq.gray_error_lsb_at_max_rate_phased": (float(np.abs(seen - image[:, :XGA.visible_columns]).max()), "LSB"),
-        "seq.gray_error_lsb_at_max_rate": (aligned[4], "LSB"),
-        "seq.gray_error_rms_lsb_at_max_rate": (aligned[5], "LSB"),
-        f"seq.gray_error_rms_lsb_misaligned_{MISALIGN_FIGURE_US}us": (off[5], "LSB"),
-        f"seq.gray_error_max_lsb_misaligned_{MISALIGN_FIGURE_US}us": (off[4], "LSB"),
-        "seq.gray_error_rate_hz_at_max_rate_model": (aligned[2], "Hz"),
+        "seq.gray_error_lsb_at_max_rate_phased": (
+            float(np.abs(seen - image[:, :XGA.visible_columns]).max()), "LSB",
+            GRAY_SOURCE.format(what="single-block (loose RST_ACTIVE reading)", name="bench_gray_error_phased")),
+        "seq.gray_error_lsb_at_max_rate": (aligned[4], "LSB", fastest),
+        "seq.gray_error_rms_lsb_at_max_rate": (aligned[5], "LSB", fastest),
+        f"seq.gray_error_rms_lsb_misaligned_{MISALIGN_FIGURE_US}us": (
+            off[5], "LSB", f"{fastest}, camera window {MISALIGN_FIGURE_US} us late"),
+        f"seq.gray_error_max_lsb_misaligned_{MISALIGN_FIGURE_US}us": (
+            off[4], "LSB", f"{fastest}, camera window {MISALIGN_FIGURE_US} us late"),
+        "seq.gray_error_rate_hz_at_max_rate_model": (aligned[2], "Hz", f"{PLAN_SOURCE}, the fastest global plan"),
     }
 
 
@@ -225,22 +246,34 @@ def run():
     newer = {late: newer_frame(TEST_DMD, small, late=late, gateware=True) for late in (False, True)}
     # the trigger that shows the newer frame; complete -> shown is the figure below
     worst = max(lat + [n[2] for n in newer.values()])
-    figures["seq.trigger_latency_cycles_typical"] = (typical, "cycle")
-    figures["seq.trigger_latency_cycles_worst"] = (worst, "cycle")
+    figures["seq.trigger_latency_cycles_typical"] = (
+        typical, "cycle", f"{LATENCY_SOURCE}, the median over a trigger pin on each phase (runs bench_latency_*)")
+    figures["seq.trigger_latency_cycles_worst"] = (
+        worst, "cycle", f"{LATENCY_SOURCE}, the largest over runs bench_latency_* and bench_newer_frame_*")
     for mhz in (200, 400):
-        figures[f"seq.trigger_latency_ns_typical_at_{mhz}mhz"] = (typical * 1e3 / mhz, "ns")
-        figures[f"seq.trigger_latency_ns_worst_at_{mhz}mhz"] = (worst * 1e3 / mhz, "ns")
+        for which in ("typical", "worst"):
+            cycles = f"seq.trigger_latency_cycles_{which}"
+            figures[f"seq.trigger_latency_ns_{which}_at_{mhz}mhz"] = (
+                figures[cycles][0] * 1e3 / mhz, "ns", f"arithmetic: {cycles} x {1e3 / mhz:g} ns")
     for late, (reload, shown, _pin) in newer.items():
         when = "late" if late else "waiting"
-        figures[f"seq.newer_frame_reload_cycles_{when}_test_dmd"] = (reload, "cycle")
-        figures[f"seq.newer_frame_to_pulse_cycles_{when}_test_dmd"] = (shown, "cycle")
+        # (the reload is the schedule model's: the earliest cycle it obeys the trigger; the gateware
+        # is played with that trigger, which it obeys, and its pulse measured)
+        figures[f"seq.newer_frame_reload_cycles_{when}_test_dmd_model"] = (
+            reload, "cycle", "model: schedule model (spec.schedule.simulate), test DMD: frame complete to the "
+                             "earliest trigger it obeys")
+        figures[f"seq.newer_frame_to_pulse_cycles_{when}_test_dmd"] = (
+            shown, "cycle", f"{LATENCY_SOURCE}, a newer frame completing {NEWER[late]}, triggered at "
+                            f"seq.newer_frame_reload_cycles_{when}_test_dmd_model; run bench_newer_frame_{when}")
     xga = schedule.plan(XGA, 200e6, depth=1).params
     for late in (False, True):
         when = "late" if late else "waiting"
         reload, shown, _pin = newer_frame(XGA, xga, late=late)
-        figures[f"seq.newer_frame_reload_cycles_{when}_dlp7000"] = (reload, "cycle")
-        figures[f"seq.newer_frame_to_pulse_cycles_{when}_dlp7000"] = (shown, "cycle")
-        figures[f"seq.newer_frame_to_pulse_us_{when}_dlp7000_at_200mhz"] = (shown / 200, "us")
+        model = f"model: schedule model (spec.schedule.simulate), DLP7000, a newer frame completing {NEWER[late]}"
+        figures[f"seq.newer_frame_reload_cycles_{when}_dlp7000_model"] = (reload, "cycle", model)
+        figures[f"seq.newer_frame_to_pulse_cycles_{when}_dlp7000_model"] = (shown, "cycle", model)
+        figures[f"seq.newer_frame_to_pulse_us_{when}_dlp7000_at_200mhz_model"] = (
+            shown / 200, "us", f"arithmetic: seq.newer_frame_to_pulse_cycles_{when}_dlp7000_model x 5 ns")
 
     for mhz in (200, 400):
         f = mhz * 1e6
@@ -250,16 +283,17 @@ def run():
         glob = schedule.plan(XGA, f, **row_rate)
         quad = schedule.plan(XGA, f, reset_mode=ResetMode.QUAD, **row_rate)
         single_loose = schedule.plan(XGA, f, reset_mode=ResetMode.SINGLE, strict_rst=False, **row_rate)
-        figures[f"seq.gray8_rate_hz_dlp7000_global{sfx}_model"] = (glob.rate_hz, "Hz")
-        figures[f"seq.gray8_frame_cycles_dlp7000_global{sfx}"] = (glob.frame_cycles, "cycle")
-        figures[f"seq.gray8_lsb_cycles_dlp7000_global{sfx}"] = (glob.params.lsb, "cycle")
-        figures[f"seq.gray8_rate_hz_dlp7000_phased{sfx}_model"] = (quad.rate_hz, "Hz")
-        figures[f"seq.gray8_lsb_cycles_dlp7000_phased{sfx}"] = (quad.params.lsb, "cycle")
-        figures[f"seq.gray8_stagger_cycles_dlp7000_phased{sfx}"] = (quad.params.stagger, "cycle")
+        figures[f"seq.gray8_rate_hz_dlp7000_global{sfx}_model"] = (glob.rate_hz, "Hz", PLAN_SOURCE)
+        figures[f"seq.gray8_frame_cycles_dlp7000_global{sfx}_model"] = (glob.frame_cycles, "cycle", PLAN_SOURCE)
+        figures[f"seq.gray8_lsb_cycles_dlp7000_global{sfx}_model"] = (glob.params.lsb, "cycle", PLAN_SOURCE)
+        figures[f"seq.gray8_rate_hz_dlp7000_phased{sfx}_model"] = (quad.rate_hz, "Hz", PLAN_SOURCE)
+        figures[f"seq.gray8_lsb_cycles_dlp7000_phased{sfx}_model"] = (quad.params.lsb, "cycle", PLAN_SOURCE)
+        figures[f"seq.gray8_stagger_cycles_dlp7000_phased{sfx}_model"] = (quad.params.stagger, "cycle", PLAN_SOURCE)
         dual = schedule.plan(XGA, f, reset_mode=ResetMode.DUAL, **row_rate)
-        figures[f"seq.gray8_rate_hz_dlp7000_phased_dual{sfx}_model"] = (dual.rate_hz, "Hz")
-        figures[f"seq.gray8_rate_hz_dlp7000_phased_single_loose{sfx}_model"] = (single_loose.rate_hz, "Hz")
-        figures[f"seq.gray8_bound_hz_dlp7000{sfx}"] = (schedule.bound(XGA, f), "Hz")
+        figures[f"seq.gray8_rate_hz_dlp7000_phased_dual{sfx}_model"] = (dual.rate_hz, "Hz", PLAN_SOURCE)
+        figures[f"seq.gray8_rate_hz_dlp7000_phased_single_loose{sfx}_model"] = (single_loose.rate_hz, "Hz",
+                                                                               PLAN_SOURCE)
+        figures[bound_figure(f)] = (schedule.bound(XGA, f), "Hz", BOUND_SOURCE)
 
         prng = schedule.plan(XGA, f, depth=1, chain=True, source=Source.PRNG)
         prng_phased = schedule.plan(XGA, f, depth=1, chain=True, source=Source.PRNG,
@@ -267,18 +301,21 @@ def run():
         mem = schedule.plan(XGA, f, depth=1, chain=True, words_per_cycle=DDR2_BYTES_PER_S / 8 / f)
         mem_phased = schedule.plan(XGA, f, depth=1, chain=True, reset_mode=ResetMode.SINGLE, strict_rst=False,
                                    words_per_cycle=DDR2_BYTES_PER_S / 8 / f)
-        figures[f"seq.binary_rate_hz_prng{sfx}_model"] = (prng.rate_hz, "Hz")
-        figures[f"seq.binary_rate_hz_prng_phased_loose{sfx}_model"] = (prng_phased.rate_hz, "Hz")
-        figures[f"seq.binary_rate_hz_memory{sfx}_model"] = (mem.rate_hz, "Hz")
-        figures[f"seq.binary_rate_hz_memory_phased_loose{sfx}_model"] = (mem_phased.rate_hz, "Hz")
+        figures[f"seq.binary_rate_hz_prng{sfx}_model"] = (prng.rate_hz, "Hz", PLAN_SOURCE)
+        figures[f"seq.binary_rate_hz_prng_phased_loose{sfx}_model"] = (prng_phased.rate_hz, "Hz", PLAN_SOURCE)
+        figures[f"seq.binary_rate_hz_memory{sfx}_model"] = (mem.rate_hz, "Hz", f"{PLAN_SOURCE}, DDR2 at 1.3 GB/s")
+        figures[f"seq.binary_rate_hz_memory_phased_loose{sfx}_model"] = (mem_phased.rate_hz, "Hz",
+                                                                        f"{PLAN_SOURCE}, DDR2 at 1.3 GB/s")
         figures.update(dlp9500_figures(f, sfx))
 
     measured, model = gateware_binary_period()
-    figures["seq.binary_period_cycles_test_dmd_gateware"] = (measured, "cycle")
-    figures["seq.binary_period_cycles_test_dmd_model"] = (model, "cycle")
+    figures["seq.binary_period_cycles_test_dmd_gateware"] = (
+        measured, "cycle", "gateware: sequencer, Amaranth simulator (sim.tb.seq_sim), test DMD, on-chip source "
+                           "phased, the last two patterns' block 0 pulses; run bench_binary_period")
+    figures["seq.binary_period_cycles_test_dmd_model"] = (model, "cycle", PLAN_SOURCE)
     return figures
 
 
 if __name__ == "__main__":
-    for name, (value, unit) in run().items():
+    for name, (value, unit, *_source) in run().items():
         print(f"{name:55s} {value:14.2f} {unit}")

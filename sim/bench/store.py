@@ -183,18 +183,27 @@ def run():
     w = write_rate()
     alone = read_rate(timing=McbTiming())
     busy = read_rate(timing=McbTiming(), planes=INGEST_PLANES, ingest_bytes_per_s=INGEST_BYTES_PER_S)
+    reader = "gateware: the store's plane reader (128-bit port), Amaranth simulator, MCB model (sim.models.mcb)"
+    alone_source = f"{reader}, one DLP7000 plane alone"
+    busy_source = f"{reader}, {INGEST_PLANES} DLP7000 planes while the writer takes rows at the GigE line rate"
     return {
-        "store.write_bytes_per_s": (w["bytes_per_s"], "B/s"),
-        "store.read_words_per_dmd_cycle_128": (alone["words_per_cycle"], "word/cycle"),
-        "store.read_fraction_of_model_bandwidth": (alone["fraction"], "1"),
-        "store.xga_plane_read_us": (alone["plane_us"], "us"),
-        "store.read_words_per_dmd_cycle_with_ingest": (busy["words_per_cycle"], "word/cycle"),
-        "store.dlp7000_row_period_cycles_with_ingest": (row_period(DMDS["dlp7000"], busy["words_per_cycle"]),
-                                                        "cycle"),
-        "store.ingest_bytes_per_s_during_read": (busy["ingest_bytes_per_s"], "B/s"),
+        "store.write_bytes_per_s": (w["bytes_per_s"], "B/s",
+                                    "gateware: serialiser and store (StoreChain), Amaranth simulator, MCB model "
+                                    "(sim.models.mcb), DLP7000 rows"),
+        "store.read_words_per_dmd_cycle_128": (alone["words_per_cycle"], "word/cycle", alone_source),
+        # (the name says it: a fraction of the memory model's sustained bandwidth)
+        "store.read_fraction_of_model_bandwidth": (
+            alone["fraction"], "1", "model: store.read_words_per_dmd_cycle_128 over the MCB model's sustained "
+                                    "bandwidth, refresh taken off (sim.models.mcb.McbTiming)"),
+        "store.xga_plane_read_us": (alone["plane_us"], "us", alone_source),
+        "store.read_words_per_dmd_cycle_with_ingest": (busy["words_per_cycle"], "word/cycle", busy_source),
+        "store.dlp7000_row_period_cycles_with_ingest": (
+            row_period(DMDS["dlp7000"], busy["words_per_cycle"]), "cycle",
+            "arithmetic: the shortest even row period that store.read_words_per_dmd_cycle_with_ingest keeps fed"),
+        "store.ingest_bytes_per_s_during_read": (busy["ingest_bytes_per_s"], "B/s", busy_source),
     }
 
 
 if __name__ == "__main__":
-    for name, (value, unit) in run().items():
+    for name, (value, unit, *_source) in run().items():
         print(f"{name} = {value:.4g} {unit}")

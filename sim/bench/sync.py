@@ -54,6 +54,11 @@ UNTRIMMED_FRAMES = 2_000
 EIGHT_FRAMES = 250
 #: The crystals' tolerance the extrapolation takes (any temperature).
 PPM_TOLERANCE = 100
+#: Where a figure of the tiled rig's run ``name`` comes from (:mod:`flow.bench`).
+TILED_SOURCE = ("gateware: tiled rig (sim.tiled_rig), the sync master's and the boards' Verilog under Verilator, "
+                "each on its own crystal model; run {name}")
+#: ... and its light: every board's pins through the DLPC410 rule model, one camera over the tiles.
+CAMERA_SOURCE = TILED_SOURCE + ", pins through the DLPC410 rule model, light through the camera model"
 
 
 def _plan(depth, **kw):
@@ -134,17 +139,21 @@ def anchors():
         spread = float(run.spreads().max())
         rows.append([name, order.name, anchor, f"{spread:.3f}",
                      *[f"{errors[w][k]:.4f}" for w in windows for k in (0, 1)]])
-        figures[f"sync.spread_ns_max_untrimmed_{name}"] = (spread, "ns, loops off")
+        figures[f"sync.spread_ns_max_untrimmed_{name}"] = (spread, "ns, loops off",
+                                                           TILED_SOURCE.format(name=f"sync_anchor_{name}"))
         for window, (seam, *_) in errors.items():
-            figures[f"sync.seam_gray_error_lsb_max_untrimmed_{name}_{window}"] = (seam, "LSB, loops off")
+            figures[f"sync.seam_gray_error_lsb_max_untrimmed_{name}_{window}"] = (
+                seam, "LSB, loops off", CAMERA_SOURCE.format(name=f"sync_anchor_{name}") + f", window {window}")
     write_table("sync_anchors", ["anchor", "order", "anchor_register", "spread_ns_max",
                                  *[f"{w}_{what}_lsb_max" for w in windows for what in ("seam", "tile")]], rows)
     names = list(ANCHORS)
     for window in windows:
-        seams = [figures[f"sync.seam_gray_error_lsb_max_untrimmed_{n}_{window}"][0] for n in names]
+        inputs = [f"sync.seam_gray_error_lsb_max_untrimmed_{n}_{window}" for n in names]
+        seams = [figures[name][0] for name in inputs]
         # ties (to a thousandth of an LSB) go to the first
         figures[f"sync.best_anchor_{window}"] = (int(np.argmin(np.round(seams, 3))),
-                                                 ", ".join(f"{i} {n}" for i, n in enumerate(names)))
+                                                 ", ".join(f"{i} {n}" for i, n in enumerate(names)),
+                                                 "arithmetic: the anchor of the least of " + ", ".join(inputs))
     return figures
 
 
@@ -183,19 +192,22 @@ def run():
     _plot(rows)
     after = spreads[locked:]
     hours = len(after) // 2
+    source = TILED_SOURCE.format(name="sync_spread_4planes")
     figures = {
-        "sync.boards": (len(OSCILLATORS), "boards"),
-        "sync.frames": (min(s["frames"] for s in long.status), "frames a board played"),
-        "sync.refused": (long.counts["not_ready"] + long.counts["early"], "pulses the master refused"),
-        "sync.ppm_max": (float(max(abs(o.error(t)) for o in OSCILLATORS for t in (0, long.syncs[-1] / 1e12)) * 1e6),
-                         "ppm, the crystals' largest error in the run"),
-        "sync.lock_frames": (locked, "frames until every board's loop stayed locked"),
-        "sync.spread_ns_max": (float(after.max()), "ns, every pulse of every frame once locked"),
-        "sync.spread_ns_max_first_half": (float(after[:hours].max()), "ns"),
-        "sync.spread_ns_max_second_half": (float(after[hours:].max()), "ns"),
-        "sync.spread_ns_max_acquiring": (float(spreads[:locked].max()), "ns, before the lock"),
+        "sync.boards": (len(OSCILLATORS), "boards", source),
+        "sync.frames": (min(s["frames"] for s in long.status), "frames a board played", source),
+        "sync.refused": (long.counts["not_ready"] + long.counts["early"], "pulses the master refused", source),
+        "sync.ppm_max_model": (
+            float(max(abs(o.error(t)) for o in OSCILLATORS for t in (0, long.syncs[-1] / 1e12)) * 1e6),
+            "ppm, the crystals' largest error in the run",
+            "model: the crystal models of run sync_spread_4planes (sim.tiled_rig.Oscillator), their largest error"),
+        "sync.lock_frames": (locked, "frames until every board's loop stayed locked", source),
+        "sync.spread_ns_max": (float(after.max()), "ns, every pulse of every frame once locked", source),
+        "sync.spread_ns_max_first_half": (float(after[:hours].max()), "ns", source),
+        "sync.spread_ns_max_second_half": (float(after[hours:].max()), "ns", source),
+        "sync.spread_ns_max_acquiring": (float(spreads[:locked].max()), "ns, before the lock", source),
         "sync.locked_rate_difference_ppm_max": (float((rates.max(axis=1) - rates.min(axis=1))[1:].max()),
-                                                "ppm between boards, per 500 frames once locked"),
+                                                "ppm between boards, per 500 frames once locked", source),
     }
 
     untrimmed = _run(4, UNTRIMMED_FRAMES, "sync_spread_4planes_untrimmed", trim=False)
@@ -203,9 +215,10 @@ def run():
     loose_rates = _chunk_rates(untrimmed)
     difference = float((loose_rates.max(axis=1) - loose_rates.min(axis=1)).max()) * 1e-6
     sampling_ns = float(loose[:, 0].max())
+    source = TILED_SOURCE.format(name="sync_spread_4planes_untrimmed")
     figures.update({
-        "sync.spread_ns_max_untrimmed": (float(loose.max()), "ns, loops off"),
-        "sync.first_pulse_spread_ns_max_untrimmed": (sampling_ns, "ns (the boards' sampling of the pulse)"),
+        "sync.spread_ns_max_untrimmed": (float(loose.max()), "ns, loops off", source),
+        "sync.first_pulse_spread_ns_max_untrimmed": (sampling_ns, "ns (the boards' sampling of the pulse)", source),
     })
 
     # 8 planes: with the loops (every board's pins checked, the seams) and without (the check)
@@ -214,13 +227,22 @@ def run():
     seam, anywhere, wrong = _seam_errors(eight, _boards(eight), _plan(8).params.lsb, eight_locked or 1)
     loose8 = _run(8, 100, "sync_spread_8planes_untrimmed", trim=False)
     predicted = sampling_ns + difference * float(_since_ns(loose8)[-1])
+    lit = CAMERA_SOURCE.format(name="sync_spread_8planes")
     figures.update({
-        "sync.spread_ns_max_8planes": (float(eight.spreads()[eight_locked:].max()), "ns, loops locked"),
-        "sync.seam_gray_error_lsb_max": (seam, "LSB, window from pulse to pulse, either side of a seam"),
-        "sync.tile_gray_error_lsb_max": (anywhere, "LSB, the same window, any pixel"),
-        "sync.gray_levels_wrong": (wrong, "pixels of every frame once locked whose light, rounded, is not their level"),
-        "sync.spread_ns_max_8planes_untrimmed": (float(loose8.spreads().max()), "ns, 100 frames, loops off"),
-        "sync.spread_ns_max_8planes_untrimmed_predicted_model": (predicted, "ns, from the 4-plane run's figures"),
+        "sync.spread_ns_max_8planes": (float(eight.spreads()[eight_locked:].max()), "ns, loops locked",
+                                       TILED_SOURCE.format(name="sync_spread_8planes")),
+        "sync.seam_gray_error_lsb_max": (seam, "LSB, window from pulse to pulse, either side of a seam", lit),
+        "sync.tile_gray_error_lsb_max": (anywhere, "LSB, the same window, any pixel", lit),
+        "sync.gray_levels_wrong": (wrong, "pixels of every frame once locked whose light, rounded, is not their level",
+                                   lit),
+        "sync.spread_ns_max_8planes_untrimmed": (float(loose8.spreads().max()), "ns, 100 frames, loops off",
+                                                 TILED_SOURCE.format(name="sync_spread_8planes_untrimmed")),
+        # (arithmetic on measured figures; ``_predicted_model``: a prediction, set against the one measured)
+        "sync.spread_ns_max_8planes_untrimmed_predicted_model": (
+            predicted, "ns, from the 4-plane run's figures",
+            "arithmetic: sync.first_pulse_spread_ns_max_untrimmed + the largest rate difference between boards in "
+            "run sync_spread_4planes_untrimmed x the time from the sync pulse to the last pulse in run "
+            "sync_spread_8planes_untrimmed"),
     })
 
     # the DLP7000's 8-bit frame, for hours: the crystals' tolerance, or the loop's residual
@@ -230,11 +252,17 @@ def run():
                    for _, e in clock_trim.lock(dlp7000.frame_cycles, ppm, pulses=400)[200:]) * 1e-6
     figures.update({
         "sync.spread_ns_max_last_hour_extrapolated_model": (
-            float(after.max()) + 2 * residual * frame_ns, "ns, DLP7000 8-bit frame, loops on"),
+            float(after.max()) + 2 * residual * frame_ns, "ns, DLP7000 8-bit frame, loops on",
+            "model: sync.spread_ns_max plus twice the clock loop model's residual at +-100 ppm "
+            "(sim.models.clock_trim.lock) over the schedule model's DLP7000 8-bit frame at 400 MHz"),
         "sync.spread_ns_max_last_hour_extrapolated_untrimmed_model": (
             2 * BOARD_PERIOD_FS / 1e6 + 2 * PPM_TOLERANCE * 1e-6 * frame_ns,
-            "ns, DLP7000 8-bit frame, loops off, +-100 ppm"),
-        "sync.wall_s": (long.wall_s + untrimmed.wall_s + eight.wall_s + loose8.wall_s, "s of simulation"),
+            "ns, DLP7000 8-bit frame, loops off, +-100 ppm",
+            "model: two board cycles plus 200 ppm of the schedule model's DLP7000 8-bit frame at 400 MHz"),
+        "sync.wall_s": (long.wall_s + untrimmed.wall_s + eight.wall_s + loose8.wall_s, "s of simulation",
+                        TILED_SOURCE.format(name="sync_spread_4planes, sync_spread_4planes_untrimmed, "
+                                                 "sync_spread_8planes and sync_spread_8planes_untrimmed")
+                        + ", wall time"),
     })
     figures.update(anchors())
     return figures
@@ -279,20 +307,23 @@ def dlp9500():
                     traces=False, trim=True, store_words=4)
     locked = run.locked_from()
     spreads = run.spreads()
+    source = TILED_SOURCE.format(name="sync_spread_dlp9500") + ", full DLP9500 geometry"
     return {
-        "sync.dlp9500_frames": (min(s["frames"] for s in run.status), "frames a board played"),
-        "sync.dlp9500_frame_cycles": (plan.frame_cycles, "dmd cycles a frame"),
-        "sync.dlp9500_lock_frames": (-1 if locked is None else locked, "frames until every loop stayed locked"),
+        "sync.dlp9500_frames": (min(s["frames"] for s in run.status), "frames a board played", source),
+        "sync.dlp9500_frame_cycles_model": (plan.frame_cycles, "dmd cycles a frame",
+                                            "model: the schedule model's plan (spec.schedule.plan)"),
+        "sync.dlp9500_lock_frames": (-1 if locked is None else locked, "frames until every loop stayed locked",
+                                     source),
         "sync.dlp9500_spread_ns_max": (float(spreads[locked:].max()) if locked is not None else float("nan"),
-                                       "ns, once locked"),
+                                       "ns, once locked", source),
         "sync.dlp9500_spread_ns_max_acquiring": (float(spreads[:locked].max()) if locked else float(spreads.max()),
-                                                 "ns, before the lock"),
-        "sync.dlp9500_wall_s": (run.wall_s, "s of simulation"),
+                                                 "ns, before the lock", source),
+        "sync.dlp9500_wall_s": (run.wall_s, "s of simulation", source + ", wall time"),
     }
 
 
 if __name__ == "__main__":
     import sys
     benches = {"dlp9500": dlp9500, "anchors": anchors}
-    for figure, (value, unit) in (benches[sys.argv[1]]() if sys.argv[1:] else run()).items():
+    for figure, (value, unit, *_source) in (benches[sys.argv[1]]() if sys.argv[1:] else run()).items():
         print(f"{figure:55s} {value:12.3f} {unit}")

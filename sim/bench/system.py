@@ -7,6 +7,10 @@ scene and reports what it measured. The full-XGA figures (``sys.sim_cycles_per_s
 
 from sim import system
 
+#: Where every figure here comes from (:mod:`flow.bench`).
+SOURCE = ("gateware: the projector's core end to end (sim.system.run: generated Verilog under Verilator, small "
+          "geometry, GMII in, MCB model, DLPC410 rule model and camera model out), the default scene")
+
 
 def run():
     r = system.run("scene", scene=True)

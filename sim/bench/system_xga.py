@@ -5,6 +5,11 @@ then back to back: DCLK, the frame period measured on the pins, latency, grey er
 from sim import xga
 from sim.system import XGA_BACK_TO_BACK, XGA_ENTRIES, XGA_FRAMES, XGA_ONE_BY_ONE, latency
 
+#: Where a figure of the run ``name`` comes from (:mod:`flow.bench`).
+XGA_SOURCE = ("gateware: the full-XGA system run (sim.xga, as make sim: the core's Verilog under Verilator, "
+              "GMII in, MCB model, DLPC410 rule model and camera model out), {what}; run {name}")
+PLAN_SOURCE = "model: the schedule model's period for the run's plan (spec.schedule), run {name}"
+
 
 def run():
     r = xga.run("bench", frames=XGA_FRAMES, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK,
@@ -12,20 +17,22 @@ def run():
     assert all(f["max_error_lsb"] == 0 for f in r["frames"]), "the XGA run showed a wrong image"
     typical, worst = latency(r["frames"])
     period = _median_period(r)
+    run = XGA_SOURCE.format(what="DLP7000, the default scene", name="bench")
     return {
-        "sys.xga_dclk_hz": (r["dclk_hz"], "Hz"),
-        "sys.xga_frame_period_cycles_measured": (period, "cycle"),
-        "sys.xga_rate_hz_measured": (xga.DMD_HZ / period, "Hz"),
-        "sys.xga_frame_period_cycles_model": (r["period_cycles"], "cycle"),
-        "sys.xga_rate_hz_model": (r["rate_hz"], "Hz"),
-        "sys.xga_frame_sim_wall_s": (r["xga_frame_sim_wall_s"], "s"),
-        "sys.sim_cycles_per_s": (r["dmd_cycles"] / r["sim_wall_s"], "dmd cycle/s"),
-        "sys.xga_trigger_latency_cycles": (typical, "cycle"),
-        "sys.xga_trigger_latency_cycles_worst": (worst, "cycle"),
-        "sys.xga_gray_error_lsb_max": (max(f["max_error_lsb"] for f in r["frames"]), "LSB"),
+        "sys.xga_dclk_hz": (r["dclk_hz"], "Hz", run),
+        "sys.xga_frame_period_cycles_measured": (period, "cycle", run + ", back-to-back frames on the pins"),
+        "sys.xga_rate_hz_measured": (xga.DMD_HZ / period, "Hz",
+                                     "arithmetic: 200 MHz / sys.xga_frame_period_cycles_measured"),
+        "sys.xga_frame_period_cycles_model": (r["period_cycles"], "cycle", PLAN_SOURCE.format(name="bench")),
+        "sys.xga_rate_hz_model": (r["rate_hz"], "Hz", PLAN_SOURCE.format(name="bench")),
+        "sys.xga_frame_sim_wall_s": (r["xga_frame_sim_wall_s"], "s", run + ", wall time"),
+        "sys.sim_cycles_per_s": (r["dmd_cycles"] / r["sim_wall_s"], "dmd cycle/s", run + ", wall time"),
+        "sys.xga_trigger_latency_cycles": (typical, "cycle", run),
+        "sys.xga_trigger_latency_cycles_worst": (worst, "cycle", run),
+        "sys.xga_gray_error_lsb_max": (max(f["max_error_lsb"] for f in r["frames"]), "LSB", run),
         # the default scene over GigE: the first frame whole, the others as deltas of it (rows changed)
-        "eth.scene_frames_per_s": (r["scene"]["delta_frames_per_s"], "frame/s"),
-        "eth.scene_whole_frames_per_s": (r["scene"]["whole_frames_per_s"], "frame/s"),
+        "eth.scene_frames_per_s": (r["scene"]["delta_frames_per_s"], "frame/s", run + ", on the GMII pins"),
+        "eth.scene_whole_frames_per_s": (r["scene"]["whole_frames_per_s"], "frame/s", run + ", on the GMII pins"),
         **faulty(),
         **dlp9500(),
     }
@@ -38,14 +45,17 @@ def dlp9500():
     r = xga.run("bench-dlp9500", frames=XGA_FRAMES, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK,
                 log=lambda _text: None, dmd=DMDS["dlp9500"])
     typical, worst = latency(r["frames"])
+    run = XGA_SOURCE.format(what="the DLP9500's core, the default scene", name="bench-dlp9500")
     return {
-        "sys.dlp9500_rate_hz_measured": (xga.DMD_HZ / _median_period(r), "Hz"),
-        "sys.dlp9500_rate_hz_model": (r["rate_hz"], "Hz"),
-        "sys.dlp9500_gray_error_lsb_max": (max(f["max_error_lsb"] for f in r["frames"]), "LSB"),
-        "sys.dlp9500_trigger_latency_cycles": (typical, "cycle"),
-        "sys.dlp9500_trigger_latency_cycles_worst": (worst, "cycle"),
-        "eth.dlp9500_scene_frames_per_s": (r["scene"]["delta_frames_per_s"], "frame/s"),
-        "eth.dlp9500_scene_whole_frames_per_s": (r["scene"]["whole_frames_per_s"], "frame/s"),
+        "sys.dlp9500_rate_hz_measured": (xga.DMD_HZ / _median_period(r), "Hz",
+                                         run + ", back-to-back frames on the pins"),
+        "sys.dlp9500_rate_hz_model": (r["rate_hz"], "Hz", PLAN_SOURCE.format(name="bench-dlp9500")),
+        "sys.dlp9500_gray_error_lsb_max": (max(f["max_error_lsb"] for f in r["frames"]), "LSB", run),
+        "sys.dlp9500_trigger_latency_cycles": (typical, "cycle", run),
+        "sys.dlp9500_trigger_latency_cycles_worst": (worst, "cycle", run),
+        "eth.dlp9500_scene_frames_per_s": (r["scene"]["delta_frames_per_s"], "frame/s", run + ", on the GMII pins"),
+        "eth.dlp9500_scene_whole_frames_per_s": (r["scene"]["whole_frames_per_s"], "frame/s",
+                                                 run + ", on the GMII pins"),
     }
 
 
@@ -58,14 +68,16 @@ def faulty():
         r = xga.run(f"bench-{kind}", frames=XGA_FRAMES, one_by_one=XGA_ONE_BY_ONE, back_to_back=XGA_BACK_TO_BACK,
                     faults=kind, log=lambda _text: None)
         status = r["status"]
+        run = XGA_SOURCE.format(what=f"DLP7000, faults {kind} (sim.xga.FAULTS)", name=f"bench-{kind}")
         figures.update({
-            f"sys.xga_faults_{kind}_gray_error_lsb_max": (max(f["max_error_lsb"] for f in r["frames"]), "LSB"),
-            f"sys.xga_faults_{kind}_rate_hz_measured": (xga.DMD_HZ / _median_period(r), "Hz"),
-            f"sys.xga_faults_{kind}_memory_stalls": (r["mcb_stalls"], "command"),
-            f"sys.xga_faults_{kind}_row_underruns": (status["row_underruns"], "row"),
-            f"sys.xga_faults_{kind}_pulses_late": (status["pulses_late"], "pulse"),
-            f"sys.xga_faults_{kind}_rst_active_late": (status["rst_active_late"], "pulse"),
-            f"sys.xga_faults_{kind}_t_rst_measured_cycles": (status["rst_active_cycles_max"], "cycle"),
+            f"sys.xga_faults_{kind}_gray_error_lsb_max": (max(f["max_error_lsb"] for f in r["frames"]), "LSB", run),
+            f"sys.xga_faults_{kind}_rate_hz_measured": (xga.DMD_HZ / _median_period(r), "Hz",
+                                                        run + ", back-to-back frames on the pins"),
+            f"sys.xga_faults_{kind}_memory_stalls": (r["mcb_stalls"], "command", run),
+            f"sys.xga_faults_{kind}_row_underruns": (status["row_underruns"], "row", run),
+            f"sys.xga_faults_{kind}_pulses_late": (status["pulses_late"], "pulse", run),
+            f"sys.xga_faults_{kind}_rst_active_late": (status["rst_active_late"], "pulse", run),
+            f"sys.xga_faults_{kind}_t_rst_measured_cycles": (status["rst_active_cycles_max"], "cycle", run),
         })
     return figures
 
