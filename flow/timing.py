@@ -2,22 +2,37 @@
 
 Nothing here can run ISE's timing analysis, so this is the best evidence we can give without
 it: the mapped netlist's deepest register-to-register paths, counted in the units a Spartan-6
-path is made of.
+path is made of, and an estimate of their delay in ns from the data sheet's figures.
 
 * **LUT levels**: LUT1..LUT6 cells on the path (a MUXF7/MUXF8 sits in the same slice as the
   LUTs it joins and is not counted; a LUT-RAM read counts as a LUT).
 * **Carry chain**: the longest CARRY4 chain on the path, in bits (4 per CARRY4), and how many
   separate chains the path goes through.
+* **Delay estimate** (:func:`path_ns_estimate`): clock to out, a LUT delay and a net a level, the
+  carry chain's bits, a net into the flip-flop and its setup, from ``spec.facts.SPARTAN6_PATH``
+  (DS162's -3 figures and a routing allowance per net that is an assumption), against the domain's
+  clock period (``timing.<domain>.period_ns``). A path's end takes the most LUT levels and the
+  longest chain of any path into it, perhaps two different paths: the estimate is the larger.
+  Not modelled: a block RAM's or DSP's clock to out (a path from one starts later than from a
+  flip-flop), fanout, placement. ISE's timing report is the check this stands in for.
 
 How the LUTs are mapped (:func:`netlist`): ``synth_xilinx`` as it is, up to its LUT mapping;
-then each clock domain's logic is mapped on its own, with every input of a LUT given the same
-delay, far above a carry chain's. This keeps the mapper's area recovery from making paths deeper
-than they need to be: Yosys has no Spartan-6 delays and maps with Artix-7's per-input delays (a
-LUT's fastest input 127 ps, its slowest 642 ps), so a chain of 2-input LUTs on fast inputs costs
-it little and a 16-bit carry chain weighs more than a level; and it stretches every path up to
-the slowest one in what it maps, which for the whole design is the ``sync`` domain's. Mapped this
-way, the mapper minimises LUT levels, as the budget counts them, each domain against its own
-deepest path.
+then each clock domain's logic is mapped on its own (the cones of its registers), so that the
+mapper's area recovery does not stretch a path towards the slowest in the whole design, another
+domain's. Each domain is mapped twice, and both are reported:
+
+* **Yosys' delays** (the headline: ``timing.<domain>.lut_levels_max``, ``.registers_over_budget``,
+  ``.path_ns_max_estimate``; ``python -m flow timing``): every LUT input given Yosys' own delay,
+  its slowest input's, :data:`LUT_DELAY` = 642 ps, against its own carry chain delays. Yosys has
+  no Spartan-6 delays and maps with Artix-7's; a 16-bit carry chain weighs more than a LUT level
+  to it, so it may relax a LUT-only path by a level or two where a path with a chain is slower.
+  This is the conservative measure, and the headline.
+* **Uniform** (``timing.<domain>.lut_levels_max_uniform_mapping`` and the others with that
+  suffix; ``--lut-delay 5000``): every LUT input :data:`UNIFORM_LUT_DELAY` = 5,000 ps, far above a
+  carry chain's, so the mapper minimises LUT levels as the budget counts them (a 16-bit chain on
+  top of them allowed). It says how deep the logic need be, where the headline says how deep a
+  mapper left to its own delays made it; the two are kept side by side so that neither is read
+  alone.
 
 A path starts at a flip-flop output, a block RAM or DSP output, a shift-register LUT or a top
 input, and ends at a flip-flop, block RAM, DSP or shift-register input, or at a LUT-RAM's write
@@ -26,9 +41,11 @@ level from its read address to its output. A path belongs to the clock domain of
 ends at. The budget for 200 MHz on a -3 Spartan-6 that the ``dmd`` domain
 is pipelined to: at most 4 LUT levels and one carry chain of at most 16 bits on any path.
 
-``python -m flow timing`` prints the figures and the deepest paths of the projector's core;
-``--path NAME`` also prints the deepest path to a register, cell by cell, with the named nets
-each cell reads (the LUTs' own names are the mapper's), to read it against the source.
+``python -m flow timing`` prints the figures and the deepest paths of the projector's core in
+the headline mapping, and the uniform mapping's figures after them (``--lut-delay PS``: that
+mapping alone); ``--path NAME`` also prints the deepest path to a register, cell by cell, with
+the named nets each cell reads (the LUTs' own names are the mapper's), to read it against the
+source.
 """
 
 import json
@@ -36,7 +53,8 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["Depth", "analyse", "deepest_path", "netlist", "report", "figures", "BUDGET", "main"]
+__all__ = ["Depth", "analyse", "deepest_path", "netlist", "netlists", "path_ns_estimate", "report", "figures",
+           "BUDGET", "LUT_DELAY", "UNIFORM_LUT_DELAY", "main"]
 
 #: The ``dmd`` domain's budget: LUT levels, carry bits, carry chains per path.
 BUDGET = {"lut_levels_max": 4, "carry_max": 16, "carry_chains_max": 1}
@@ -82,10 +100,16 @@ class Depth:
     via: int | None = None      # the input net of the deepest LUT path's last cell
 
 
-#: Every LUT input's delay (ps) to the mapper (why: the module's docstring): a level outweighs a
-#: 16-bit carry chain (about 1 ns in Yosys' model) several times over; ``--lut-delay 642``, Yosys'
-#: slowest input, maps with a chain weighing more than a level.
-LUT_DELAY = 5000
+#: Every LUT input's delay (ps) to the mapper in the headline mapping (why: the module's
+#: docstring): Yosys' own, its slowest input's (Artix-7's, the only LUT delays it has); a 16-bit
+#: carry chain (about 1 ns in Yosys' model) weighs more than a level.
+LUT_DELAY = 642
+#: Every LUT input's delay (ps) in the uniform mapping: a level outweighs a 16-bit carry chain
+#: several times over, so the mapper minimises LUT levels as the budget counts them.
+UNIFORM_LUT_DELAY = 5000
+#: The ``gmii_rx`` domain's clock, the PHY's RX_CLK: 125 MHz at 1000 Mb/s (the platform's clock
+#: constraint); the other domains' are the clock plan's (:mod:`gateware.platform.clocks`).
+GMII_RX_HZ = 125e6
 
 
 def _lut_library(delay):
@@ -114,47 +138,58 @@ def _clocks(verilog, top):
 
 def netlist(verilog, top, *, workdir, lut_delay=LUT_DELAY):
     """Synthesise ``verilog`` for XC6S: ``{clock net: flattened module's JSON netlist}``, one
-    netlist per clock domain.
+    netlist per clock domain, every LUT input ``lut_delay`` ps to the mapper (:func:`netlists`)."""
+    return netlists(verilog, top, workdir=workdir, lut_delays=(lut_delay,))[lut_delay]
+
+
+def netlists(verilog, top, *, workdir, lut_delays=(LUT_DELAY, UNIFORM_LUT_DELAY)):
+    """Synthesise ``verilog`` for XC6S: ``{lut delay: {clock net: flattened module's JSON
+    netlist}}``, one netlist per clock domain and LUT delay, in one Yosys run.
 
     ``synth_xilinx -family xc6s`` runs once up to its LUT mapping; then each domain's logic (the
     cone of the registers on its clock, back to the registers it starts from) is mapped alone, as
-    ``synth_xilinx`` maps it but with every LUT input ``lut_delay`` ps. Mapped together, the
-    mapper's area recovery would stretch every path up to the slowest in the netlist, whichever
-    clock it is on; a mapper working to a period per clock does not."""
+    ``synth_xilinx`` maps it but with every LUT input the given delay (ps), once a delay. Mapped
+    together, the mapper's area recovery would stretch every path up to the slowest in the netlist,
+    whichever clock it is on; a mapper working to a period per clock does not."""
     from flow.resources import run_yosys
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     source = workdir / f"{top}.v"
     source.write_text(verilog)
-    library = workdir / "levels.lut"
-    library.write_text("".join(f"{k} {area}.00 {delay}\n" for k, (area, delay) in _lut_library(lut_delay).items()))
     flags = f"-family xc6s -top {top} -flatten -noiopad -noclkbuf"
     clocks = _clocks(verilog, top)
     script = [f"read_verilog {source.name}", f"synth_xilinx {flags} -run :map_luts", "design -save premap"]
     outs = {}
-    for clock in clocks:
-        outs[clock] = workdir / f"{top}.{clock}.netlist.json"
-        script += [
-            "design -load premap",
-            f"select -set ends w:{clock} %co1 w:{clock} %d",
-            # (the domain's registers stay, though what reads them is not mapped here)
-            "setattr -set keep 1 @ends",
-            f"select -set cone @ends %ci1 %ci*:{_CONE_STOPS}",
-            "delete c:* @cone %d",
-            # ``synth_xilinx``'s map_luts, with the LUT library
-            "opt_expr -mux_undef -noclkinv",
-            "read_verilog -icells -lib -specify +/xilinx/abc9_model.v",
-            f"abc9 -W {_WIRE_DELAY} -lut {library.name}",
-            "clean",
-            "xilinx_srl -fixed -minlen 3",
-            "techmap -map +/xilinx/lut_map.v -map +/xilinx/cells_map.v -D LUT_WIDTH=6",
-            "xilinx_dffopt",
-            "opt_lut_ins -tech xilinx",
-            f"synth_xilinx {flags} -run finalize:",
-            f"write_json {outs[clock].name}",
-        ]
+    for lut_delay in dict.fromkeys(lut_delays):
+        library = workdir / f"levels.{lut_delay}.lut"
+        library.write_text("".join(f"{k} {area}.00 {delay}\n"
+                                   for k, (area, delay) in _lut_library(lut_delay).items()))
+        for clock in clocks:
+            outs[lut_delay, clock] = workdir / f"{top}.{clock}.{lut_delay}ps.netlist.json"
+            script += [
+                "design -load premap",
+                f"select -set ends w:{clock} %co1 w:{clock} %d",
+                # (the domain's registers stay, though what reads them is not mapped here)
+                "setattr -set keep 1 @ends",
+                f"select -set cone @ends %ci1 %ci*:{_CONE_STOPS}",
+                "delete c:* @cone %d",
+                # ``synth_xilinx``'s map_luts, with the LUT library
+                "opt_expr -mux_undef -noclkinv",
+                "read_verilog -icells -lib -specify +/xilinx/abc9_model.v",
+                f"abc9 -W {_WIRE_DELAY} -lut {library.name}",
+                "clean",
+                "xilinx_srl -fixed -minlen 3",
+                "techmap -map +/xilinx/lut_map.v -map +/xilinx/cells_map.v -D LUT_WIDTH=6",
+                "xilinx_dffopt",
+                "opt_lut_ins -tech xilinx",
+                f"synth_xilinx {flags} -run finalize:",
+                f"write_json {outs[lut_delay, clock].name}",
+            ]
     run_yosys("; ".join(script), top, workdir)
-    return {clock: json.loads(out.read_text())["modules"][top] for clock, out in outs.items()}
+    out = {}
+    for (lut_delay, clock), path in outs.items():
+        out.setdefault(lut_delay, {})[clock] = json.loads(path.read_text())["modules"][top]
+    return out
 
 
 def _registered_dsp(cell):
@@ -282,8 +317,10 @@ def _ends(cells, names, inputs, of):
 
 def analyse(module, *, keep=5):
     """Per clock domain (named after the net on the clock pins): ``{"lut_levels_max",
-    "carry_max", "carry_chains_max", "paths"}``, ``paths`` the ``keep`` deepest, deepest first, as
-    ``(luts, carry bits, chains, start, end)``."""
+    "carry_max", "carry_chains_max", "paths", "over", "path_ns_max_estimate", "path_ns_deepest"}``,
+    ``paths`` the ``keep`` deepest, deepest first, as ``(luts, carry bits, chains, start, end)``;
+    ``over`` as :func:`over_budget`; the largest :func:`path_ns_estimate` of any path and that
+    path."""
     of, names, cells, _drivers, inputs = _depths(module)
     domains = {}
     for clock, end, _bit, d in _ends(cells, names, inputs, of):
@@ -296,6 +333,8 @@ def analyse(module, *, keep=5):
         entry["paths"].append((d.luts, d.carry, d.chains, d.start, end))
     for entry in domains.values():
         entry["over"] = over_budget(entry["paths"])
+        entry["path_ns_deepest"] = max(entry["paths"], key=lambda p: path_ns_estimate(p[0], p[1]))
+        entry["path_ns_max_estimate"] = path_ns_estimate(*entry["path_ns_deepest"][:2])
         seen, paths = set(), []
         for path in sorted(entry["paths"], key=lambda p: (p[0], p[1], p[2]), reverse=True):
             if (path[3], path[4]) not in seen:
@@ -334,6 +373,29 @@ def deepest_path(module, end):
     return name, [(0, "start", [start])] + steps[::-1]
 
 
+def _path_delays():
+    """``spec.facts.SPARTAN6_PATH`` in ns."""
+    from spec.facts import SPARTAN6_PATH
+    return {key: fact.value * 1e9 for key, fact in SPARTAN6_PATH.items()}
+
+
+def path_ns_estimate(luts, carry_bits, delays=None):
+    """A register-to-register path's delay (ns) on a -3 Spartan-6, from its LUT levels and carry
+    chain bits: clock to out, a net and a LUT a level, the chain a bit at a time (a CARRY4's CIN to
+    COUT over its four bits), a net into the flip-flop and its setup::
+
+        t_cko + luts * (t_route_net + t_ilo) + carry_bits * t_byp / 4 + t_route_net + max(t_as, t_dick)
+
+    ``delays``: ``{name: ns}`` as ``spec.facts.SPARTAN6_PATH`` names them (its figures by default).
+    The setup is the larger of the two (TAS, through the last LUT, counts that LUT a second time);
+    every net gets the routing allowance, though a LUT's output into its own slice's flip-flop
+    takes none: both on the side of a longer path."""
+    d = _path_delays() if delays is None else delays
+    net = d["t_route_net"]
+    return (d["t_cko"] + luts * (net + d["t_ilo"]) + carry_bits * d["t_byp"] / 4
+            + net + max(d["t_as"], d["t_dick"]))
+
+
 def _within(path):
     luts, carry, chains = path[:3]
     return (luts <= BUDGET["lut_levels_max"] and carry <= BUDGET["carry_max"]
@@ -361,39 +423,79 @@ def _domain_of(net):
     return "sync" if net == "clk" else net[:-len("_clk")] if net.endswith("_clk") else net
 
 
-def _synthesise(component=None, *, name="projector", workdir="build/timing", lut_delay=LUT_DELAY):
-    """The netlists of the projector's core (or ``component``), one per clock domain."""
+def _periods_ns():
+    """``{domain: clock period in ns}`` of the projector's domains."""
+    from gateware.platform.clocks import Spartan6Clocks
+    hz = {"gmii_rx": GMII_RX_HZ, **Spartan6Clocks.frequencies()}
+    return {domain: 1e9 / f for domain, f in hz.items()}
+
+
+def _synthesise(component=None, *, name="projector", workdir="build/timing", lut_delays=(LUT_DELAY,)):
+    """The netlists of the projector's core (or ``component``), ``{lut delay: {clock net: module}}``."""
     from amaranth.back import verilog
     if component is None:
         from flow.blocks import core
         component = core()
     text = verilog.convert(component, name=name, emit_src=False, strip_internal_attrs=True)
-    return netlist(text, name, workdir=workdir, lut_delay=lut_delay)
+    return netlists(text, name, workdir=workdir, lut_delays=lut_delays)
 
 
-def _by_domain(netlists):
-    """Each domain's figures, from the netlist it was mapped in."""
+def _by_domain(netlists, periods=None):
+    """Each domain's figures, from the netlist it was mapped in, with its clock period in ns
+    (``period_ns``, None where ``periods``, by default the projector's, has none)."""
+    periods = _periods_ns() if periods is None else periods
     out = {}
     for clock, module in netlists.items():
         entry = analyse(module).get(clock)
         if entry is not None:
-            out[_domain_of(clock)] = entry
+            domain = _domain_of(clock)
+            entry["period_ns"] = periods.get(domain)
+            out[domain] = entry
     return out
 
 
 def report(component=None, *, name="projector", workdir="build/timing"):
-    """Synthesise the projector's core (or ``component``) and analyse it: ``{domain: ...}``."""
-    return _by_domain(_synthesise(component, name=name, workdir=workdir))
+    """Synthesise the projector's core (or ``component``) and analyse it in both mappings (the
+    module's docstring): ``{domain: ...}`` of the headline mapping, Yosys' delays, each with the
+    uniform mapping's under ``"uniform_mapping"``."""
+    mapped = _synthesise(component, name=name, workdir=workdir, lut_delays=(LUT_DELAY, UNIFORM_LUT_DELAY))
+    result = _by_domain(mapped[LUT_DELAY])
+    for domain, entry in _by_domain(mapped[UNIFORM_LUT_DELAY]).items():
+        if domain in result:
+            result[domain]["uniform_mapping"] = entry
+    return result
+
+
+_FIGURES = (("lut_levels_max", "LUT levels"), ("carry_max", "bits"), ("carry_chains_max", "chains"))
 
 
 def figures(result):
+    """``{name: (value, unit)}``: each domain's headline figures (Yosys' delays),
+    ``timing.<domain>.lut_levels_max``, ``.carry_max``, ``.carry_chains_max``,
+    ``.registers_over_budget``, ``.path_ns_max_estimate`` and ``.period_ns``; the same figures of
+    the uniform mapping, where ``result`` has it, with ``_uniform_mapping`` after the name."""
     out = {}
     for domain, entry in result.items():
-        for key in ("lut_levels_max", "carry_max", "carry_chains_max"):
-            out[f"timing.{domain}.{key}"] = (entry[key], "LUT levels" if key == "lut_levels_max" else
-                                             "bits" if key == "carry_max" else "chains")
-        out[f"timing.{domain}.registers_over_budget"] = (len(entry["over"]), "registers")
+        mappings = [("", entry)]
+        if "uniform_mapping" in entry:
+            mappings.append(("_uniform_mapping", entry["uniform_mapping"]))
+        for suffix, figures_of in mappings:
+            for key, unit in _FIGURES:
+                out[f"timing.{domain}.{key}{suffix}"] = (figures_of[key], unit)
+            out[f"timing.{domain}.registers_over_budget{suffix}"] = (len(figures_of["over"]), "registers")
+            out[f"timing.{domain}.path_ns_max_estimate{suffix}"] = (round(figures_of["path_ns_max_estimate"], 3),
+                                                                    "ns")
+        if entry.get("period_ns") is not None:
+            out[f"timing.{domain}.period_ns"] = (round(entry["period_ns"], 3), "ns")
     return out
+
+
+def _summary(domain, entry):
+    period = entry.get("period_ns")
+    against = f" (period {period:.2f} ns)" if period is not None else ""
+    return (f"{domain}: {entry['lut_levels_max']} LUT levels, carry chains up to {entry['carry_max']} bits, "
+            f"{entry['carry_chains_max']} chain(s) on a path; {len(entry['over'])} register(s) over the budget; "
+            f"path estimate up to {entry['path_ns_max_estimate']:.2f} ns{against}")
 
 
 def print_report(result, *, over=()):
@@ -401,26 +503,48 @@ def print_report(result, *, over=()):
     a path over the budget ends at."""
     for domain in sorted(result):
         entry = result[domain]
-        budget = " (budget: 4 LUT levels, one carry chain of 16 bits)" if domain == "dmd" else ""
-        print(f"{domain}: {entry['lut_levels_max']} LUT levels, carry chains up to {entry['carry_max']} bits, "
-              f"{entry['carry_chains_max']} chain(s) on a path{budget}")
+        budget = "  (budget: 4 LUT levels, one carry chain of 16 bits)" if domain == "dmd" else ""
+        print(_summary(domain, entry) + budget)
         for luts, carry, chains, start, end in entry["paths"]:
-            print(f"    {luts} LUT, carry {carry} bits ({chains} chain(s)): {start} -> {end}")
+            print(f"    {luts} LUT, carry {carry} bits ({chains} chain(s)), ~{path_ns_estimate(luts, carry):.2f} ns: "
+                  f"{start} -> {end}")
+        luts, carry, chains, start, end = entry["path_ns_deepest"]
+        print(f"  longest estimate: {luts} LUT, carry {carry} bits, ~{entry['path_ns_max_estimate']:.2f} ns: "
+              f"{start} -> {end}")
         if domain in over:
             print(f"  registers with a path over the budget: {len(entry['over'])}")
             for name, count, (luts, carry, chains, start, _end) in entry["over"]:
                 print(f"    {luts:3d} LUT {carry:3d} bits {chains} chain(s) {count:5d} path(s): {name} <- {start}")
 
 
+def _estimate_basis():
+    from spec.facts import SPARTAN6_PATH
+    return ", ".join(f"{key} {fact.value * 1e9:g} ns" + (" (assumed)" if fact.confidence == "assumption" else "")
+                     for key, fact in SPARTAN6_PATH.items())
+
+
 def main(*, block=None, over=(), path=(), lut_delay=LUT_DELAY):
     """``block``: one block of :data:`flow.blocks.BLOCKS` instead of the projector's core;
-    ``path``: print the deepest path to each register named like these, step by step."""
+    ``path``: print the deepest path to each register named like these, step by step;
+    ``lut_delay``: the headline mapping's (:data:`LUT_DELAY`, and the uniform mapping's figures
+    after it), or another delay's alone (:data:`UNIFORM_LUT_DELAY`: the uniform mapping)."""
+    delays = (lut_delay, UNIFORM_LUT_DELAY) if lut_delay == LUT_DELAY else (lut_delay,)
     if block is None:
-        netlists = _synthesise(lut_delay=lut_delay)
+        mapped = _synthesise(lut_delays=delays)
     else:
         from flow.blocks import BLOCKS
-        netlists = _synthesise(BLOCKS[block](), name=block, workdir=f"build/timing/{block}", lut_delay=lut_delay)
-    print_report(_by_domain(netlists), over=over)
+        mapped = _synthesise(BLOCKS[block](), name=block, workdir=f"build/timing/{block}", lut_delays=delays)
+    kind = ("Yosys' delays, the headline" if lut_delay == LUT_DELAY else
+            "uniform" if lut_delay == UNIFORM_LUT_DELAY else "given")
+    print(f"mapping: every LUT input {lut_delay} ps ({kind})")
+    print(f"path estimate (-3): {_estimate_basis()}")
+    print_report(_by_domain(mapped[lut_delay]), over=over)
+    if len(delays) > 1:
+        print(f"uniform mapping, every LUT input {UNIFORM_LUT_DELAY} ps (levels as the budget counts them):")
+        uniform = _by_domain(mapped[UNIFORM_LUT_DELAY])
+        for domain in sorted(uniform):
+            print("  " + _summary(domain, uniform[domain]))
+    netlists = mapped[lut_delay]
     for end in path:
         # (a register of another domain is in a netlist too, where its cone is not mapped)
         found = []

@@ -19,7 +19,9 @@ refHDL      TI's applications-FPGA reference HDL as quoted in public repositorie
 forum       TI E2E forum answers (quoting the datasheet); Mathews et al., IEEE QCE 2022 (measured)
 DLPU133     DLPC964 applications FPGA user guide (loading into settling mirrors)
 four-DMD    the tiled four-DLP9500 projector paper (2026), eq. 6-7 (450.6 Hz 8-bit, runs at 400 Hz)
-DS162       Xilinx Spartan-6 FPGA data sheet: DC and switching characteristics (PLL)
+DS162       Xilinx Spartan-6 FPGA data sheet: DC and switching characteristics (PLL; CLB switching
+            characteristics, -3 speed grade)
+assumption  a planning figure, no document behind it: said so in the entry
 AD5662      Analog Devices AD5662 16-bit nanoDAC data sheet (serial interface timing)
 """
 
@@ -27,7 +29,7 @@ import enum
 from dataclasses import dataclass
 
 __all__ = ["Fact", "TIMING", "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "VCXO_DAC", "DmdType", "DMDS",
-           "RowMode", "BlockMode",
+           "SPARTAN6_PATH", "RowMode", "BlockMode",
            "TEST_DMD", "TEST_DMD4",
            "TEST_DMD_400", "TEST_DMD4_400"]
 
@@ -193,6 +195,30 @@ def frames_held(rows, columns):
 SPARTAN6 = {
     "pll_pfd_min": Fact(19e6, "Hz", "DS162 PLL specification (F_PFDMIN)", "medium",
                         "the phase detector's lowest input: the oscillator after the PLL's input divider"),
+}
+
+
+#: A register-to-register path on a -3 Spartan-6, as the path-delay estimate of the logic-depth
+#: analysis (:func:`flow.timing.path_ns_estimate`) sums it. Seconds. The DS162 figures are its CLB
+#: switching characteristics table's -3 column (ns, max), written down without a copy of the table
+#: at hand to check them against: confidence low until they are read off DS162 again.
+SPARTAN6_PATH = {
+    "t_cko": Fact(0.39e-9, "s", "DS162 CLB switching characteristics table (TCKO, -3)", "low",
+                  "flip-flop clock to AQ-DQ output; to check against the table"),
+    "t_ilo": Fact(0.21e-9, "s", "DS162 CLB switching characteristics table (TILO, -3)", "low",
+                  "a LUT's An-Dn address inputs to its output, one LUT level; to check against the table"),
+    "t_as": Fact(0.33e-9, "s", "DS162 CLB switching characteristics table (TAS, -3)", "low",
+                 "setup of an A-D flip-flop from its slice's An-Dn LUT inputs (through the LUT): the larger "
+                 "of the two setup figures; to check against the table"),
+    "t_dick": Fact(0.20e-9, "s", "DS162 CLB switching characteristics table (TDICK, -3)", "low",
+                   "setup of an A-D flip-flop from the AX-DX bypass input; to check against the table"),
+    "t_byp": Fact(0.08e-9, "s", "DS162 CLB switching characteristics table (TBYP, -3); ISE's speed "
+                  "files if the table leaves it out", "low",
+                  "a carry chain's CIN to COUT through one CARRY4, four bits; a quarter of it a bit"),
+    "t_route_net": Fact(0.5e-9, "s", "assumption (planning figure, no document)", "assumption",
+                        "routing allowance per net on a path: a few hundred ps is the usual planning "
+                        "figure on Spartan-6, taken at its high end; a net of high fanout or one across "
+                        "the die takes more, a net inside a slice (LUT to its own flip-flop) none"),
 }
 
 

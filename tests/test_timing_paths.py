@@ -69,3 +69,57 @@ def test_each_domain_is_mapped_on_its_own():
     luts = {clock: sum(cell["type"].startswith("LUT") for cell in module["cells"].values())
             for clock, module in netlists.items()}
     assert luts["fast_clk"] == 3 and luts["clk"] >= 13
+
+
+def test_path_estimate_is_the_sum_of_its_parts():
+    # made-up delays (ns), each a different power of ten, so that every term shows in the sum
+    delays = {"t_cko": 1, "t_ilo": 10, "t_route_net": 100, "t_byp": 4000, "t_as": 0.5, "t_dick": 0.25}
+    # clock to out + 2 levels of (net + LUT) + 8 carry bits at a quarter of a CARRY4 + net in + setup
+    assert timing.path_ns_estimate(2, 8, delays) == 1 + 2 * 110 + 8 * 1000 + 100 + 0.5
+    # the facts' figures, by default: the data sheet's and the routing allowance
+    from spec.facts import SPARTAN6_PATH
+    ns = {key: fact.value * 1e9 for key, fact in SPARTAN6_PATH.items()}
+    expected = (ns["t_cko"] + 4 * (ns["t_route_net"] + ns["t_ilo"]) + 16 * ns["t_byp"] / 4
+                + ns["t_route_net"] + max(ns["t_as"], ns["t_dick"]))
+    assert abs(timing.path_ns_estimate(4, 16) - expected) < 1e-9
+    assert SPARTAN6_PATH["t_route_net"].confidence == "assumption"
+
+
+def _lut_chain(levels):
+    """A hand-made netlist: a flip-flop, ``levels`` LUT1s in series, a flip-flop, on ``clk``."""
+    def cell(kind, ins, outs):
+        return {"type": kind, "parameters": {},
+                "port_directions": {**{p: "input" for p in ins}, **{p: "output" for p in outs}},
+                "connections": {**ins, **outs}}
+    clk, first = 2, 3
+    cells = {"src": cell("FDRE", {"C": [clk], "D": [10]}, {"Q": [first]}),
+             "dst": cell("FDRE", {"C": [clk], "D": [first + levels]}, {"Q": [11]})}
+    for level in range(levels):
+        cells[f"lut{level}"] = cell("LUT1", {"I0": [first + level]}, {"O": [first + level + 1]})
+    return {"cells": cells, "netnames": {"clk": {"bits": [clk]}, "a": {"bits": [first]}, "b": {"bits": [11]},
+                                         "d": {"bits": [10]}}}
+
+
+def test_analyse_gives_the_deepest_paths_estimate():
+    (domain,) = timing.analyse(_lut_chain(3)).values()
+    assert domain["lut_levels_max"] == 3
+    assert domain["path_ns_max_estimate"] == timing.path_ns_estimate(3, 0)
+    assert domain["path_ns_deepest"][:2] == (3, 0)
+
+
+def test_figures_name_both_mappings():
+    def entry(levels, ns, over):
+        return {"lut_levels_max": levels, "carry_max": 16, "carry_chains_max": 1, "over": [None] * over,
+                "path_ns_max_estimate": ns, "period_ns": 5.0}
+    result = {"dmd": {**entry(6, 5.4, 30), "uniform_mapping": entry(4, 4.1, 0)}}
+    out = timing.figures(result)
+    # the headline is Yosys' delays' mapping; the uniform one beside it, named so
+    assert out["timing.dmd.lut_levels_max"] == (6, "LUT levels")
+    assert out["timing.dmd.lut_levels_max_uniform_mapping"] == (4, "LUT levels")
+    assert out["timing.dmd.registers_over_budget"] == (30, "registers")
+    assert out["timing.dmd.registers_over_budget_uniform_mapping"] == (0, "registers")
+    assert out["timing.dmd.path_ns_max_estimate"] == (5.4, "ns")
+    assert out["timing.dmd.path_ns_max_estimate_uniform_mapping"] == (4.1, "ns")
+    assert out["timing.dmd.period_ns"] == (5.0, "ns")
+    for key in ("carry_max", "carry_chains_max"):
+        assert f"timing.dmd.{key}" in out and f"timing.dmd.{key}_uniform_mapping" in out
