@@ -57,7 +57,7 @@ timing: $(STAMP)
 
 # Every formal property: k-induction proofs and deep bounded checks (SymbiYosys, Yices).
 formal: $(STAMP)
-	$(PY) -m flow formal
+	$(PY) -m flow formal --jobs $(JOBS)
 
 # Every benchmark; writes build/bench.json and prints the figures.
 bench: $(STAMP)

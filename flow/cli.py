@@ -24,12 +24,13 @@ def main(argv=None):
                         help="the deepest path to the register named like this, cell by cell, with the named "
                              "signals each cell reads (repeatable)")
     timing.add_argument("--lut-delay", type=int, default=None, metavar="PS",
-                        help="every LUT input's delay to the mapper (default 5000 ps, far above a 16-bit carry "
-                             "chain's: levels count as the budget counts them; 642, Yosys' slowest input: a "
-                             "16-bit chain weighs more than a level)")
+                        help="every LUT input's delay to the mapper (default 642 ps, Yosys' slowest input: the "
+                             "conservative headline; 5000, far above a 16-bit carry chain's: the uniform mapping, "
+                             "levels minimised as the budget counts them)")
     formal = sub.add_parser("formal", help="prove or check every formal property (SymbiYosys)")
     formal.add_argument("--quick", action="store_true", help="BMC to the test suite's depths, no proofs")
     formal.add_argument("--only", action="append", help="only this block (repeatable)")
+    formal.add_argument("--jobs", type=int, default=1, help="checks run at a time")
     bench = sub.add_parser("bench", help="run the benchmarks and write build/bench.json")
     bench.add_argument("--only", action="append", help="run only this benchmark module (repeatable)")
     bench.add_argument("--no-resources", action="store_true", help="skip the synthesis figures")
@@ -66,7 +67,7 @@ def main(argv=None):
         return run(block=args.block, over=args.over, path=args.path, lut_delay=args.lut_delay or LUT_DELAY)
     if args.command == "formal":
         from flow.formal import main as run
-        return run(quick=args.quick, only=args.only)
+        return run(quick=args.quick, only=args.only, jobs=args.jobs)
     if args.command == "bench":
         from flow.bench import main as run
         return run(args.only, resources=not args.no_resources)

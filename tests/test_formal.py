@@ -1,15 +1,17 @@
 """Formal checks (SymbiYosys, Yices, from PyPI) within the suite's budget: the harness catches
-what it must, a proof closes, the store's properties and the frame slots' streams hold to a
-short depth. ``make formal`` runs every property at its full depth."""
+what it must (a broken rule, a cover not reached, a property without a cover), every property
+with a suite depth holds there with its covers reached, and each sequencer rule fails against a
+claim the sequencer must break. ``make formal`` runs every property at its full depth."""
 
 import dataclasses
 
 import pytest
 from amaranth import Module, Signal
+from amaranth.hdl import Assert, Cover
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from sim.formal import blocks, sequencer, store
+from sim.formal import blocks, sequencer, suite
 from sim.formal.harness import Check, FormalFailure, FormalTop, run
 from sim.formal.streams import ready_paths, stream_rules
 from sim.harness.paths import build_dir
@@ -89,25 +91,58 @@ def test_ready_paths():
     assert ready_paths(Register(leak=True), build_dir("formal", "test-ready-leak")) == {"o__valid": ["o__ready"]}
 
 
-@pytest.mark.parametrize("check", [
-    *[c for c in blocks.checks() if c.block in ("Countdown", "SlotStates", "SyncMaster")],
-    *[c for c in store.store_checks()],
-], ids=lambda c: c.key)
-def test_checks_quick(check):
-    result = run(dataclasses.replace(check, induction=None), depth=check.quick)
+def _suite_checks():
+    """Every property ``make formal`` lists that the suite runs too (those with a suite depth);
+    the others are deep checks of ``make formal`` alone."""
+    return [check for check in suite.checks() if check.quick is not None]
+
+
+@pytest.mark.parametrize("check", _suite_checks(), ids=lambda c: c.key)
+def test_property(check):
+    """Proven (k-induction) or checked to the suite's depth, and every cover of what the property
+    is about reached within that depth (else the run fails: a bounded check that never meets its
+    subject proves nothing)."""
+    result = run(check if check.quick_proof else dataclasses.replace(check, induction=None), depth=check.quick)
     assert result.status in ("proven", "checked")
+    assert result.covers and not result.unreached
 
 
-@pytest.mark.parametrize("check", blocks.stream_checks(), ids=lambda c: c.block)
-def test_stream_rules_of_every_block(check):
-    """The stream rules of every block with stream ports: proven where a proof closes, else
-    checked to the block's test depth (20 steps: the transmitter's header changing with the
-    addresses failed at step 9, the transmit crossing offering a frame too soon after a frame
-    longer than its FIFO at step 19); and no output ``valid`` waits combinationally for a
-    ``ready``."""
-    assert run(check, depth=check.quick).status in ("proven", "checked")
-    block = next(b for b in blocks.STREAM_BLOCKS if b.name == check.block)
-    assert ready_paths(block.make(), build_dir("formal", f"test-ready-{check.block}")) == {}
+@pytest.mark.parametrize("block", blocks.STREAM_BLOCKS, ids=lambda b: b.name)
+def test_no_valid_waits_for_ready(block):
+    """No output ``valid`` of a block with stream ports waits combinationally for a ``ready``."""
+    assert ready_paths(block.make(), build_dir("formal", f"test-ready-{block.name}")) == {}
+
+
+class Unreachable(wiring.Component):
+    """A counter that never passes 3: a cover of 5 cannot be reached."""
+    count: Out(4)
+
+    def elaborate(self, platform):
+        m = Module()
+        with m.If(self.count != 3):
+            m.d.sync += self.count.eq(self.count + 1)
+        return m
+
+
+def test_a_cover_not_reached_fails_the_check():
+    def prop(m, top):
+        m.d.comb += [Assert(top.dut.count <= 3, "at most 3"), Cover(top.dut.count == 3, "three"),
+                     Cover(top.dut.count == 5, "five")]
+    check = Check("covers", "Unreachable", lambda: FormalTop(Unreachable(), [prop]), depth=8, induction=2)
+    with pytest.raises(FormalFailure) as failure:
+        run(check)
+    result = failure.value.result
+    assert result.covers == {"three": 3, "five": None}
+    assert result.failed == ["cover not reached within 8 steps: five"]
+
+
+def test_a_property_without_a_cover_fails_the_check():
+    def prop(m, top):
+        m.d.comb += Assert(top.dut.count <= 3, "at most 3")
+    check = Check("no cover", "Unreachable", lambda: FormalTop(Unreachable(), [prop]), depth=6, induction=2)
+    with pytest.raises(FormalFailure) as failure:
+        run(check)
+    assert failure.value.result.failed == ["no cover of the property's subject"]
 
 
 class Through(wiring.Component):
@@ -127,77 +162,37 @@ def _sequencer_check(name):
     return next(check for check in sequencer.sequencer_checks() if check.name == name)
 
 
-def test_sequencer_init_rule(monkeypatch):
+# Each sequencer rule against a claim the sequencer must break (its proof and covers run in
+# test_property): the check fails, so it is not vacuous, and the bound it keeps is exact.
+
+def test_sequencer_init_rule_without_its_synchroniser_fails(monkeypatch):
     from gateware.dlpc410 import init
     check = _sequencer_check("no command during INIT_ACTIVE")
-    assert run(check).status == "proven"
     monkeypatch.setattr(init, "FFSynchronizer", Through)
     with pytest.raises(FormalFailure) as failure:
         run(dataclasses.replace(check, block="Sequencer-unsynchronised"))
     assert "running other than the controller's state three cycles ago" in failure.value.result.failed
 
 
-def test_sequencer_rst_active_rule():
-    """Proven; and not vacuous: claimed one cycle sooner than the synchroniser allows, it fails
-    (a pulse is reached with RST_ACTIVE rising just before it)."""
+def test_sequencer_rst_active_rule_one_cycle_sooner_fails():
+    """Claimed one cycle sooner than the synchroniser allows, it fails (a pulse is reached with
+    RST_ACTIVE rising just before it)."""
     check = _sequencer_check("no clocking pulse while RST_ACTIVE is high")
-    assert run(check).status == "proven"
     with pytest.raises(FormalFailure) as failure:
         run(dataclasses.replace(check, block="Sequencer-rst-one-cycle", induction=None,
                                 build=lambda: sequencer.rst_top(latency=1, init_to_dvalid=2)), depth=24)
     assert "a clocking pulse while RST_ACTIVE was high" in failure.value.result.failed
 
 
-def _first_failure(check, build, depth):
-    """The failure of ``check`` with the property ``build`` makes (a claim stronger than the
-    check's), within ``depth`` steps."""
-    with pytest.raises(FormalFailure) as failure:
-        run(dataclasses.replace(check, block=f"{check.block}-stronger", build=build), depth=depth)
-    return failure.value.result
-
-
-# A claim one cycle stronger than the sequencer keeps fails, so the check is not vacuous; and as a
-# bounded check stops at the first step where any assertion fails, and the stronger claim fails
-# wherever the real one does, the step it fails at (on its strengthened assertion only) shows the
-# real claim holding at every step before it.
-
-def test_sequencer_settle_rule():
-    """The real claim holds at every step before 31 (past the suite's depth of the check): claimed
-    one cycle longer after a pulse than the sequencer waits, it fails at step 31 (a load right at
-    ``t_rst + t_settle`` after a pulse)."""
-    check = _sequencer_check("no load within the settle time after a pulse and after RST_ACTIVE fell")
-    result = _first_failure(check, lambda: sequencer.settle_top(extra=1), 32)
-    assert result.failed == ["a load sooner than t_rst + t_settle after a pulse"]
-    assert result.step == 31 and result.step > check.quick, result.step
-
-
 @pytest.mark.parametrize("dmd", [sequencer.DMD, sequencer.DMD_1080P_CLEAR], ids=["one-row-clear", "1080p-clear"])
-def test_sequencer_clear_rule(dmd):
-    """Proven; and not vacuous: claimed one no-op row cycle longer than the DMD takes, it fails (a
-    second clear right after a clear, at step 19; on the 1080p clear a row load right after the
-    two no-op rows, at step 23)."""
+def test_sequencer_clear_rule_one_row_more_fails(dmd):
+    """Claimed one no-op row cycle longer than the DMD takes, it fails (a second clear right after
+    a clear, at step 19; on the 1080p clear a row load right after the two no-op rows, at step
+    23)."""
     name = "no clear overlapping a row load" + (", 1080p clear" if dmd.clear_row_cycles > 1 else "")
     check = _sequencer_check(name)
-    assert run(check).status == "proven"
     with pytest.raises(FormalFailure) as failure:
         run(dataclasses.replace(check, block="Sequencer-clear-one-more", induction=None,
                                 build=lambda: sequencer.clear_top(dmd, extra=1)), depth=24)
     assert failure.value.result.failed == ["a row load, clear or pulse of the block within a clear's no-op rows"]
     assert failure.value.result.step == (23 if dmd.clear_row_cycles > 1 else 19)
-
-
-def test_sequencer_phased_settle_rule():
-    """The real claim holds at every step before 35 (past the suite's depth of the check): claimed
-    one cycle longer after a pulse than the sequencer waits, it fails at step 35 (a load of a
-    pulsed group right at ``t_rst + t_settle`` after its pulse)."""
-    check = _sequencer_check("no load of a pulsed group within its settle time, phased modes")
-    result = _first_failure(check, lambda: sequencer.phased_settle_top(extra=1), 36)
-    assert result.failed == ["a load sooner than t_rst + t_settle after a pulse"]
-    assert result.step == 35 and result.step > check.quick, result.step
-
-
-def test_slot_states_last_write_wins_is_proven():
-    """The sequence slots' states (two writers built of one-writer memories, XOR halves): each
-    slot reads what was last written to it, by k-induction."""
-    check = blocks.slot_states_check()
-    assert run(check, depth=check.depth).status == "proven"

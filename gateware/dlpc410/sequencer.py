@@ -160,6 +160,9 @@ class Sequencer(wiring.Component):
         m.submodules.bus = bus = Bus(dmd, beats=beats)
         m.submodules.camera = camera = CameraTrigger()
         m.submodules.period_watch = period_watch = PeriodWatch()
+        # the parts joined by streams, by name (the formal stream rules check each one's)
+        self.parts = {"init": init, "planner": planner, "jobs": jobs, "requester": requester, "loads": loads,
+                      "darks": darks, "row_source": source, "bus": bus, "control": control}
         m.d.comb += [
             init.ecp2_finished.eq(self.pins.ecp2_finished),
             init.init_active.eq(self.pins.init_active),

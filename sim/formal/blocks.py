@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 from amaranth import Mux, Signal
 from amaranth.asserts import AnyConst
-from amaranth.hdl import Assert, Assume, Fragment
+from amaranth.hdl import Assert, Assume, Cover, Fragment
 
 from .geometry import FORMAL_DMD
 from .harness import Check, FormalTop
@@ -30,16 +30,19 @@ _ADDRESSES = {"mac": 0x02_00_00_00_00_01, "ip": 0xC0_A8_01_0A, "port": 5000}
 @dataclass(frozen=True)
 class StreamBlock:
     """A block to check the stream rules on: ``make()`` builds it; ``port_domains`` maps its
-    ports to domains (default ``sync``); ``depth``/``induction`` as in :class:`Check`."""
+    ports to domains (default ``sync``); ``depth``/``induction``/``quick`` as in :class:`Check`
+    (``quick`` None: a deep check, ``make formal`` only); ``uncovered``: output streams whose
+    transfer lies beyond any bounded depth (their rule still asserted; the reason beside)."""
     name: str
     make: object
     depth: int
     induction: int | None = None
     domains: tuple = ("sync",)
     port_domains: dict = field(default_factory=dict)
-    quick: int = 20
+    quick: int | None = 20
     parts: object = None
     resets: tuple = ()
+    uncovered: tuple = ()
 
 
 def _queue():
@@ -144,7 +147,11 @@ _SLOTS_DMD = {"ask": "dmd", "frames": "dmd", "release": "dmd", "occupancy": "dmd
 
 def _slot_parts(slots):
     """The parts of :class:`~gateware.store.slots.FrameSlots` and their ports' domains."""
-    return [(name, part, _SLOTS_DMD if name in ("crossing", "maps") else {})
+    # (a memory that loses its calibration withdraws an answer on offer: the frame it named is
+    # gone; the loss is a reset of the table's answers, as ``discard`` is of the writer's notice,
+    # and no answer is lost, as none was taken)
+    return [(name, part, _SLOTS_DMD if name in ("crossing", "maps") else {},
+             *([part.lose] if name == "table" else []))
             for name, part in slots._parts.items()]
 
 #: Every block with stream ports (the sequencer's parts are checked with the sequencer).
@@ -161,8 +168,11 @@ STREAM_BLOCKS = [
                 port_domains={"gmii": "gmii_rx"}),
     StreamBlock("FrameBuffer", _frame_buffer, depth=24, induction=4),
     StreamBlock("Transmitter", _net_transmitter, depth=24, induction=4),
-    StreamBlock("Stack", _stack, depth=16),
-    StreamBlock("Parser", _parser, depth=20, induction=4),
+    # (a datagram comes out at step 49 at the soonest: the Ethernet, IPv4 and UDP headers first)
+    StreamBlock("Stack", _stack, depth=52, quick=None),
+    # (a sequencer record is 150 bytes: its register set comes out past step 150, beyond a
+    # bounded check; the rule on it is proven with the others by k-induction)
+    StreamBlock("Parser", _parser, depth=20, induction=4, uncovered=("registers",)),
     StreamBlock("StatusReply", _status_reply, depth=20, induction=4),
     StreamBlock("MasterParser", _master_parser, depth=20, induction=4),
     StreamBlock("Serialiser", _serialiser, depth=24, induction=4),
@@ -176,21 +186,22 @@ STREAM_BLOCKS = [
     StreamBlock("FrameBroker", _broker, depth=24, induction=6),
     # the slot table answers only for the slots its ingest opened and completed: its streams are
     # checked inside the frame slots, with every part's
-    StreamBlock("FrameSlots", _frame_slots, depth=30, domains=("sync", "dmd"), port_domains=_SLOTS_DMD,
-                parts=_slot_parts),
+    StreamBlock("FrameSlots", _frame_slots, depth=48, domains=("sync", "dmd"), port_domains=_SLOTS_DMD,
+                parts=_slot_parts, quick=None),
 ]
 
 
 def _top(block):
     dut = block.make()
     parts = block.parts(dut) if block.parts else ()
-    return FormalTop(dut, [stream_rules(parts=parts, resets=block.resets)], domains=block.domains,
+    return FormalTop(dut, [stream_rules(parts=parts, resets=block.resets, uncovered=block.uncovered)],
+                     domains=block.domains,
                      port_domains=block.port_domains)
 
 
 def stream_checks():
     return [Check("stream rules", block.name, lambda block=block: _top(block), depth=block.depth,
-                  induction=block.induction, quick=min(block.quick, block.depth))
+                  induction=block.induction, quick=block.quick and min(block.quick, block.depth))
             for block in STREAM_BLOCKS]
 
 
@@ -229,6 +240,9 @@ def _countdown_top(width=7, within=(2, 5)):
                     m.d.comb += Assert(dut.within[i] == (value < elapsed + k), f"within[{i}] is T - t < {k}")
             with m.Else():
                 m.d.comb += Assert(dut.done & dut.late & dut.within.all(), "a timer never loaded is late")
+            # the subject: a load's time coming, past a borrow between limbs, and its time passing
+            m.d.comb += [Cover(loaded & dut.done & ~dut.late & (value > 2**_LIMB), "a load's time comes, across limbs"),
+                         Cover(loaded & dut.late & (elapsed == value + 1) & (value > 2**_LIMB), "a load's time passes")]
 
         return Fragment.get(FormalTop(dut, [definition]), None)
     finally:
@@ -237,32 +251,44 @@ def _countdown_top(width=7, within=(2, 5)):
 
 def countdown_check():
     return Check("flags against their definition", "Countdown", _countdown_top, depth=2**7 + 8,
-                 induction=2**7 + 4, quick=24)
+                 induction=2**7 + 4, quick=24, quick_proof=False)
 
 
 # -- RegisterCrossing ---------------------------------------------------------------------------
 
 def _register_crossing_top():
     from gateware.dlpc410.register_crossing import RegisterCrossing
+    from gateware.registers import TriggerMode
     dut = RegisterCrossing({}, depth=2)
 
     def at_rest_only(m, top):
-        # the registers the sequencer runs with change only in a dmd cycle it rests in
-        before = Signal.like(dut.regs.as_value())
-        rested = Signal()
-        m.d.dmd += [before.eq(dut.regs.as_value()), rested.eq(dut.at_rest)]
-        started = Signal()
-        m.d.dmd += started.eq(1)
-        with m.If(started & ~rested):
-            m.d.comb += Assert(dut.regs.as_value() == before, "regs changed while the sequencer ran")
+        # the registers the sequencer runs with change only in a dmd cycle it rests in; arming
+        # gates two of them (chain low, trigger software while disarmed) a cycle later, so a
+        # change of ``armed`` may change those two while the sequencer runs, and nothing else
+        regs = dut.regs.as_value()
+        before = Signal.like(regs)
+        rested, started = Signal(), Signal()
+        armed_1, armed_2 = Signal(init=1), Signal(init=1)     # ``armed`` one and two cycles ago
+        m.d.dmd += [before.eq(regs), rested.eq(dut.at_rest), armed_1.eq(dut.armed), armed_2.eq(armed_1),
+                    started.eq(1)]
+        with m.If(started & ~rested & (armed_1 == armed_2)):
+            m.d.comb += Assert(regs == before, "regs changed while the sequencer ran")
+        with m.If(~armed_1):
+            m.d.comb += [Assert(~dut.regs.chain, "chained while disarmed"),
+                         Assert(dut.regs.trigger == TriggerMode.SOFTWARE,
+                                "a trigger mode other than software while disarmed")]
+        # the subject: sets applied at rest, and arming changing while the sequencer runs
+        m.d.comb += [Cover(dut.applied == 2, "two sets applied"),
+                     Cover(started & ~rested & (armed_1 != armed_2) & (dut.applied != 0),
+                           "arming changed while the sequencer ran with a set applied")]
 
     return FormalTop(dut, [stream_rules(), at_rest_only], domains=("sync", "dmd"),
                      port_domains={"at_rest": "dmd", "regs": "dmd", "reload": "dmd", "applied": "dmd"})
 
 
 def register_crossing_check():
-    return Check("registers change only at rest; stream rules", "RegisterCrossing", _register_crossing_top,
-                 depth=40, quick=12)
+    return Check("registers change only at rest (arming aside); stream rules", "RegisterCrossing",
+                 _register_crossing_top, depth=40, quick=12)
 
 
 # -- SlotStates ------------------------------------------------------------------------------------
@@ -296,6 +322,8 @@ def _slot_states_top():
             m.d.comb += Assert(view.depth == depth, "depth")
         with m.If(known_stale):
             m.d.comb += Assert(view.stale == stale, "stale")
+        # the subject: a slot written by both writers, read back
+        m.d.comb += Cover(known_depth & known_stale & (view.depth != 0) & view.stale, "a slot written by both writers")
 
     return FormalTop(dut, [last_write_wins], driven=("place",))
 
@@ -345,6 +373,9 @@ def _sync_master_top(boards=3):
             m.d.comb += Assert(since >= min_period, "pulses at least min_period apart")
         with m.If(was & ~out[0]):
             m.d.comb += Assert(high == width, "each pulse lasts width cycles")
+        # the subject: a second pulse, and a pulse refused for a board not ready
+        m.d.comb += [Cover(started & seen & (since != 127), "a second pulse"),
+                     Cover(dut.not_ready != 0, "a pulse refused for a board not ready")]
 
     return FormalTop(dut, [pulses_keep_their_rules], driven=("min_period", "width"))
 

@@ -48,7 +48,7 @@ from sim.harness.paths import build_dir, slug
 
 from .tools import environment
 
-__all__ = ["Check", "Result", "FormalFailure", "FormalTop", "run", "reach", "sby_text"]
+__all__ = ["Check", "Result", "FormalFailure", "FormalTop", "run", "reach", "covered", "sby_text"]
 
 
 class FormalFailure(AssertionError):
@@ -77,15 +77,19 @@ class Check:
         BMC depth (steps) for ``make formal``.
     induction : int or None
         k for a k-induction proof; None when induction does not close (BMC only).
-    quick : int
-        BMC depth for the test suite.
+    quick : int or None
+        Depth for the test suite, at least the step its covers are reached at; None: a deep
+        check, run by ``make formal`` only (which ``.ci/run`` runs).
+    quick_proof : bool
+        The suite tries the k-induction proof too (False: a costly proof, BMC to ``quick``).
     """
     name: str
     block: str
     build: object
     depth: int
     induction: int | None = None
-    quick: int = 10
+    quick: int | None = 10
+    quick_proof: bool = True
 
     @property
     def key(self):
@@ -103,6 +107,12 @@ class Result:
     step: int | None = None
     failed: list = field(default_factory=list)
     induction_failed: bool = False
+    #: each cover's message -> the first step it is reached at (``None``: not reached)
+    covers: dict = field(default_factory=dict)
+
+    @property
+    def unreached(self):
+        return sorted(k for k, v in self.covers.items() if v is None)
 
     def describe(self):
         if self.status == "proven":
@@ -130,10 +140,15 @@ class FormalTop(Elaboratable):
     max_pause : int
         With several domains: a domain's clock never pauses for ``max_pause`` formal steps in a
         row, so any two clocks are within a ratio of ``max_pause`` to one.
+    body : Elaboratable or None
+        ``dut`` already elaborated (its ``elaborate``'s module), for properties about parts the
+        component makes while it is elaborated; default: ``dut`` itself.
     """
 
-    def __init__(self, dut, properties=(), *, domains=("sync",), port_domains=None, driven=(), max_pause=2):
+    def __init__(self, dut, properties=(), *, domains=("sync",), port_domains=None, driven=(), max_pause=2,
+                 body=None):
         self.dut = dut
+        self.body = dut if body is None else body
         self.max_pause = max_pause
         self.driven = set(driven)
         self.properties = list(properties)
@@ -145,7 +160,8 @@ class FormalTop(Elaboratable):
 
     def elaborate(self, platform):
         m = Module()
-        m.submodules.dut = dut = self.dut
+        dut = self.dut
+        m.submodules.dut = self.body
         ticked = len(self.domains) > 1
         for name in self.domains:
             m.d.comb += Assume(~ResetSignal(name))
@@ -208,6 +224,7 @@ def _convert(check, folder):
     return path
 
 
+_COVER = re.compile(r"(Reached|Unreached) cover statement (?:in step (\d+) )?at .*\(_witness_\.(\w+)\)")
 _FAILED = re.compile(r"(Assert failed in .*|Assumptions are unsatisfiable.*)$")
 _STEP = re.compile(r"BMC failed!|Checking assertions in step (\d+)")
 
@@ -260,9 +277,10 @@ def _failure(check, workdir, text, seconds, depth):
                   vcd=traces[0] if traces else None, step=steps[-1] if steps else None, failed=failed)
 
 
-def run(check, *, depth=None, prove=True, timeout=3600, raise_on_failure=True):
+def run(check, *, depth=None, prove=True, timeout=3600, raise_on_failure=True, covers=True):
     """Run ``check``: a k-induction proof when it has one (and ``prove``), else BMC to ``depth``
-    (default ``check.depth``)."""
+    (default ``check.depth``); then (``covers``) its covers to the same depth. A cover not
+    reached within that depth fails the check: the property never met its subject."""
     folder = build_dir("formal", check.key)
     start = time.monotonic()
     _convert(check, folder)
@@ -285,6 +303,16 @@ def run(check, *, depth=None, prove=True, timeout=3600, raise_on_failure=True):
                             induction_failed=induction_failed)
         else:
             result = _failure(check, workdir, text, seconds, depth)
+    if covers and result.status != "failed":
+        reached, unreached = covered(check, depth, timeout=timeout)
+        result.covers = {**reached, **dict.fromkeys(unreached)}
+        if not result.covers:
+            # a property must come with a cover of the event it is about
+            result.status = "failed"
+            result.failed = ["no cover of the property's subject"]
+        elif unreached:
+            result.status = "failed"
+            result.failed = [f"cover not reached within {depth} steps: {message}" for message in unreached]
     if result.status == "failed" and raise_on_failure:
         raise FormalFailure(result)
     return result
@@ -292,12 +320,28 @@ def run(check, *, depth=None, prove=True, timeout=3600, raise_on_failure=True):
 
 def reach(check, depth, *, timeout=3600):
     """The first step at which each ``Cover`` of ``check`` is reached within ``depth`` steps:
-    ``{message or source: step}``; a cover not reached is absent."""
+    ``{message: step}``, ``None`` for a cover not reached. SymbiYosys stops as soon as every
+    cover is reached, so a deep ``depth`` costs only what the last cover needs."""
     folder = build_dir("formal", check.key)
     _convert(check, folder)
     _status, _workdir, text = _sby(folder, check, "cover", depth, timeout, allow_fail=True)
+    messages = _messages(folder)
     reached = {}
     for line in text.splitlines():
-        if match := re.search(r"Reached cover statement in step (\d+) at (\S+)", line):
-            reached.setdefault(match.group(2), int(match.group(1)))
+        if match := _COVER.search(line):
+            kind, step, witness = match.groups()
+            message = messages.get(witness, witness)
+            if kind == "Reached":
+                step = int(step)
+                reached[message] = step if reached.get(message) is None else min(reached[message], step)
+            else:
+                reached.setdefault(message, None)
     return reached
+
+
+def covered(check, depth, *, timeout=3600):
+    """Run ``check``'s covers to ``depth``; returns ``(reached, unreached)``: ``{message: step}``
+    and the messages of covers not reached."""
+    reached = reach(check, depth, timeout=timeout)
+    return ({k: v for k, v in reached.items() if v is not None},
+            sorted(k for k, v in reached.items() if v is None))

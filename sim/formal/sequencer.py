@@ -39,15 +39,16 @@ import dataclasses
 from contextlib import contextmanager, nullcontext
 
 from amaranth import Cat, Mux, Signal
-from amaranth.hdl import Assert, Assume, Fragment
+from amaranth.hdl import Assert, Assume, Cover, Fragment
 
 from spec.facts import TEST_DMD
 from spec.schedule import DECISION_TO_PINS
 
 from .harness import Check, FormalTop
+from .streams import stream_rules
 
-__all__ = ["sequencer_checks", "rst_top", "settle_top", "phased_settle_top", "clear_top", "DMD", "DMD4",
-           "DMD_1080P_CLEAR"]
+__all__ = ["sequencer_checks", "streams_top", "two_beats", "rst_top", "settle_top", "phased_settle_top",
+           "clear_top", "DMD", "DMD4", "DMD_1080P_CLEAR"]
 
 #: Two words a row on two buses (two DCLK cycles a row at one beat, the fewest the sequencer
 #: takes), eight rows in two blocks: the smallest geometry the sequencer builds for.
@@ -152,6 +153,9 @@ def _no_command_during_init(running):
             Assert(~command | ready_3, "a command while INIT_ACTIVE was high (or ECP2_FINISHED low)"),
             Assert(running == ready_3, "running other than the controller's state three cycles ago"),
         ]
+        # the subject: commands once the controller is ready (a command after it initialised
+        # again lies past the suite's depth)
+        m.d.comb += Cover(command, "a command at the pins")
 
     return prop
 
@@ -164,6 +168,16 @@ def _no_pulse_while_rst_active(pulse, latency):
             m.d.sync += later.eq(seen)
             seen = later
         m.d.comb += Assert(~pulse | ~seen | ~top.dut.regs.strict_rst, "a clocking pulse while RST_ACTIVE was high")
+        # the subject: pulses decided under the strict reading, a second one after RST_ACTIVE
+        # was high since the first
+        strict_pulse = pulse & top.dut.regs.strict_rst
+        pulsed, busy_since = Signal(), Signal()
+        with m.If(strict_pulse):
+            m.d.sync += [pulsed.eq(1), busy_since.eq(0)]
+        with m.Elif(pulsed & seen):
+            m.d.sync += busy_since.eq(1)
+        m.d.comb += [Cover(strict_pulse, "a clocking pulse under the strict reading"),
+                     Cover(strict_pulse & busy_since, "a second pulse after RST_ACTIVE was high since the first")]
 
     return prop
 
@@ -181,7 +195,7 @@ def _settle_environment(m, regs, modes, strict):
         m.d.comb += Assume(regs.strict_rst)
 
 
-def _settle_rule(m, regs, rst, pulse, write, extra, name):
+def _settle_rule(m, regs, rst, pulse, write, extra, name, cover=False):
     """The settle rule of one block: ``pulse`` its clocking pulse's first cycle on the pins,
     ``write`` a row load or clear of it on the pins, ``rst`` RST_ACTIVE at the pins; ``extra``
     cycles claimed beyond ``t_rst + t_settle``."""
@@ -202,6 +216,13 @@ def _settle_rule(m, regs, rst, pulse, write, extra, name):
     # fall (0 on the first cycle RST_ACTIVE is low)
     age = Mux(pulse, 0, since_pulse)
     risen = rose | (pulse & rst)
+    if cover:
+        # the subject: a load after a pulse's settle, right at ``t_rst + t_settle`` (the wait is
+        # no longer than the rule asks); a block's second pulse and the load after it lie beyond
+        # the depth a bounded check of the sequencer affords
+        m.d.comb += [Cover(write & pulsed & ~pulse & (since_pulse == regs.t_rst + regs.t_settle),
+                           f"{name}: a load right at t_rst + t_settle after a pulse"),
+                     Cover(pulse, f"{name}: a pulse")]
     m.d.comb += [
         Assert(~(write & pulsed) | (age >= regs.t_rst + regs.t_settle + extra),
                "a load sooner than t_rst + t_settle after a pulse"),
@@ -223,12 +244,12 @@ def _settle_after_pulse(pulse, dmd, modes, extra, strict):
             on_pins = later
         for b, (pulsed, written) in enumerate(zip(_pulsed_blocks(pins, dmd.blocks), _written_blocks(pins, dmd),
                                                   strict=True)):
-            _settle_rule(m, regs, pins.rst_active, on_pins & pulsed, written, extra, f"block{b}")
+            _settle_rule(m, regs, pins.rst_active, on_pins & pulsed, written, extra, f"block{b}", cover=b == 0)
 
     return prop
 
 
-def _no_clear_overlap(dmd, extra):
+def _no_clear_overlap(dmd, extra, beats=1):
     """DLPA008B 4.2 as the rule model checks it (see the module's notes); ``extra``: claim this
     many no-op row cycles after a clear more than the DMD takes."""
     from gateware.dlpc410.interface import BlockMode, RowMode
@@ -239,7 +260,7 @@ def _no_clear_overlap(dmd, extra):
         # a controller that initialises again forgets the clear under way (as the model does);
         # the pins show the sequencer's commands for three cycles more, unseen by it
         restarting = ~Cat(_ready(m, pins, 3)).all()
-        start = _row_start(m, pins, row_cycles(dmd))
+        start = _row_start(m, pins, row_cycles(dmd, beats))
         rows = dmd.clear_row_cycles - 1 + extra
         busy = Signal(range(rows + 1))            # no-op row cycles the last clear still takes
         clearing = Signal.like(pins.blkad)        # its block
@@ -259,15 +280,30 @@ def _no_clear_overlap(dmd, extra):
             # (the rows claimed beyond the DMD's may end in a gap: the claim is about loads)
             Assert(restarting | pins.dvalid[0] | (busy <= extra), "an idle gap within a clear's no-op rows"),
         ]
+        # the subject: a row load right after a clear's no-op rows (at once after the clear on a
+        # one-row clear)
+        after = Signal()
+        m.d.sync += after.eq(Mux(start, (clear & (rows == 0)) | (~clear & (busy == 1)), after))
+        m.d.comb += [Cover(start & clear, "a block clear"),
+                     Cover(start & load & after & ~restarting, "a row load right after a clear")]
 
     return prop
 
 
-def _sequencer_top(prop, watch=None, *, init_to_dvalid=None, dmd=DMD):
+def two_beats(dmd):
+    """``dmd`` with twice the columns, so that at two beats (DCLK 400 MHz, the default build) a
+    row cycle takes as many ``dmd`` cycles as ``dmd``'s at one beat."""
+    return dataclasses.replace(dmd, name=f"{dmd.name}, two beats", columns=2 * dmd.columns,
+                               visible_columns=2 * dmd.visible_columns, dclk_per_row=2 * dmd.dclk_per_row)
+
+
+def _sequencer_top(prop, watch=None, *, init_to_dvalid=None, dmd=DMD, beats=1, streams=False):
     """The sequencer on ``dmd`` with ``prop(watched)`` as its property, ``watched`` a copy of the
     member ``member`` of its part ``part`` for ``watch = (part, member)`` (:func:`_watched`);
     ``init_to_dvalid``: a shorter wait before the first load than the facts' 64 clocks, so that a
-    bounded check reaches a pulse within a few tens of steps (15 with 2)."""
+    bounded check reaches a pulse within a few tens of steps (15 with 2); ``beats``: DCLK beats
+    per cycle (the DMD then :func:`two_beats` of ``dmd``); ``streams``: also the stream rules on
+    the sequencer's stream ports and between its parts."""
     from gateware.dlpc410 import control
     from gateware.dlpc410.sequencer import Sequencer
     watched = Signal()
@@ -275,55 +311,116 @@ def _sequencer_top(prop, watch=None, *, init_to_dvalid=None, dmd=DMD):
     control.INIT_TO_DVALID = original if init_to_dvalid is None else init_to_dvalid
     try:
         with _watched(*watch, watched) if watch else nullcontext():
-            return Fragment.get(FormalTop(Sequencer(dmd, beats=1, store_words=1), [prop(watched)]), None)
+            dut = Sequencer(two_beats(dmd) if beats == 2 else dmd, beats=beats, store_words=1)
+            body = Fragment.get(dut, None)          # (its parts made, for the stream rules)
+            properties = [prop(watched)]
+            if streams:
+                # the frame control's flush drops the row source's beats owed to stale loads, a
+                # register set applied at rest may change their source (the pattern source's or
+                # the store's), and a reseed restarts the pattern source (its word changes two
+                # cycles later): resets of its output, as the writer's ``discard`` is of the
+                # writer's
+                reseeded = Signal()
+
+                def reseed_seen(m, top):
+                    m.d.sync += reseeded.eq(top.dut.reseed)
+                # a controller that initialises again, a store that lost its memory, or a
+                # register set applied (every group's first plane loaded again) stops the groups:
+                # the loads under way are dropped, their requests withdrawn
+                stopped = ~dut.parts["init"].running | dut.store_lost | dut.reload
+                resets = {"row_source": dut.parts["row_source"].flushing | dut.reload | dut.reseed | reseeded,
+                          "requester": stopped}
+                parts = [(name, part, {}, *([resets[name]] if name in resets else []))
+                         for name, part in dut.parts.items()]
+                # (a dark pulse's clears come past the check's depth: the darks queue's transfers
+                # are not covered)
+                properties += [_registers_at_rest, reseed_seen,
+                               stream_rules(resets=[stopped], parts=parts, uncovered=("darks",))]
+            return Fragment.get(FormalTop(dut, properties, body=body), None)
     finally:
         control.INIT_TO_DVALID = original
 
 
-def _init_top():
-    return _sequencer_top(_no_command_during_init, ("Init", "running"))
+def _registers_at_rest(m, top):
+    """The sequencer's contract for its registers: they change only while it rests, in the
+    cycle ``reload`` says so."""
+    regs = top.dut.regs.as_value()
+    before, first = Signal.like(regs), Signal(init=1)
+    m.d.sync += [before.eq(regs), first.eq(0)]
+    m.d.comb += Assume(first | (regs == before) | (top.dut.reload & top.dut.at_rest))
 
 
-def rst_top(latency=2, init_to_dvalid=None):
+def _init_top(init_to_dvalid=2, beats=1):
+    return _sequencer_top(_no_command_during_init, ("Init", "running"), init_to_dvalid=init_to_dvalid, beats=beats)
+
+
+def streams_top(beats=1, init_to_dvalid=2):
+    """The stream rules on the sequencer's ports and between its parts (the planner, the
+    queues, the requester, the row source, the bus, the frame control), with covers of
+    transfers on each."""
+    return _sequencer_top(lambda _: (lambda m, top: None), init_to_dvalid=init_to_dvalid, beats=beats,
+                          streams=True)
+
+
+def rst_top(latency=2, init_to_dvalid=2, beats=1):
     """The RST_ACTIVE property's top; ``latency``: cycles from the pins to the decision it allows
     (the synchroniser's two; one is too few, and the check must then fail)."""
     return _sequencer_top(lambda pulse: _no_pulse_while_rst_active(pulse, latency), ("Bus", "pulsing"),
-                          init_to_dvalid=init_to_dvalid)
+                          init_to_dvalid=init_to_dvalid, beats=beats)
 
 
-def settle_top(init_to_dvalid=2, extra=0):
+def settle_top(init_to_dvalid=2, extra=0, beats=1):
     """The settle property's top, global pulses. ``extra``: claim this many cycles more after a
     pulse than the sequencer keeps (1: the check must fail, for the sequencer loads right at
     ``t_rst + t_settle``)."""
     from gateware.registers import ResetMode
-    return _sequencer_top(lambda pulse: _settle_after_pulse(pulse, DMD, [ResetMode.GLOBAL], extra, strict=False),
-                          ("Bus", "pulsing"), init_to_dvalid=init_to_dvalid)
+    dmd = two_beats(DMD) if beats == 2 else DMD
+    return _sequencer_top(lambda pulse: _settle_after_pulse(pulse, dmd, [ResetMode.GLOBAL], extra, strict=False),
+                          ("Bus", "pulsing"), init_to_dvalid=init_to_dvalid, beats=beats)
 
 
-def phased_settle_top(modes=("QUAD", "DUAL", "SINGLE"), init_to_dvalid=2, extra=0, strict=True, dmd=DMD4):
+def phased_settle_top(modes=("QUAD", "DUAL", "SINGLE"), init_to_dvalid=2, extra=0, strict=True, dmd=DMD4,
+                      beats=1):
     """The settle property's top in the phased ``modes`` (names of
     :class:`~gateware.registers.ResetMode`) on ``dmd``; ``extra`` as for :func:`settle_top`;
     ``strict``: the strict RST_ACTIVE reading only."""
     from gateware.registers import ResetMode
     modes = [ResetMode[mode] for mode in modes]
-    return _sequencer_top(lambda pulse: _settle_after_pulse(pulse, dmd, modes, extra, strict),
-                          ("Bus", "pulsing"), init_to_dvalid=init_to_dvalid, dmd=dmd)
+    geometry = two_beats(dmd) if beats == 2 else dmd
+    return _sequencer_top(lambda pulse: _settle_after_pulse(pulse, geometry, modes, extra, strict),
+                          ("Bus", "pulsing"), init_to_dvalid=init_to_dvalid, dmd=dmd, beats=beats)
 
 
-def clear_top(dmd=DMD, extra=0, init_to_dvalid=2):
+def clear_top(dmd=DMD, extra=0, init_to_dvalid=2, beats=1):
     """The clear property's top on ``dmd``. ``extra``: claim one no-op row cycle more after a
     clear than the DMD takes (the check must fail: the sequencer loads right after them)."""
-    return _sequencer_top(lambda _: _no_clear_overlap(dmd, extra), init_to_dvalid=init_to_dvalid, dmd=dmd)
+    geometry = two_beats(dmd) if beats == 2 else dmd
+    return _sequencer_top(lambda _: _no_clear_overlap(geometry, extra, beats), init_to_dvalid=init_to_dvalid,
+                          dmd=dmd, beats=beats)
 
 
 def sequencer_checks():
-    return [Check("no command during INIT_ACTIVE", "Sequencer", _init_top, depth=12, induction=4, quick=4),
-            Check("no clocking pulse while RST_ACTIVE is high", "Sequencer", rst_top, depth=12, induction=4,
-                  quick=4),
-            Check("no load within the settle time after a pulse and after RST_ACTIVE fell", "Sequencer",
-                  settle_top, depth=40, quick=30),
-            Check("no load of a pulsed group within its settle time, phased modes", "Sequencer",
-                  phased_settle_top, depth=40, quick=24),
-            Check("no clear overlapping a row load", "Sequencer", clear_top, depth=24, induction=4, quick=4),
-            Check("no clear overlapping a row load, 1080p clear", "Sequencer",
-                  lambda: clear_top(DMD_1080P_CLEAR), depth=24, induction=6, quick=4)]
+    """Every property at one beat (block ``Sequencer``: DCLK 200 MHz) and at two (``Sequencer
+    x2``: DCLK 400 MHz, the default build). The suite runs the one-beat proofs; the stream
+    rules, the settle checks (their covers from step 31) and the two-beat checks are ``make
+    formal``'s."""
+    checks = []
+    for beats, block in ((1, "Sequencer"), (2, "Sequencer x2")):
+        def at(top, beats=beats, **kwargs):
+            return lambda: top(beats=beats, **kwargs)
+
+        def suite(depth, beats=beats):
+            return depth if beats == 1 else None
+        checks += [
+            Check("stream rules", block, at(streams_top), depth=24, quick=None),
+            Check("no command during INIT_ACTIVE", block, at(_init_top), depth=24, induction=4, quick=suite(24)),
+            Check("no clocking pulse while RST_ACTIVE is high", block, at(rst_top), depth=24, induction=4,
+                  quick=suite(24)),
+            Check("no load within the settle time after a pulse and after RST_ACTIVE fell", block,
+                  at(settle_top), depth=40, quick=None),
+            Check("no load of a pulsed group within its settle time, phased modes", block,
+                  at(phased_settle_top), depth=40, quick=None),
+            Check("no clear overlapping a row load", block, at(clear_top), depth=24, induction=4, quick=suite(24)),
+            Check("no clear overlapping a row load, 1080p clear", block, at(clear_top, dmd=DMD_1080P_CLEAR),
+                  depth=24, induction=6, quick=suite(24))]
+    return checks

@@ -7,8 +7,10 @@ proof that no output stream's ``valid`` has a combinational path from a consumer
 (:func:`sim.formal.streams.ready_paths`, one per block with stream ports).
 """
 
+import concurrent.futures
+import multiprocessing
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from sim.harness.paths import build_dir, slug
 
@@ -32,6 +34,15 @@ class Row:
     depth: int | None
     seconds: float
     detail: str = ""
+    #: each cover's message -> the first step it is reached at (``None``: not reached); empty
+    #: for a structural proof, which holds in every state and has no event to reach
+    covers: dict = field(default_factory=dict)
+
+    @property
+    def cover_step(self):
+        """The step at which the last of the row's covers is first reached."""
+        steps = [step for step in self.covers.values() if step is not None]
+        return max(steps) if steps else None
 
     def describe(self):
         if self.status == "failed":
@@ -51,19 +62,37 @@ def _ready_row(block):
                time.monotonic() - start, detail)
 
 
-def run_all(*, quick=False, only=None, log=print):
-    """Run every check (``quick``: BMC to each check's test depth, no proofs) and the structural
-    proofs; ``only``: block names. Returns the rows."""
-    rows = []
-    for check in checks():
-        if only and check.block not in only:
-            continue
-        result = run(check, depth=check.quick if quick else None, prove=not quick, raise_on_failure=False)
-        method = "k-induction" if result.status == "proven" else "BMC"
-        detail = "" if result.status != "failed" else \
-            f"step {result.step}: {'; '.join(result.failed)} (counterexample {result.vcd})"
-        rows.append(Row(check.block, check.name, result.status, method, result.depth, result.seconds, detail))
-        log(_line(rows[-1]))
+def _check_row(index, quick):
+    """Row of the ``index``-th check (by index: checks build their tops from closures, which do
+    not cross to a worker process)."""
+    check = checks()[index]
+    result = run(check, depth=check.quick if quick else None, prove=not quick, raise_on_failure=False)
+    method = "k-induction" if result.status == "proven" else "BMC"
+    detail = "" if result.status != "failed" else \
+        f"step {result.step}: {'; '.join(result.failed)} (counterexample {result.vcd})"
+    return Row(check.block, check.name, result.status, method, result.depth, result.seconds, detail,
+               result.covers)
+
+
+def run_all(*, quick=False, only=None, log=print, jobs=1):
+    """Run every check (``quick``: BMC to each check's suite depth, no proofs, the deep checks
+    left out) and the structural proofs, ``jobs`` checks at a time; ``only``: block names.
+    Returns the rows, in the checks' order."""
+    chosen = [i for i, check in enumerate(checks())
+              if (not only or check.block in only) and not (quick and check.quick is None)]
+    rows = {}
+    if jobs > 1:
+        context = multiprocessing.get_context("spawn")
+        with concurrent.futures.ProcessPoolExecutor(jobs, mp_context=context) as pool:
+            futures = {pool.submit(_check_row, i, quick): i for i in chosen}
+            for future in concurrent.futures.as_completed(futures):
+                rows[futures[future]] = row = future.result()
+                log(_line(row))
+    else:
+        for i in chosen:
+            rows[i] = row = _check_row(i, quick)
+            log(_line(row))
+    rows = [rows[i] for i in chosen]
     for block in blocks.STREAM_BLOCKS:
         if only and block.name not in only:
             continue
@@ -73,14 +102,21 @@ def run_all(*, quick=False, only=None, log=print):
 
 
 def _line(row):
-    return f"{row.block:<17} {row.name:<45} {row.describe():<40} {row.seconds:7.1f} s"
+    covers = f"covers by step {row.cover_step}" if row.cover_step is not None else ""
+    return f"{row.block:<17} {row.name:<45} {row.describe():<40} {covers:<20} {row.seconds:7.1f} s"
 
 
 def figures(rows):
     """``formal.properties_proven``: rows proven (k-induction or structural);
-    ``formal.properties_bmc_depth_min``: the shallowest BMC depth among the rest."""
+    ``formal.properties_bmc_depth_min``: the shallowest BMC depth among the rest;
+    ``formal.properties_without_cover``: SymbiYosys rows with no cover of their subject;
+    ``formal.covers_unreached``: covers not reached at their row's depth (each fails its row)."""
     bmc = [row.depth for row in rows if row.method == "BMC" and row.status == "checked"]
+    solver = [row for row in rows if row.method != "structural"]
     return {
+        "formal.properties_without_cover": (sum(not row.covers for row in solver), "properties"),
+        "formal.covers_unreached": (sum(step is None for row in solver for step in row.covers.values()), "covers"),
+        "formal.properties_bmc": (sum(row.status == "checked" for row in rows), "properties"),
         "formal.properties_proven": (sum(row.status == "proven" for row in rows), "properties"),
         "formal.properties_bmc_depth_min": (min(bmc) if bmc else 0, "steps"),
         "formal.properties_failed": (sum(row.status == "failed" for row in rows), "properties"),
