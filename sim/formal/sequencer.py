@@ -47,7 +47,7 @@ from spec.schedule import DECISION_TO_PINS
 from .harness import Check, FormalTop
 from .streams import stream_rules
 
-__all__ = ["sequencer_checks", "streams_top", "two_beats", "rst_top", "settle_top", "phased_settle_top",
+__all__ = ["sequencer_checks", "streams_top", "at_beats", "rst_top", "settle_top", "phased_settle_top",
            "clear_top", "DMD", "DMD4", "DMD_1080P_CLEAR"]
 
 #: Two words a row on two buses (two DCLK cycles a row at one beat, the fewest the sequencer
@@ -290,9 +290,11 @@ def _no_clear_overlap(dmd, extra, beats=1):
     return prop
 
 
-def two_beats(dmd):
-    """``dmd`` with twice the columns, so that at two beats (DCLK 400 MHz, the default build) a
-    row cycle takes as many ``dmd`` cycles as ``dmd``'s at one beat."""
+def at_beats(dmd, beats):
+    """``dmd`` for ``beats`` DCLK beats a cycle: at two (DCLK 400 MHz, the default build) with
+    twice the columns, so that a row cycle takes as many ``dmd`` cycles as ``dmd``'s at one."""
+    if beats == 1:
+        return dmd
     return dataclasses.replace(dmd, name=f"{dmd.name}, two beats", columns=2 * dmd.columns,
                                visible_columns=2 * dmd.visible_columns, dclk_per_row=2 * dmd.dclk_per_row)
 
@@ -302,7 +304,7 @@ def _sequencer_top(prop, watch=None, *, init_to_dvalid=None, dmd=DMD, beats=1, s
     member ``member`` of its part ``part`` for ``watch = (part, member)`` (:func:`_watched`);
     ``init_to_dvalid``: a shorter wait before the first load than the facts' 64 clocks, so that a
     bounded check reaches a pulse within a few tens of steps (15 with 2); ``beats``: DCLK beats
-    per cycle (the DMD then :func:`two_beats` of ``dmd``); ``streams``: also the stream rules on
+    per cycle (the DMD then :func:`at_beats` of ``dmd``); ``streams``: also the stream rules on
     the sequencer's stream ports and between its parts."""
     from gateware.dlpc410 import control
     from gateware.dlpc410.sequencer import Sequencer
@@ -311,7 +313,7 @@ def _sequencer_top(prop, watch=None, *, init_to_dvalid=None, dmd=DMD, beats=1, s
     control.INIT_TO_DVALID = original if init_to_dvalid is None else init_to_dvalid
     try:
         with _watched(*watch, watched) if watch else nullcontext():
-            dut = Sequencer(two_beats(dmd) if beats == 2 else dmd, beats=beats, store_words=1)
+            dut = Sequencer(at_beats(dmd, beats), beats=beats, store_words=1)
             body = Fragment.get(dut, None)          # (its parts made, for the stream rules)
             properties = [prop(watched)]
             if streams:
@@ -374,8 +376,8 @@ def settle_top(init_to_dvalid=2, extra=0, beats=1):
     pulse than the sequencer keeps (1: the check must fail, for the sequencer loads right at
     ``t_rst + t_settle``)."""
     from gateware.registers import ResetMode
-    dmd = two_beats(DMD) if beats == 2 else DMD
-    return _sequencer_top(lambda pulse: _settle_after_pulse(pulse, dmd, [ResetMode.GLOBAL], extra, strict=False),
+    return _sequencer_top(lambda pulse: _settle_after_pulse(pulse, at_beats(DMD, beats), [ResetMode.GLOBAL], extra,
+                                                            strict=False),
                           ("Bus", "pulsing"), init_to_dvalid=init_to_dvalid, beats=beats)
 
 
@@ -386,17 +388,15 @@ def phased_settle_top(modes=("QUAD", "DUAL", "SINGLE"), init_to_dvalid=2, extra=
     ``strict``: the strict RST_ACTIVE reading only."""
     from gateware.registers import ResetMode
     modes = [ResetMode[mode] for mode in modes]
-    geometry = two_beats(dmd) if beats == 2 else dmd
-    return _sequencer_top(lambda pulse: _settle_after_pulse(pulse, geometry, modes, extra, strict),
+    return _sequencer_top(lambda pulse: _settle_after_pulse(pulse, at_beats(dmd, beats), modes, extra, strict),
                           ("Bus", "pulsing"), init_to_dvalid=init_to_dvalid, dmd=dmd, beats=beats)
 
 
 def clear_top(dmd=DMD, extra=0, init_to_dvalid=2, beats=1):
     """The clear property's top on ``dmd``. ``extra``: claim one no-op row cycle more after a
     clear than the DMD takes (the check must fail: the sequencer loads right after them)."""
-    geometry = two_beats(dmd) if beats == 2 else dmd
-    return _sequencer_top(lambda _: _no_clear_overlap(geometry, extra, beats), init_to_dvalid=init_to_dvalid,
-                          dmd=dmd, beats=beats)
+    return _sequencer_top(lambda _: _no_clear_overlap(at_beats(dmd, beats), extra, beats),
+                          init_to_dvalid=init_to_dvalid, dmd=dmd, beats=beats)
 
 
 def sequencer_checks():
