@@ -7,7 +7,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 JOBS   ?= 2
 
-.PHONY: setup test sim verilog resources timing formal bench figures waves lint clean
+.PHONY: setup test properties sim verilog resources timing formal bench figures waves lint clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -17,9 +17,15 @@ $(STAMP): pyproject.toml
 
 setup: $(STAMP)
 
-# The whole suite: Amaranth-simulator unit tests and cocotb tests on the generated Verilog.
+# The suite: Amaranth-simulator unit tests, cocotb tests on the generated Verilog, the formal
+# harness's own tests. The formal properties run in make properties (CI runs both).
 test: $(STAMP)
-	$(PY) -m pytest -n $(JOBS) -q
+	$(PY) -m pytest -n $(JOBS) -q -m "not formal"
+
+# Every formal property at the depth its covers are reached, and each sequencer rule failing a
+# claim the sequencer must break (tests/test_formal.py, marked formal); make formal: full depth.
+properties: $(STAMP)
+	$(PY) -m pytest -n $(JOBS) -q -m formal tests/test_formal.py
 
 # The main job: the system simulation on the default scene (DCLK 400 MHz; DCLK=200 for 200 MHz;
 # DMD=dlp9500: the DLP9500's core, four buses;

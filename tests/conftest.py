@@ -71,5 +71,8 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
         return
     wall = time.monotonic() - _started
     workers = getattr(config.option, "numprocesses", None) or 1
+    if config.option.markexpr == "formal":      # make properties: no budget of its own
+        terminalreporter.write_line(f"formal properties wall time: {wall:.0f} s on {workers} worker(s)")
+        return
     terminalreporter.write_line(
         f"suite wall time: {wall:.0f} s on {workers} worker(s) (budget {BUDGET_S} s on 2 cores)")

@@ -1,7 +1,10 @@
-"""Formal checks (SymbiYosys, Yices, from PyPI) within the suite's budget: the harness catches
-what it must (a broken rule, a cover not reached, a property without a cover), every property
-with a suite depth holds there with its covers reached, and each sequencer rule fails against a
-claim the sequencer must break. ``make formal`` runs every property at its full depth."""
+"""Formal checks (SymbiYosys, Yices, from PyPI): the harness catches what it must (a broken rule,
+a cover not reached, a property without a cover), every property with a suite depth holds there
+with its covers reached, and each sequencer rule fails against a claim the sequencer must break.
+
+The harness's own tests run in ``make test``. The properties and the sequencer's failing claims
+(marked ``formal``) run in ``make properties``, which CI runs after ``make test``: together they
+take as long as the rest of the suite. ``make formal`` runs every property at its full depth."""
 
 import dataclasses
 
@@ -97,6 +100,7 @@ def _suite_checks():
     return [check for check in suite.checks() if check.quick is not None]
 
 
+@pytest.mark.formal
 @pytest.mark.parametrize("check", _suite_checks(), ids=lambda c: c.key)
 def test_property(check):
     """Proven (k-induction) or checked to the suite's depth, and every cover of what the property
@@ -165,6 +169,7 @@ def _sequencer_check(name):
 # Each sequencer rule against a claim the sequencer must break (its proof and covers run in
 # test_property): the check fails, so it is not vacuous, and the bound it keeps is exact.
 
+@pytest.mark.formal
 def test_sequencer_init_rule_without_its_synchroniser_fails(monkeypatch):
     from gateware.dlpc410 import init
     check = _sequencer_check("no command during INIT_ACTIVE")
@@ -174,6 +179,7 @@ def test_sequencer_init_rule_without_its_synchroniser_fails(monkeypatch):
     assert "running other than the controller's state three cycles ago" in failure.value.result.failed
 
 
+@pytest.mark.formal
 def test_sequencer_rst_active_rule_one_cycle_sooner_fails():
     """Claimed one cycle sooner than the synchroniser allows, it fails (a pulse is reached with
     RST_ACTIVE rising just before it)."""
@@ -184,6 +190,7 @@ def test_sequencer_rst_active_rule_one_cycle_sooner_fails():
     assert "a clocking pulse while RST_ACTIVE was high" in failure.value.result.failed
 
 
+@pytest.mark.formal
 @pytest.mark.parametrize("dmd", [sequencer.DMD, sequencer.DMD_1080P_CLEAR], ids=["one-row-clear", "1080p-clear"])
 def test_sequencer_clear_rule_one_row_more_fails(dmd):
     """Claimed one no-op row cycle longer than the DMD takes, it fails (a second clear right after

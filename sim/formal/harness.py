@@ -197,11 +197,13 @@ class FormalTop(Elaboratable):
 
 
 def sby_text(check, *, mode, depth):
-    """The ``.sby`` file of a check."""
+    """The ``.sby`` file of a check. A cover run writes no VCD: only the step each cover is
+    reached at is read, and writing a deep trace costs more than finding it."""
     return "\n".join([
         "[options]",
         f"mode {mode}",
         f"depth {depth}",
+        *(["vcd off"] if mode == "cover" else []),
         "",
         "[engines]",
         "smtbmc yices",
