@@ -60,7 +60,7 @@ def test_lowest_due_and_its_flag(test_name):
 
     from amaranth import Module, Signal
 
-    from gateware.dlpc410.bus import lowest_due, lowest_due_has
+    from gateware.dlpc410.due import lowest_due, lowest_due_has
 
     G = 16
     due, flags = Signal(G), Signal(G)

@@ -37,8 +37,8 @@ def beat_lanes(buses):
     """(bus, edge, first beat bit) of every 16-bit lane of a beat of ``buses // 2`` words: word
     ``i`` of the beat (bits ``64 * i`` up) travels on buses A/B (i = 0) or C/D (i = 1)."""
     pairs = ("AB", "CD")[:buses // 2]
-    return tuple((pair["AB".index(bus)], edge, 64 * i + lsb)
-                 for i, pair in enumerate(pairs) for bus, edge, lsb in LANES)
+    return tuple((pair["AB".index(bus)], edge, 64 * i + first_bit)
+                 for i, pair in enumerate(pairs) for bus, edge, first_bit in LANES)
 
 
 def cycle_lanes(buses, beats):
@@ -46,18 +46,18 @@ def cycle_lanes(buses, beats):
     beat ``b`` (bits ``b * 32 * buses`` up of the cycle's words) travels on edges ``2b``
     (rising) and ``2b + 1`` (falling) of :func:`gateware.dlpc410.interface.din_layout`."""
     width = 32 * buses
-    return tuple((bus, 2 * b + (0 if edge == "rise" else 1), b * width + lsb)
-                 for b in range(beats) for bus, edge, lsb in beat_lanes(buses))
+    return tuple((bus, 2 * b + (0 if edge == "rise" else 1), b * width + first_bit)
+                 for b in range(beats) for bus, edge, first_bit in beat_lanes(buses))
 
 
 def word_to_lanes(word):
     """Split a 64-bit word (int) into ``{(bus, edge): 16-bit value}``."""
-    return {(bus, edge): (word >> lsb) & 0xffff for bus, edge, lsb in LANES}
+    return {(bus, edge): (word >> first_bit) & 0xffff for bus, edge, first_bit in LANES}
 
 
 def lanes_to_word(lanes):
     """Inverse of :func:`word_to_lanes`."""
     word = 0
-    for bus, edge, lsb in LANES:
-        word |= (lanes[(bus, edge)] & 0xffff) << lsb
+    for bus, edge, first_bit in LANES:
+        word |= (lanes[(bus, edge)] & 0xffff) << first_bit
     return word

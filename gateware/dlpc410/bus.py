@@ -2,16 +2,21 @@
 
 The DLPC410 runs at DCLK/2, so idle gaps are even: the bus decides on even cycles only, once the
 row cycle before (and a clear's no-op rows) leaves room for the next on the pins. It makes, in
-this order of priority: a clocking pulse of a group that is due (the lowest such group), if the
-strict RST_ACTIVE reading's pin allows it, else the next clear of the oldest dark pulse's group,
-once that group's memory may change (a dark load needs no data, and its deadline is the shortest
-plane's, so it overtakes the loads queued before it), else the next load operation of the ready
-load at the head (a row of an occupied block, ``row_period`` after the last row and with a whole
-row of beats buffered; or a clear of an empty block), if that group's memory may change and the
-oldest dark pulse's group's memory does not free before the operation would end (its clears
-would wait for it: their deadline is the shortest plane's); each only if no loaded group's pulse
-falls due before the operation would end; else nothing. A load
-whose row data has not arrived is counted as an underrun (one per row that waits, however long).
+this order of priority:
+
+1. A clocking pulse of a due group (the lowest such group), if the strict RST_ACTIVE reading's
+   pin allows it.
+2. Else the next clear of the oldest dark pulse's group, once that group's memory may change. A
+   dark load needs no data and its deadline is the shortest plane's, so it overtakes the loads
+   queued before it.
+3. Else the next operation of the ready load at the head: a row of an occupied block,
+   ``row_period`` after the last row and with a whole row of beats buffered, or a clear of an
+   empty block. It goes only if that group's memory may change, and if the oldest dark pulse's
+   group's memory does not free before the operation would end (its clears would wait for it).
+4. Else nothing.
+
+A load or clear goes only if no loaded group's pulse falls due before it would end. A load whose
+row data has not arrived is counted as an underrun (one per row that waits, however long).
 
 The decision is made from registered flags (the planner's, the bus's own) and registered; the
 cycle after, it is applied: the command registers (the pins show it :data:`DECISION_TO_PINS`
@@ -30,37 +35,11 @@ from spec.schedule import DECISION_TO_PINS, row_cycles
 from ..countdown import Countdown
 from ..counter import Counter
 from ..registers import Registers, ResetMode
+from .due import lowest_due
 from .interface import BlockMode, RowMode
 from .layouts import COUNTER_BITS, Command, dark_load, group_bits, ready_load
 
-__all__ = ["Bus", "DECISION_TO_PINS", "fours_of", "lowest_due", "lowest_due_has"]
-
-
-def fours_of(bits):
-    """Bit q: some bit of ``bits[4q:4q + 4]`` is set (registered beside ``bits``, so that a
-    question over every bit is a LUT or two of these, not a chain)."""
-    return Cat(bits[lo:lo + 4].any() for lo in range(0, len(bits), 4))
-
-
-def lowest_due(due, fours):
-    """The lowest due group, one-hot (the pulse the bus chooses, when it may pulse): from the
-    ``due`` flags and their ``fours`` (bit q: some flag of ``due[4q:4q + 4]``), so that no chain
-    runs over every flag."""
-    return Cat(due[g] & ~(due[g - g % 4:g].any() | fours[:g // 4].any()) for g in range(len(due)))
-
-
-def lowest_due_has(due, fours, flags):
-    """Whether the lowest due group (:func:`lowest_due`'s) has its bit of ``flags`` set: the
-    lowest due quad's answer, each quad's from its own four groups (a priority choice at each
-    level, so that the answer is two small choices deep, not a chain over every group)."""
-    def first(bits, values):                  # the value at the lowest set bit (0: none set)
-        out = 0
-        for bit, value in reversed(list(zip(bits, values, strict=True))):
-            out = Mux(bit, value, out)
-        return out
-    quads = [range(q, min(q + 4, len(due))) for q in range(0, len(due), 4)]
-    return first([fours[i] for i in range(len(quads))],
-                 [first([due[g] for g in quad], [flags[g] for g in quad]) for quad in quads])
+__all__ = ["Bus", "DECISION_TO_PINS"]
 
 
 class Bus(wiring.Component):
@@ -151,10 +130,10 @@ class Bus(wiring.Component):
         m = Module()
         dmd, regs = self._dmd, self.regs
         R = row_cycles(dmd, self._beats)
-        rpb = dmd.rows_per_block
+        rows_per_block = dmd.rows_per_block
         G = dmd.blocks
-        gb = group_bits(dmd)
-        bb = ceil_log2(G) or 1
+        group_index_bits = group_bits(dmd)
+        block_index_bits = ceil_log2(G) or 1
         clear_cycles = dmd.clear_row_cycles * R
 
         # after an operation is applied: cycles until the next decision may be made (the next
@@ -170,23 +149,23 @@ class Bus(wiring.Component):
         # ---- pulses: the lowest due group, if the pin allows it ----
         pin_ok = ~(regs.strict_rst & self.rst_active)
         due, fours = self.due, self.due_fours
-        P = Signal(G)
-        m.d.comb += P.eq(Mux(free & pin_ok, lowest_due(due, fours), 0))
+        pulse_choice = Signal(G)
+        m.d.comb += pulse_choice.eq(Mux(free & pin_ok, lowest_due(due, fours), 0))
         do_pulse = free & pin_ok & fours.any()
-        m.d.comb += [self.choice.eq(P), self.pulsing.eq(do_pulse)]
+        m.d.comb += [self.choice.eq(pulse_choice), self.pulsing.eq(do_pulse)]
 
         # ---- loads: the operation at the head ----
         # (the head's first operation, or the next of a load under way: whether it loads a row
         # and whether it is the load's last, worked out as the operation before was applied)
         head = self.loads.payload
         fresh = Signal(init=1)                 # the head's first operation is next
-        l_block = Signal(bb)
-        l_row = Signal(range(rpb))
-        l_occupied, l_last = Signal(), Signal()
+        load_block = Signal(block_index_bits)
+        load_row = Signal(range(rows_per_block))
+        load_occupied, load_last = Signal(), Signal()
         row_at = Signal(11)                    # the next row's address, once not fresh
-        cur_block = Mux(fresh, head.first, l_block)
-        occupied = Mux(fresh, head.first_occupied, l_occupied)
-        last_op = Mux(fresh, head.single, l_last)
+        cur_block = Mux(fresh, head.first, load_block)
+        occupied = Mux(fresh, head.first_occupied, load_occupied)
+        last_op = Mux(fresh, head.single, load_last)
         m.submodules.pace = pace = Countdown(8, lag=1, flags="settled")
         # (one AND of the flags each: the head's group may change, ...; chosen as if no pulse
         # were due, the pulse's priority applied from the registered decision, so that the due
@@ -194,9 +173,9 @@ class Bus(wiring.Component):
         may_op = free & ~self.flushing & ~self.hold
         # ---- a dark pulse's clears first, once its group's memory may change ----
         dark = self.darks.payload
-        d_fresh = Signal(init=1)               # the dark's first block is next
-        d_block = Signal(bb)
-        cur_dark = Mux(d_fresh, dark.first, d_block)
+        dark_fresh = Signal(init=1)               # the dark's first block is next
+        dark_block = Signal(block_index_bits)
+        cur_dark = Mux(dark_fresh, dark.first, dark_block)
         dark_ready = self.darks.valid & self.writable.bit_select(dark.group, 1)
         do_dark = may_op & dark_ready & ~self.imminent_clear
         # a load operation waits while the dark's clears go first, or would wait for it (the
@@ -209,58 +188,60 @@ class Bus(wiring.Component):
         do_clear = (can_load & ~self.imminent_clear & ~dark_soon_clear & ~occupied) | do_dark
 
         # ---- the decision, registered ----
-        dec = Signal(data.StructLayout({
-            "pulse": 1, "pulse_group": gb, "row": 1, "clear": 1, "dark": 1, "last": 1, "load_group": G, "block": bb,
-            "row_at": 11, "fresh": 1, "starved": 1, "block_last": 1, "following": bb, "following_last": 1,
-            "following_filled": 1}))
-        following = (cur_block + 1)[:bb]
-        m.d.sync += [dec.pulse.eq(do_pulse), dec.pulse_group.eq(_lowest(due, fours)),
-                     dec.row.eq(do_row), dec.clear.eq(do_clear), dec.dark.eq(dark_ready),
-                     dec.last.eq(Mux(dark_ready, cur_dark == dark.last, last_op)),
-                     dec.load_group.eq(1 << Mux(dark_ready, dark.group, head.group)),
-                     dec.block.eq(Mux(dark_ready, cur_dark, cur_block)),
-                     dec.row_at.eq(Mux(fresh, head.first_row, row_at)), dec.fresh.eq(fresh),
-                     dec.starved.eq(wants_row & ~self.row_ready),
+        decision = Signal(data.StructLayout({
+            "pulse": 1, "pulse_group": group_index_bits, "row": 1, "clear": 1, "dark": 1, "last": 1,
+            "load_group": G, "block": block_index_bits, "row_at": 11, "fresh": 1, "starved": 1, "block_last": 1,
+            "following": block_index_bits, "following_last": 1, "following_filled": 1}))
+        following = (cur_block + 1)[:block_index_bits]
+        m.d.sync += [decision.pulse.eq(do_pulse), decision.pulse_group.eq(_lowest(due, fours)),
+                     decision.row.eq(do_row), decision.clear.eq(do_clear), decision.dark.eq(dark_ready),
+                     decision.last.eq(Mux(dark_ready, cur_dark == dark.last, last_op)),
+                     decision.load_group.eq(1 << Mux(dark_ready, dark.group, head.group)),
+                     decision.block.eq(Mux(dark_ready, cur_dark, cur_block)),
+                     decision.row_at.eq(Mux(fresh, head.first_row, row_at)), decision.fresh.eq(fresh),
+                     decision.starved.eq(wants_row & ~self.row_ready),
                      # (for the operation after it)
-                     dec.block_last.eq(cur_block == head.last), dec.following.eq(following),
-                     dec.following_last.eq(following == head.last),
-                     dec.following_filled.eq(head.mask.bit_select(following, 1))]
+                     decision.block_last.eq(cur_block == head.last), decision.following.eq(following),
+                     decision.following_last.eq(following == head.last),
+                     decision.following_filled.eq(head.mask.bit_select(following, 1))]
 
         # ---- applied ----
         # (a pulse goes first: the operation was chosen as if none were due)
         row, clear, starved = Signal(), Signal(), Signal()
-        m.d.comb += [row.eq(dec.row & ~dec.pulse), clear.eq(dec.clear & ~dec.pulse),
-                     starved.eq(dec.starved & ~dec.pulse)]
+        m.d.comb += [row.eq(decision.row & ~decision.pulse), clear.eq(decision.clear & ~decision.pulse),
+                     starved.eq(decision.starved & ~decision.pulse)]
         op = row | clear
         m.d.comb += [pace.load.eq(row), pace.value.eq(regs.row_period)]
-        with m.If(clear & dec.dark):
-            with m.If(dec.last):
+        with m.If(clear & decision.dark):
+            with m.If(decision.last):
                 m.d.comb += self.darks.ready.eq(1)
-                m.d.sync += d_fresh.eq(1)
+                m.d.sync += dark_fresh.eq(1)
             with m.Else():
-                m.d.sync += [d_fresh.eq(0), d_block.eq(dec.block + 1)]
+                m.d.sync += [dark_fresh.eq(0), dark_block.eq(decision.block + 1)]
         with m.Elif(op):
-            with m.If(dec.last):
+            with m.If(decision.last):
                 m.d.comb += self.loads.ready.eq(1)
                 m.d.sync += fresh.eq(1)
             with m.Else():
                 m.d.sync += fresh.eq(0)
-                at_row = Mux(dec.fresh, 0, l_row)
-                with m.If(row & (at_row != rpb - 1)):
+                at_row = Mux(decision.fresh, 0, load_row)
+                with m.If(row & (at_row != rows_per_block - 1)):
                     # the block's next row
-                    m.d.sync += [l_block.eq(dec.block), l_row.eq(at_row + 1), l_occupied.eq(1),
-                                 l_last.eq(dec.block_last & (at_row == rpb - 2))]
+                    m.d.sync += [load_block.eq(decision.block), load_row.eq(at_row + 1), load_occupied.eq(1),
+                                 load_last.eq(decision.block_last & (at_row == rows_per_block - 2))]
                 with m.Else():
                     # the next block: its rows, or a clear
-                    m.d.sync += [l_block.eq(dec.following), l_row.eq(0), l_occupied.eq(dec.following_filled),
-                                 l_last.eq(dec.following_last & (~dec.following_filled | (rpb == 1)))]
+                    m.d.sync += [load_block.eq(decision.following), load_row.eq(0),
+                                 load_occupied.eq(decision.following_filled),
+                                 load_last.eq(decision.following_last
+                                              & (~decision.following_filled | (rows_per_block == 1)))]
             # rows are numbered block after block: the next row follows this one, or the next
             # block's first row follows a cleared block's
-            m.d.sync += row_at.eq(dec.row_at + Mux(row, 1, rpb))
+            m.d.sync += row_at.eq(decision.row_at + Mux(row, 1, rows_per_block))
         with m.If(self.flushing):
             m.d.comb += [self.loads.ready.eq(1), self.darks.ready.eq(1)]
         with m.If(self.restart):
-            m.d.sync += [fresh.eq(1), d_fresh.eq(1)]
+            m.d.sync += [fresh.eq(1), dark_fresh.eq(1)]
 
         # a row counts once however many cycles it waits for its data
         waiting = Signal()
@@ -276,22 +257,22 @@ class Bus(wiring.Component):
         length_two = Mux(clear, clear_cycles == 2, R == 2)
         finishing = Signal(G)                  # this group's load ends at ``remain == 1``
         ends = Signal(G)                       # the load of this group ends next cycle
-        with m.If(op & dec.last & ~length_two):
-            m.d.sync += finishing.eq(dec.load_group)
+        with m.If(op & decision.last & ~length_two):
+            m.d.sync += finishing.eq(decision.load_group)
         with m.If(remain == 2):
             m.d.sync += [finishing.eq(0), ends.eq(finishing)]
         with m.Else():
             m.d.sync += ends.eq(0)
         with m.If(self.restart):
             m.d.sync += [finishing.eq(0), ends.eq(0)]
-        m.d.comb += self.loaded.eq(ends | Mux(op & dec.last & length_two, dec.load_group, 0))
+        m.d.comb += self.loaded.eq(ends | Mux(op & decision.last & length_two, decision.load_group, 0))
 
         # ---- the command registers ----
-        self._command_registers(m, dec, row, clear, remain=remain, spent=spent)
+        self._command_registers(m, decision, row, clear, remain=remain, spent=spent)
         return m
 
-    def _command_registers(self, m, dec, row, clear, *, remain, spent):
-        """The pins of the decision ``dec`` (``row``, ``clear``: it loads a row, clears a block),
+    def _command_registers(self, m, decision, row, clear, *, remain, spent):
+        """The pins of the decision ``decision`` (``row``, ``clear``: it loads a row, clears a block),
         from the cycle after it: the command held through its row cycles (a clear's no-op rows
         after it), DVALID, the row's beats; and ``remain``, the cycles until the next decision may
         be made (``spent``: none)."""
@@ -313,18 +294,18 @@ class Bus(wiring.Component):
         m.d.sync += self.beat.eq(Mux(reading, self.beats.payload, 0))
         with m.If(remain != 0):
             m.d.sync += [remain.eq(remain - 1), spent.eq(remain == 1)]
-        with m.If(dec.pulse | op):
+        with m.If(decision.pulse | op):
             length = Mux(clear, clear_cycles, R)
             m.d.sync += [self.dvalid.eq(1), remain.eq(length - 2), spent.eq(length == 2), row_left.eq(whole_row),
                          op_row.eq(row), noops.eq(Mux(clear, dmd.clear_row_cycles - 1, 0)),
                          cmd.rowmd.eq(RowMode.NOOP), cmd.blkmd.eq(BlockMode.NOOP),
                          cmd.rowad.eq(0), cmd.blkad.eq(0), cmd.rst2blkz.eq(1)]
             with m.If(row):
-                m.d.sync += [cmd.rowmd.eq(RowMode.ADDRESSED), cmd.rowad.eq(dec.row_at)]
+                m.d.sync += [cmd.rowmd.eq(RowMode.ADDRESSED), cmd.rowad.eq(decision.row_at)]
             with m.Elif(clear):
-                m.d.sync += [cmd.blkmd.eq(BlockMode.CLEAR), cmd.blkad.eq(dec.block)]
+                m.d.sync += [cmd.blkmd.eq(BlockMode.CLEAR), cmd.blkad.eq(decision.block)]
             with m.Else():
-                p = dec.pulse_group
+                p = decision.pulse_group
                 with m.Switch(regs.reset_mode):
                     with m.Case(ResetMode.GLOBAL):
                         m.d.sync += [cmd.blkmd.eq(BlockMode.MULTI), cmd.blkad.eq(0b1000)]

@@ -116,7 +116,7 @@ class PlaneInfo(wiring.Component):
         each = Signal(data.ArrayLayout(3, 8))
         m.d.sync += [at.eq(order_position(m, regs, pos, depth, "info_at")),
                      each.eq(exponents(m, regs, depth, "info_exps", table)),
-                     lsb.eq(Mux(show.lsb != 0, show.lsb, regs.lsb)), last0.eq(pos == depth - 1),
+                     lsb.eq(show.lsb_or(regs.lsb)), last0.eq(pos == depth - 1),
                      dark0.eq(dark), edark0.eq(show.dark), nodark0.eq(show.dark == 0)]
 
         # 2: the plane's weight

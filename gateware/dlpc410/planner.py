@@ -28,7 +28,7 @@ from spec.schedule import row_cycles
 from ..counter import Counter
 from ..registers import LSB_BITS, PlaneOrder, Registers, Source
 from ..store.layouts import SLOT_BITS, FrameInfo, Showing
-from .bus import fours_of, lowest_due_has
+from .due import fours_of, lowest_due_has
 from .frame_offer import FrameOffer, Offer
 from .group_frames import GroupFrames
 from .group_times import GroupTimes
@@ -219,7 +219,7 @@ class Planner(wiring.Component):
         m.d.comb += info.dark.eq(dark)
         first = frames.frame[0]
         m.d.comb += [self.depth.eq(first.depth),
-                     self.lsb.eq(Mux(first.showing.lsb != 0, first.showing.lsb, regs.lsb))]
+                     self.lsb.eq(first.showing.lsb_or(regs.lsb))]
 
         # ---- the frame offered: taken by a group (last cycle), or by a start or retake now ----
         m.submodules.offers = offers = FrameOffer(G)

@@ -308,8 +308,8 @@ class Sequencer(wiring.Component):
                 m.d.comb += pins.dvalid[e].eq(bit)
             m.d.comb += pins.rst2blkz.eq(1)
         with m.Else():
-            for bus_name, edge, lsb in cycle_lanes(dmd.buses, beats):
-                m.d.comb += getattr(pins, f"din_{bus_name.lower()}")[edge].eq(bus.beat[lsb:lsb + 16])
+            for bus_name, edge, first_bit in cycle_lanes(dmd.buses, beats):
+                m.d.comb += getattr(pins, f"din_{bus_name.lower()}")[edge].eq(bus.beat[first_bit:first_bit + 16])
             cmd = bus.command
             m.d.comb += [pins.dvalid.eq(bus.dvalid.replicate(edges)), pins.rowmd.eq(cmd.rowmd),
                          pins.rowad.eq(cmd.rowad), pins.blkmd.eq(cmd.blkmd), pins.blkad.eq(cmd.blkad),

@@ -26,6 +26,7 @@ and is stable from the moment the slot is complete, long before the slot can be 
 sequencer, so reading it from another clock domain is safe for every slot the sequencer holds.
 """
 
+from amaranth import Mux
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -66,6 +67,11 @@ class Showing(data.Struct):
     camera_off: 1     # no camera trigger for it
     last: 1           # the last entry of a sequence played once: nothing follows it, and
                       # triggers after it starts are ignored (counted)
+
+    def lsb_or(self, register):
+        """The least significant plane's time the entry shows its frame with: its own, or the
+        register's (``register``) when it gives none (0)."""
+        return Mux(self.lsb != 0, self.lsb, register)
 
 
 class FrameInfo(data.Struct):

@@ -30,7 +30,7 @@ skipped and counted: its slot is outside the sequence, or its planes are not all
 (skip + depth more than the frame's depth, or no plane left below the skipped ones).
 """
 
-from types import SimpleNamespace
+from dataclasses import dataclass
 
 from amaranth import Array, Cat, Module, Mux, Signal
 from amaranth.lib import data, enum, stream, wiring
@@ -365,7 +365,7 @@ class SlotTable(wiring.Component):
         ready_found, ready_slot = _first_of(m, live, lambda s: (state[s] == SlotState.READY) & ~in_sequence[s])
         # the slot, or the entry, given out next; the entry table is read a cycle ahead, at the
         # position from the next cycle on (``play.next``)
-        play = SimpleNamespace(now=Signal(ENTRY_BITS, name="play"), next=Signal(ENTRY_BITS, name="play_next"))
+        play = Position(now=Signal(ENTRY_BITS, name="play"), next=Signal(ENTRY_BITS, name="play_next"))
         m.d.comb += play.next.eq(play.now)
         m.d.sync += play.now.eq(play.next)
         finished = Signal()            # played once: the last entry given out
@@ -422,8 +422,8 @@ class SlotTable(wiring.Component):
                     m.d.sync += finished.eq(1)
             with m.Else():
                 m.d.comb += play.next.eq(Mux(play.now + 1 >= seq_len, 0, play.now + 1))
-        return SimpleNamespace(play=play, finished=finished, advance=advance, slot=answer_slot,
-                               can_answer=can_answer, skip=skip)
+        return Answering(play=play, finished=finished, advance=advance, slot=answer_slot,
+                         can_answer=can_answer, skip=skip)
 
     def _place(self, m, slots, seq_len, hold, sequence):
         """Drive ``placement``: where a row of ``placement.frame`` goes, from the registers ``t``
@@ -489,6 +489,35 @@ class SlotTable(wiring.Component):
             verdict(Placement.STALE)
 
 
+@dataclass(frozen=True)
+class Position:
+    """The sequence entry given out: ``now`` (registered) and ``next`` (from the next cycle on)."""
+    now: Signal
+    next: Signal
+
+
+@dataclass(frozen=True)
+class Answering:
+    """What the table answers the sequencer with this cycle: the slot, whether it can answer,
+    whether the entry is skipped, and the sequence's play position and end."""
+    play: Position
+    finished: Signal
+    advance: Signal
+    slot: Signal
+    can_answer: Signal
+    skip: Signal
+
+
+@dataclass(frozen=True)
+class SlotFields:
+    """A slot's fields read this cycle (from registers, or from LUT RAM beyond the live slots)."""
+    state: object
+    depth: object
+    in_sequence: object
+    stale: object
+    frame_id: object
+
+
 class _Slots:
     """Every slot's fields, looked up by slot number: the live slots' registers ``t``, and the
     sequence slots' states in memory (:class:`~gateware.store.slot_states.SlotStates`) when there
@@ -504,17 +533,17 @@ class _Slots:
     def view(self, name, slot):
         """The fields of slot ``slot`` (a value), this cycle."""
         t, live = self.t, self.live
-        fields = SimpleNamespace(state=t.state[slot], depth=t.depth[slot], in_sequence=t.in_sequence[slot],
-                                 stale=t.stale[slot], frame_id=t.frame_id[slot])
+        fields = SlotFields(state=t.state[slot], depth=t.depth[slot], in_sequence=t.in_sequence[slot],
+                            stale=t.stale[slot], frame_id=t.frame_id[slot])
         if self.memory is None:
             return fields
         port = getattr(self.memory, name)
         self.m.d.comb += port.slot.eq(slot)
         low = slot < live
-        return SimpleNamespace(state=Mux(low, fields.state, port.state), depth=Mux(low, fields.depth, port.depth),
-                               in_sequence=Mux(low, fields.in_sequence, port.in_sequence),
-                               stale=Mux(low, fields.stale, port.stale),
-                               frame_id=Mux(low, fields.frame_id, slot))
+        return SlotFields(state=Mux(low, fields.state, port.state), depth=Mux(low, fields.depth, port.depth),
+                          in_sequence=Mux(low, fields.in_sequence, port.in_sequence),
+                          stale=Mux(low, fields.stale, port.stale),
+                          frame_id=Mux(low, fields.frame_id, slot))
 
     def housekeeping(self, slot):
         """The view of the slot housekeeping changes (with :meth:`keep`)."""
