@@ -5,7 +5,7 @@ period the model gives it, every level exact; the host CLI uses it before sendin
 import pytest
 
 from host import cli
-from sim.bench.rates import measured_rate
+from sim.bench.rig_rate import measured_rate
 from spec import plan_search, schedule
 from spec.facts import TEST_DMD
 from spec.registers import PlaneOrder, ResetMode

@@ -23,6 +23,9 @@ the row cycle, and at the DDR2's pace of ``make sim``):
 
 import numpy as np
 
+from sim import xga
+from sim.bench.rig_rate import RIG_SOURCE, measured_rate
+from sim.bench.seq import bound_figure
 from spec import ceiling
 from spec.facts import DMDS
 from spec.group_orders import find, solve, terms
@@ -104,10 +107,6 @@ def figures(*, seconds=120.0):
     checked, against the bound, one timeline's ceiling and the frame the solver proved no plan of
     that kind beats; then the plan finder's, under the sequencer's terms, measured on the
     gateware beside the model's period."""
-    from sim import xga
-    from sim.bench.rates import RIG_SOURCE, measured_rate
-    from sim.bench.seq import bound_figure
-
     out, dmd = {}, DMDS["dlp7000"]
     # the store's words a cycle: a row every row cycle (as the rates bench's store stand-in), or
     # the DDR2's read rate
