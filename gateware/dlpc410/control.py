@@ -105,7 +105,7 @@ class FrameControl(wiring.Component):
 
     def __init__(self, dmd, *, beats=1):
         self._dmd, self._beats = dmd, beats
-        gb = group_bits(dmd)
+        group_index_bits = group_bits(dmd)
         G = dmd.blocks
         super().__init__({
             "regs": In(Registers),
@@ -124,7 +124,7 @@ class FrameControl(wiring.Component):
             "start": Out(event(START)),
             "retake": Out(event(data.StructLayout({"newer": 1, "abandon": 1}))),
             "trigger": Out(1),
-            "queue_first": Out(event(gb)),
+            "queue_first": Out(event(group_index_bits)),
             "lead_over": Out(1),
             "running": Out(1),
             "ready": Out(1),

@@ -27,12 +27,12 @@ block_bits = group_bits
 def group_span(dmd, reset_mode, size_log2, group):
     """The first and last block of ``group``: every block in global mode, else ``2**size_log2``
     from ``group << size_log2``, cut at the last block (the DLP9500's 15 blocks)."""
-    bb = block_bits(dmd)
-    first = (group << size_log2)[:bb + 1]
+    block_index_bits = block_bits(dmd)
+    first = (group << size_log2)[:block_index_bits + 1]
     end = first | ((Const(1, 4) << size_log2) - 1)
     is_global = reset_mode == ResetMode.GLOBAL
-    return (Mux(is_global, 0, first)[:bb],
-            Mux(is_global | (end > dmd.blocks - 1), dmd.blocks - 1, end)[:bb])
+    return (Mux(is_global, 0, first)[:block_index_bits],
+            Mux(is_global | (end > dmd.blocks - 1), dmd.blocks - 1, end)[:block_index_bits])
 
 
 def load_job(dmd):

@@ -61,14 +61,16 @@ class LoadJobs(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        dmd, G, gb = self._dmd, self._dmd.blocks, group_bits(self._dmd)
+        dmd, G, group_index_bits = self._dmd, self._dmd.blocks, group_bits(self._dmd)
         job = Signal(load_job(dmd))
         low_plane = Signal(3)                  # the job's frame's lowest stored plane
         table = Signal(24)                     # the job's group's order table (GROUPS)
         tables = group_tables(self.regs, G)
-        pulsed, group, formed = Signal(), Signal(gb), Signal()
+        pulsed, group, formed = Signal(), Signal(group_index_bits), Signal()
         m.d.sync += [pulsed.eq(self.pulse_any),
-                     group.eq(Cat(Cat(self.pulse[g] for g in range(G) if g >> b & 1).any() for b in range(gb))),
+                     # the pulsed group's index, bit by bit
+                     group.eq(Cat(Cat(self.pulse[g] for g in range(G) if g >> b & 1).any()
+                                  for b in range(group_index_bits))),
                      formed.eq(pulsed | self.queue_first.valid)]
         with m.If(pulsed):
             kept = self.frame[group]

@@ -70,14 +70,14 @@ class Requester(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         dmd, regs, n_groups = self._dmd, self.regs, self.n_groups
-        rpb = dmd.rows_per_block
-        bb = block_bits(dmd)
+        rows_per_block = dmd.rows_per_block
+        block_index_bits = block_bits(dmd)
         use_prng = regs.source == Source.PRNG
         flushing = self.flushing
 
         entry = Signal(load_job(dmd))          # the job being requested
         mask = Signal(dmd.blocks)
-        block = Signal(bb + 1)
+        block = Signal(block_index_bits + 1)
         block_row = Signal(11)                 # the first row of ``block``
         first_row = Signal(11)
         first_occupied = Signal()
@@ -87,25 +87,25 @@ class Requester(wiring.Component):
         passed = Signal()                      # the last block's request is made (or skipped)
         last_group = Signal.like(self.n_groups)          # (the registers hold still)
         m.d.sync += last_group.eq(n_groups - 1)
-        last = Signal(bb)
+        last = Signal(block_index_bits)
         head = self.jobs.payload
         plane = Signal(3)
 
         # the head job's plane, and its group's blocks, registered as the job is taken
-        head_first, head_last = Signal(bb), Signal(bb)
+        head_first, head_last = Signal(block_index_bits), Signal(block_index_bits)
         m.d.comb += Cat(head_first, head_last).eq(Cat(*group_span(dmd, regs.reset_mode, self.size_log2, head.group)))
-        span_first, span_last = Signal(bb), Signal(bb)
+        span_first, span_last = Signal(block_index_bits), Signal(block_index_bits)
 
         m.d.comb += [
             self.loads.payload.group.eq(entry.group), self.loads.payload.mask.eq(mask),
             self.loads.payload.first.eq(span_first), self.loads.payload.last.eq(last),
             self.loads.payload.first_row.eq(first_row),
             self.loads.payload.first_occupied.eq(first_occupied),
-            self.loads.payload.single.eq((span_first == last) & (~first_occupied | (rpb == 1))),
+            self.loads.payload.single.eq((span_first == last) & (~first_occupied | (rows_per_block == 1))),
             self.requests.payload.slot.eq(entry.slot),
             self.requests.payload.plane.eq(plane),
             self.requests.payload.first_row.eq(block_row),
-            self.requests.payload.row_count.eq(rpb),
+            self.requests.payload.row_count.eq(rows_per_block),
         ]
 
         # slots handed back, in order
@@ -156,12 +156,12 @@ class Requester(wiring.Component):
             with m.State("MASK"):
                 # (comparisons that cannot fail are left out: Verilator rejects them)
                 def in_span(b):
-                    after_first = (span_first <= b) if b < (1 << bb) - 1 else 1
+                    after_first = (span_first <= b) if b < (1 << block_index_bits) - 1 else 1
                     before_last = (span_last >= b) if b else 1
                     return after_first & before_last
                 looked = Cat(in_span(b) & occupied[b] for b in range(dmd.blocks))
                 m.d.sync += [mask.eq(looked), block.eq(span_first), last.eq(span_last),
-                             first_row.eq(span_first * rpb), block_row.eq(span_first * rpb),
+                             first_row.eq(span_first * rows_per_block), block_row.eq(span_first * rows_per_block),
                              first_occupied.eq(occupied.bit_select(span_first, 1)),
                              at_last.eq(span_first == span_last), passed.eq(0)]
                 goto("PUSH")
@@ -182,7 +182,7 @@ class Requester(wiring.Component):
                 wanted = ahead[0] & ~use_prng
 
                 def next_block():
-                    m.d.sync += [block.eq(block + 1), block_row.eq(block_row + rpb), ahead.eq(ahead >> 1),
+                    m.d.sync += [block.eq(block + 1), block_row.eq(block_row + rows_per_block), ahead.eq(ahead >> 1),
                                  at_last.eq(block + 1 == last), passed.eq(at_last)]
                 # flushing: a request offered is held until taken (its words are discarded)
                 with m.If(passed | (flushing & ~wanted)):
