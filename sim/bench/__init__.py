@@ -18,6 +18,7 @@ MODULES = [
     "sim.bench.mac",
     "sim.bench.net",
     "sim.bench.rates",
+    "sim.bench.registers",
     "sim.bench.store",
     "sim.bench.sync",
     "sim.bench.seq",
