@@ -36,6 +36,7 @@ the read bandwidth the memory model gives the plane reader.
 import fcntl
 import hashlib
 import json
+import math
 import time
 from pathlib import Path
 
@@ -58,7 +59,7 @@ from spec import plan_search, records, schedule
 from spec.facts import DMDS, TIMING
 from spec.registers import PlaneOrder, ResetMode
 
-__all__ = ["run", "plan", "DMD", "DMD_HZ", "DCLK_HZ"]
+__all__ = ["run", "stream", "plan", "DMD", "DMD_HZ", "DCLK_HZ"]
 
 DMD = DMDS["dlp7000"]
 DMD_HZ, SYNC_HZ = schedule.FABRIC_HZ, 125e6
@@ -262,7 +263,7 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
     build = cocotb_run.run(top(the_plan, bool(window), dmd), toplevel=TOPLEVEL, module="sim.tb.system_fast",
                            key=f"{_name(dmd)}-{the_plan.params.beats}beats" + ("-window" if window else ""),
                            params=p, extra_sources=SOURCES + (WINDOW_SOURCES if window else []), plusargs=plusargs,
-                           waves=False, traced=bool(window), top_signals_only=True)
+                           waves=False, traced=bool(window), top_signals_only=True, testcase="stream_frames")
     stimulus = json.loads(report_path.read_text())
     sim_wall = stimulus["wall_s"]
     log(f"simulation done: build and run {time.monotonic() - t_build:.0f} s, of which the run {sim_wall:.0f} s; "
@@ -441,3 +442,89 @@ def _model_span(dmd, the_plan):
 
 if __name__ == "__main__":
     print(json.dumps(run(frames=2, one_by_one=1, back_to_back=2), indent=1, default=str))
+
+
+def _stream_files(directory, images, whole):
+    """GMII replay files for a stream: one per frame, the first whole (the key frame), each later
+    one a delta of it (the rows in which the moving target differs from it: a delta's base must
+    be a whole frame, which the store keeps while deltas use it), or whole too (``whole``).
+    Returns (sends, query)."""
+    sends, sequence = [], 0
+    for index, image in enumerate(images):
+        delta = {}
+        if index and not whole:
+            rows = codec.changed_rows(image, images[0])
+            delta = {"base": 0, "rows": rows if len(rows) else [0]}
+        payloads = codec.image_records(image, frame=index, sequence=sequence, **delta)
+        sequence += len(payloads)
+        path = directory / f"stream{index}.bin"
+        gmii.replay_file(path, _datagrams(payloads))
+        sends.append({"path": str(path), "what": f"frame {index + 1}/{len(images)}",
+                      "kind": "delta" if delta else "whole", "wire_ns": path.stat().st_size // 2 * 8})
+    query = directory / "status_query.bin"
+    gmii.replay_file(query, _datagrams([codec.status_query(sequence)]))
+    return sends, str(query)
+
+
+def stream(key="stream", frames=6, *, whole=False, dclk_hz=DCLK_HZ, log=print, dmd=DMD):
+    """A new frame at every trigger: ``frames`` frames of the default scene streamed over GMII
+    (the store in its power-up streaming mode: each frame replaces the one before it), each sent
+    while the one before it is shown, as a delta of the first (or whole: ``whole``); a trigger every
+    frame period of the plan, or every frame's wire time when that is longer (whole frames).
+    Returns the report: every frame on the pins with its error against the frame sent for that
+    trigger, and the rate of new frames measured between the first and the last frame's first
+    pulses. Raises when a frame is missing, repeated or wrong, or a counter says a record or a
+    row was lost."""
+    the_plan = plan(dclk_hz, None, dmd)
+    directory = build_dir("system", key)
+    images = default_scene(frames, dmd.rows, dmd.columns)
+    sends, query = _stream_files(directory, images, whole)
+    settle_us = 250
+    # (the first frame goes before the first trigger, so its wire time does not set the pace)
+    wire_cycles = max(s["wire_ns"] for s in sends[1:]) * DMD_HZ / 1e9 + settle_us * DMD_HZ / 1e6
+    period = max(the_plan.frame_cycles, math.ceil(wire_cycles / 2) * 2)
+    files = {name: directory / f"{name}.txt" for name in ("pins", "tx")}
+    report_path = directory / "stimulus.json"
+    p = {"sends": sends, "status_query": query, "replay": str(directory / "replay.bin"),
+         "trigger_period_cycles": period, "settle_us": settle_us, "margin_us": 20, "reply_us": 30,
+         "progress_us": 2000, "report": str(report_path)}
+    plusargs = [f"+{PLUSARGS['replay']}={p['replay']}", f"+{PLUSARGS['pins']}={files['pins']}",
+                f"+{PLUSARGS['tx']}={files['tx']}"]
+    start = time.monotonic()
+    build = cocotb_run.run(top(the_plan, False, dmd), toplevel=TOPLEVEL, module="sim.tb.system_fast",
+                           key=f"{_name(dmd)}-{the_plan.params.beats}beats", params=p, extra_sources=SOURCES,
+                           plusargs=plusargs, waves=False, testcase="stream_new_frames", top_signals_only=True)
+    stimulus = json.loads(report_path.read_text())
+    log(f"simulation done: build and run {time.monotonic() - start:.0f} s; checking the pins")
+    layout = pin_layout(dmd.buses, the_plan.params.beats)
+    pins = trace.read(files["pins"])
+    model = Dlpc410(dmd, beats=the_plan.params.beats, clock_hz=DMD_HZ, init_cycles=INIT_CYCLES,
+                    init_grace_cycles=INIT_GRACE)
+    trace.replay_dlpc410(model, pins, layout)
+    triggers = trace.rising_edges(pins, layout, "trigger_in")
+    shown = _frames_shown(pins, layout, [c.cycle for c in model.log if c.kind == "pulse"])
+    assert len(shown) == len(triggers) == frames, f"{len(shown)} frames shown for {len(triggers)} triggers"
+    camera, lsb = Camera(model, ramp_cycles=0), the_plan.params.lsb
+    report = {"frames": [], "trigger_period_cycles": period, "period_cycles": the_plan.frame_cycles,
+              "whole": whole, "sends": stimulus["sends"], "build": str(build)}
+    for index, ((first, _last), trigger) in enumerate(zip(shown, triggers, strict=True)):
+        light = to_lsb(camera.image(first, first + the_plan.frame_cycles), lsb)
+        error = np.abs(light - images[index][:, :light.shape[1]].astype(np.float64))
+        # a frame shown twice, or one left out, shows another frame's image: the scene moves
+        others = [k for k, image in enumerate(images) if k != index
+                  and np.array_equal(light, image[:, :light.shape[1]].astype(np.float64))]
+        report["frames"].append({"trigger_cycle": trigger, "start_cycle": first, "latency_cycles": first - trigger,
+                                 "max_error_lsb": float(error.max()), "wrong_pixels": int((error > 1e-9).sum()),
+                                 "equals_frames": others})
+    status = _status(trace.read(files["tx"]))
+    counted = ("drop_overflow", "mac_rx_dropped", "rows_incomplete", "store_rows_refused", "store_rows_no_base",
+               "store_frames_abandoned", "pulses_late")
+    lost = {name: status[name] for name in counted if status[name]}
+    assert not lost, lost
+    assert status["store_frames_complete"] == frames and status["frames_shown"] == frames, status
+    assert status["shown_frame"] == status["newest_frame"] == frames - 1, status
+    starts = [f["start_cycle"] for f in report["frames"]]
+    report["status"] = status
+    report["new_frames_per_s"] = (frames - 1) * DMD_HZ / (starts[-1] - starts[0])
+    report["wire_ms"] = [s["end_ns"] / 1e6 - s["start_ns"] / 1e6 for s in stimulus["sends"]]
+    return report

@@ -1,6 +1,9 @@
 """System figures of the full-XGA run (:mod:`sim.xga`, what ``make sim`` runs): DLP7000, TI
 timing, DCLK 400 MHz, the default scene stored as a sequence played by an entry table, one by one
-then back to back: DCLK, the frame period measured on the pins, latency, grey error, simulation speed."""
+then back to back: DCLK, the frame period measured on the pins, latency, grey error, simulation
+speed. Beside it the streamed runs (:func:`streamed`): a new frame of the scene at every trigger.
+
+``python -m sim.bench.system_xga streamed`` prints the streamed runs' figures alone."""
 
 from sim import xga
 from sim.system import XGA_BACK_TO_BACK, XGA_ENTRIES, XGA_FRAMES, XGA_ONE_BY_ONE, latency
@@ -35,7 +38,37 @@ def run():
         "eth.scene_whole_frames_per_s": (r["scene"]["whole_frames_per_s"], "frame/s", run + ", on the GMII pins"),
         **faulty(),
         **dlp9500(),
+        **streamed(),
     }
+
+
+#: Frames of the streamed runs: as deltas (each of the frame before it), and whole.
+STREAMED_FRAMES = {"delta": 6, "whole": 4}
+
+
+def streamed():
+    """A new frame at every trigger (:func:`sim.xga.stream`): the default scene streamed over GMII
+    while triggers come at the plan's display rate (deltas: each frame the rows in which it differs
+    from the first, a whole key frame), or at the pace GigE allows (whole frames). Every frame is shown
+    once, in order, exact; the rate is measured between the first and the last frame's first
+    clocking pulses on the pins."""
+    figures = {}
+    for kind, frames in STREAMED_FRAMES.items():
+        name = f"bench-stream-{kind}"
+        r = xga.stream(name, frames=frames, whole=kind == "whole", log=lambda _text: None)
+        assert all(f["max_error_lsb"] == 0 and not f["equals_frames"] for f in r["frames"]), r["frames"]
+        run = XGA_SOURCE.format(what=f"DLP7000, {frames} frames of the default scene streamed ({kind}), a trigger "
+                                     f"every {r['trigger_period_cycles']} cycles, each frame new and exact", name=name)
+        suffix = "" if kind == "delta" else "_whole"
+        figures[f"sys.xga_new_frames_per_s_streamed{suffix}"] = (r["new_frames_per_s"], "frame/s",
+                                                                  run + ", first pulses on the pins")
+        figures[f"sys.xga_streamed{suffix}_trigger_period_cycles"] = (r["trigger_period_cycles"], "cycle", run)
+        _typical, worst = latency([{**f, "held": False} for f in r["frames"]])
+        figures[f"sys.xga_streamed{suffix}_trigger_latency_cycles_worst"] = (worst, "cycle", run)
+        # (a row that waited for its data while the next frame was written; no pulse late)
+        for counter in ("row_underruns", "pulses_late", "triggers_held"):
+            figures[f"sys.xga_streamed{suffix}_{counter}"] = (r["status"][counter], "count", run + ", status reply")
+    return figures
 
 
 def dlp9500():
@@ -86,3 +119,10 @@ def _median_period(r):
     """The median of the back-to-back frame periods a run measured on the pins."""
     periods = sorted(r["periods_measured"])
     return periods[len(periods) // 2]
+
+
+if __name__ == "__main__":
+    import sys
+    only = {"streamed": streamed, "faulty": faulty, "dlp9500": dlp9500}
+    for figure, (value, unit, source) in (only[sys.argv[1]]() if sys.argv[1:] else run()).items():
+        print(f"{figure:55s} {value:12.1f} {unit:10s} {source}")

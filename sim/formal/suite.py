@@ -18,7 +18,11 @@ from . import blocks, sequencer, store
 from .harness import run
 from .streams import ready_paths
 
-__all__ = ["checks", "Row", "run_all", "figures"]
+__all__ = ["checks", "Row", "run_all", "figures", "RESULTS"]
+
+#: Where a whole ``make formal`` run leaves its rows, in ``build/formal`` (quick or partial runs
+#: write beside it): the rows the bench and ``docs/formal.md`` quote.
+RESULTS = "results.json"
 
 
 def checks():

@@ -115,6 +115,24 @@ class Run:
             await Timer(every_us, "us")
             self.log("running")
 
+    async def finish(self):
+        """After the last frame: the status query (its reply goes to the transmit trace), the
+        traces flushed, the memory model's rules checked, and the events written."""
+        dut, p = self.dut, self.p
+        await Timer(p["margin_us"], "us")
+        self.check_memory()
+        await self.send(p["status_query"], "status query", "query")
+        await Timer(p["reply_us"], "us")
+        dut.flush.value = 1
+        await ClockCycles(dut.clk, 2)
+        await ClockCycles(dut.dmd_clk, 2)
+        dut.flush.value = 0
+        self.check_memory()
+        self.events["mcb_stalls"] = int(dut.mcb_stalls.value)
+        self.events["sim_ns"] = self.now_ns()
+        self.events["wall_s"] = time.monotonic() - self.wall0
+        Path(p["report"]).write_text(json.dumps(self.events))
+
     def check_memory(self):
         fault = int(self.dut.mcb_fault.value)
         assert fault == 0, f"memory model: rule broken on a port (codes {fault:#04x}, see the log)"
@@ -171,16 +189,37 @@ async def stream_frames(dut):
     while (run.frames_started < p["one_by_one"] + p["back_to_back"] or dut.sync_out.value) \
             and run.now_ns() < give_up:
         await Timer(10, "us")
-    await Timer(p["margin_us"], "us")
-    run.check_memory()
-    await run.send(p["status_query"], "status query", "query")
-    await Timer(p["reply_us"], "us")
-    dut.flush.value = 1
-    await ClockCycles(dut.clk, 2)
-    await ClockCycles(dut.dmd_clk, 2)
-    dut.flush.value = 0
-    run.check_memory()
-    run.events["mcb_stalls"] = int(dut.mcb_stalls.value)
-    run.events["sim_ns"] = run.now_ns()
-    run.events["wall_s"] = time.monotonic() - run.wall0
-    Path(p["report"]).write_text(json.dumps(run.events))
+    await run.finish()
+
+
+@cocotb.test()
+async def stream_new_frames(dut):
+    """A new frame at every trigger (:func:`sim.xga.stream`): the first frame sent and left to
+    settle, then a trigger every ``trigger_period_cycles``; right after each trigger the next
+    frame goes over GMII, while the one triggered is shown."""
+    p = params()
+    run = Run(dut, p)
+    await run.start()
+    cocotb.start_soon(run.progress(p["progress_us"]))
+    cocotb.start_soon(run.count_frames())
+    sends = p["sends"]
+    await run.send(sends[0]["path"], sends[0]["what"], sends[0]["kind"])
+    await Timer(p["settle_us"], "us")
+    period_ns = p["trigger_period_cycles"] * DMD_NS
+    first = run.now_ns()
+    sending = None
+    for index in range(len(sends)):
+        wait = round(first + index * period_ns - run.now_ns())
+        if wait > 0:
+            await Timer(wait, "ns")
+        if sending is not None:
+            assert sending.done(), f"frame {index + 1} still on the wire at its trigger"
+        await run.trigger((index * 700) % int(DMD_NS * 1000))
+        run.log(f"frame {index + 1} triggered")
+        if index + 1 < len(sends):
+            following = sends[index + 1]
+            sending = cocotb.start_soon(run.send(following["path"], following["what"], following["kind"]))
+    give_up = run.now_ns() + 2 * period_ns
+    while (run.frames_started < len(sends) or dut.sync_out.value) and run.now_ns() < give_up:
+        await Timer(10, "us")
+    await run.finish()
