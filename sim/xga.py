@@ -252,8 +252,7 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
          "settle_us": 250,
          "margin_us": 20, "reply_us": 30, "progress_us": 2000, "report": str(report_path),
          "window": window and {"after_us": WINDOW_AFTER_US}}
-    plusargs = [f"+{PLUSARGS['replay']}={p['replay']}", f"+{PLUSARGS['pins']}={files['pins']}",
-                f"+{PLUSARGS['tx']}={files['tx']}"]
+    plusargs = _trace_plusargs(p["replay"], files)
     if faults:
         plusargs += [f"+{name}={value}" for name, value in FAULTS[faults].items()]
     if window:
@@ -319,16 +318,30 @@ def _model_back_to_back(dmd, the_plan, images, slots, strobes):
     return [t - r.frame_starts[0] for t in r.frame_starts]
 
 
+def _trace_plusargs(replay, files):
+    """The testbench's plusargs: the GMII replay file, and where the pin and transmit traces go."""
+    return [f"+{PLUSARGS['replay']}={replay}", f"+{PLUSARGS['pins']}={files['pins']}",
+            f"+{PLUSARGS['tx']}={files['tx']}"]
+
+
+def _pins_checked(dmd, beats, path, rst_extra=0):
+    """The pin trace at ``path`` replayed through the rule-checking DLPC410 model (its RST_ACTIVE
+    ``rst_extra`` cycles longer than the facts table's): (layout, pins, model); raises on a
+    broken rule."""
+    layout = pin_layout(dmd.buses, beats)
+    pins = trace.read(path)
+    model = Dlpc410(dmd, beats=beats, clock_hz=DMD_HZ, init_cycles=INIT_CYCLES, init_grace_cycles=INIT_GRACE)
+    model.rst_active_cycles += rst_extra
+    trace.replay_dlpc410(model, pins, layout)
+    return layout, pins, model
+
+
 def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, build=None, faults=None, dmd=DMD,
             window=False, entries=None):
     t0 = time.monotonic()
     p = the_plan.params
-    layout = pin_layout(dmd.buses, p.beats)
-    pins = trace.read(files["pins"])
-    model = Dlpc410(dmd, beats=p.beats, clock_hz=DMD_HZ, init_cycles=INIT_CYCLES, init_grace_cycles=INIT_GRACE)
-    if faults:
-        model.rst_active_cycles += FAULTS[faults].get("dlpc410_rst_extra", 0)
-    trace.replay_dlpc410(model, pins, layout)
+    layout, pins, model = _pins_checked(dmd, p.beats, files["pins"],
+                                        FAULTS[faults].get("dlpc410_rst_extra", 0) if faults else 0)
     triggers = trace.rising_edges(pins, layout, "trigger_in")
     pulses = [c.cycle for c in model.log if c.kind == "pulse"]
     period, lsb = the_plan.frame_cycles, p.lsb
@@ -440,9 +453,6 @@ def _model_span(dmd, the_plan):
     return cycles[-1] - cycles[0]
 
 
-if __name__ == "__main__":
-    print(json.dumps(run(frames=2, one_by_one=1, back_to_back=2), indent=1, default=str))
-
 
 def _stream_files(directory, images, whole):
     """GMII replay files for a stream: one per frame, the first whole (the key frame), each later
@@ -488,19 +498,14 @@ def stream(key="stream", frames=6, *, whole=False, dclk_hz=DCLK_HZ, log=print, d
     p = {"sends": sends, "status_query": query, "replay": str(directory / "replay.bin"),
          "trigger_period_cycles": period, "settle_us": settle_us, "margin_us": 20, "reply_us": 30,
          "progress_us": 2000, "report": str(report_path)}
-    plusargs = [f"+{PLUSARGS['replay']}={p['replay']}", f"+{PLUSARGS['pins']}={files['pins']}",
-                f"+{PLUSARGS['tx']}={files['tx']}"]
+    plusargs = _trace_plusargs(p["replay"], files)
     start = time.monotonic()
     build = cocotb_run.run(top(the_plan, False, dmd), toplevel=TOPLEVEL, module="sim.tb.system_fast",
                            key=f"{_name(dmd)}-{the_plan.params.beats}beats", params=p, extra_sources=SOURCES,
                            plusargs=plusargs, waves=False, testcase="stream_new_frames", top_signals_only=True)
     stimulus = json.loads(report_path.read_text())
     log(f"simulation done: build and run {time.monotonic() - start:.0f} s; checking the pins")
-    layout = pin_layout(dmd.buses, the_plan.params.beats)
-    pins = trace.read(files["pins"])
-    model = Dlpc410(dmd, beats=the_plan.params.beats, clock_hz=DMD_HZ, init_cycles=INIT_CYCLES,
-                    init_grace_cycles=INIT_GRACE)
-    trace.replay_dlpc410(model, pins, layout)
+    layout, pins, model = _pins_checked(dmd, the_plan.params.beats, files["pins"])
     triggers = trace.rising_edges(pins, layout, "trigger_in")
     shown = _frames_shown(pins, layout, [c.cycle for c in model.log if c.kind == "pulse"])
     assert len(shown) == len(triggers) == frames, f"{len(shown)} frames shown for {len(triggers)} triggers"
@@ -528,3 +533,7 @@ def stream(key="stream", frames=6, *, whole=False, dclk_hz=DCLK_HZ, log=print, d
     report["new_frames_per_s"] = (frames - 1) * DMD_HZ / (starts[-1] - starts[0])
     report["wire_ms"] = [s["end_ns"] / 1e6 - s["start_ns"] / 1e6 for s in stimulus["sends"]]
     return report
+
+
+if __name__ == "__main__":
+    print(json.dumps(run(frames=2, one_by_one=1, back_to_back=2), indent=1, default=str))

@@ -115,6 +115,12 @@ class Run:
             await Timer(every_us, "us")
             self.log("running")
 
+    async def frames_ended(self, count, give_up_ns):
+        """Wait until ``count`` frames have started and the last has ended (sync out low), or
+        until ``give_up_ns``; the checks after the run say what was missing."""
+        while (self.frames_started < count or self.dut.sync_out.value) and self.now_ns() < give_up_ns:
+            await Timer(10, "us")
+
     async def finish(self):
         """After the last frame: the status query (its reply goes to the transmit trace), the
         traces flushed, the memory model's rules checked, and the events written."""
@@ -185,10 +191,8 @@ async def stream_frames(dut):
     # the held frames play one after another: the last ends its back-to-back lag after the loop
     # (sync out falls after its last group's final dark pulse); a memory that stalls may make it
     # later, so wait for it, two frames at most
-    give_up = run.now_ns() + p["back_to_back"] * (period_ns - fast_ns) + 2 * period_ns
-    while (run.frames_started < p["one_by_one"] + p["back_to_back"] or dut.sync_out.value) \
-            and run.now_ns() < give_up:
-        await Timer(10, "us")
+    await run.frames_ended(p["one_by_one"] + p["back_to_back"],
+                           run.now_ns() + p["back_to_back"] * (period_ns - fast_ns) + 2 * period_ns)
     await run.finish()
 
 
@@ -219,7 +223,5 @@ async def stream_new_frames(dut):
         if index + 1 < len(sends):
             following = sends[index + 1]
             sending = cocotb.start_soon(run.send(following["path"], following["what"], following["kind"]))
-    give_up = run.now_ns() + 2 * period_ns
-    while (run.frames_started < len(sends) or dut.sync_out.value) and run.now_ns() < give_up:
-        await Timer(10, "us")
+    await run.frames_ended(len(sends), run.now_ns() + 2 * period_ns)
     await run.finish()
