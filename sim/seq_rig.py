@@ -239,8 +239,9 @@ def build_key(dmd, beats=1, store_words=1):
 
 @functools.cache
 def rig_verilog(dmd, beats=1, store_words=1):
-    """The rig's Verilog, converted once per process."""
-    return cocotb_run.emit_verilog(SequencerRig(dmd, beats=beats, store_words=store_words), TOPLEVEL)
+    """The rig's Verilog, converted once per source tree (:func:`cocotb_run.converted`)."""
+    return cocotb_run.converted(lambda: SequencerRig(dmd, beats=beats, store_words=store_words), TOPLEVEL,
+                                ["SequencerRig", dmd, beats, store_words])
 
 
 def write_hex(path, words, width):

@@ -26,7 +26,7 @@ from spec import schedule
 from spec.facts import DMDS
 from spec.registers import PlaneOrder, ResetMode
 
-__all__ = ["main", "run", "core", "plan", "power_up_plan", "PARAMS", "XGA_FRAMES", "XGA_ENTRIES"]
+__all__ = ["main", "run", "core", "core_verilog", "plan", "power_up_plan", "PARAMS", "XGA_FRAMES", "XGA_ENTRIES"]
 
 MAC, IP, PORT = 0x02_00_00_00_00_01, 0x0A_00_00_02, 5000
 DMD_NS = 5.0
@@ -69,11 +69,19 @@ def core(p):
                      armed=False, mdio_cycles=(40, 10))
 
 
+def core_verilog(p):
+    """:func:`core`'s Verilog, converted once while the sources stay the same: the system
+    testbench's runs and the virtual projector share it."""
+    dmd = DMDS[p["dmd"]]
+    return cocotb_run.converted(lambda: core(p), "projector",
+                                ["Projector", dmd, power_up_plan(p).params.registers(dmd)])
+
+
 def run(key="test", testcase="frames_over_gmii_are_shown_exactly", **overrides):
     """Build and run one test of the system testbench (``testcase``); returns its report (dict)."""
     report = build_dir("system") / f"{key}-{testcase}.json"
     p = {**PARAMS, **overrides, "report": str(report)}
-    build = cocotb_run.run(core(p), toplevel="projector", module="sim.tb.system", key=key, params=p,
+    build = cocotb_run.run(core_verilog(p), toplevel="projector", module="sim.tb.system", key=key, params=p,
                            testcase=testcase)
     result = json.loads(report.read_text())
     result["build"] = str(build)

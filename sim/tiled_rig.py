@@ -408,7 +408,9 @@ def run_tiled(dmd, params, images, *, oscillators, master=Oscillator(), frames, 
           "status": [(n, f.offset, f.width) for n, f in data.Layout.cast(Status)],
           "loops": [(n, f.offset, f.width) for n, f in data.Layout.cast(LoopState)]}
     key = f"{slug(dmd.name)}-{boards}-{p.beats}-{store_words}"
-    cocotb_run.run(TiledRig(dmd, boards, beats=p.beats, store_words=store_words), toplevel=TOPLEVEL,
+    verilog = cocotb_run.converted(lambda: TiledRig(dmd, boards, beats=p.beats, store_words=store_words), TOPLEVEL,
+                                   ["TiledRig", dmd, boards, p.beats, store_words])
+    cocotb_run.run(verilog, toplevel=TOPLEVEL,
                    module="sim.tb.tiled_rig", key=key, params=tb, extra_sources=SOURCES, plusargs=plusargs,
                    run_dir=directory / "run", build_args=VERILATOR_TIMING)
     result = json.loads(report.read_text())

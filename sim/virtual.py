@@ -109,9 +109,9 @@ def _params(out, seconds):
 
 def serve(out, seconds):
     """Run the virtual projector in this process's namespace (started by :class:`Namespace`)."""
-    from sim.system import core
+    from sim.system import core_verilog
     p = _params(Path(out), seconds)
-    return cocotb_run.run(core(p), toplevel="projector", module="sim.tb.virtual", key="test", params=p,
+    return cocotb_run.run(core_verilog(p), toplevel="projector", module="sim.tb.virtual", key="test", params=p,
                           timeout_s=seconds + START_S)
 
 

@@ -142,6 +142,13 @@ def calibrate(key, dclk_hz=DCLK_HZ, faults=None, log=print, dmd=DMD):
     return r["status"]["rst_active_cycles_max"]
 
 
+def top_verilog(the_plan, window=False, dmd=DMD):
+    """The run's core as Verilog, converted once while the sources stay the same (``make sim``
+    and the suite's run of the same plan share it)."""
+    return cocotb_run.converted(lambda: top(the_plan, window, dmd), TOPLEVEL,
+                                ["FastSystem", dmd, the_plan.params, bool(window)])
+
+
 def top(the_plan, window=False, dmd=DMD):
     return FastSystem(dmd, the_plan.params.registers(dmd), mac=MAC, ip=IP_ADDR, port=PORT,
                       clocks={"sync": SYNC_HZ, "dmd": DMD_HZ}, init_cycles=INIT_CYCLES,
@@ -259,7 +266,7 @@ def run(key="xga", frames=3, *, one_by_one=2, back_to_back=6, dclk_hz=DCLK_HZ, f
         plusargs.append(f"+{PLUSARGS['window']}={directory / 'window.vcd'}")
     t_build = time.monotonic()
     # the window's build traces: a key of its own, so that the other runs stay untraced
-    build = cocotb_run.run(top(the_plan, bool(window), dmd), toplevel=TOPLEVEL, module="sim.tb.system_fast",
+    build = cocotb_run.run(top_verilog(the_plan, window, dmd), toplevel=TOPLEVEL, module="sim.tb.system_fast",
                            key=f"{_name(dmd)}-{the_plan.params.beats}beats" + ("-window" if window else ""),
                            params=p, extra_sources=SOURCES + (WINDOW_SOURCES if window else []), plusargs=plusargs,
                            waves=False, traced=bool(window), top_signals_only=True, testcase="stream_frames")
@@ -500,7 +507,7 @@ def stream(key="stream", frames=6, *, whole=False, dclk_hz=DCLK_HZ, log=print, d
          "progress_us": 2000, "report": str(report_path)}
     plusargs = _trace_plusargs(p["replay"], files)
     start = time.monotonic()
-    build = cocotb_run.run(top(the_plan, False, dmd), toplevel=TOPLEVEL, module="sim.tb.system_fast",
+    build = cocotb_run.run(top_verilog(the_plan, False, dmd), toplevel=TOPLEVEL, module="sim.tb.system_fast",
                            key=f"{_name(dmd)}-{the_plan.params.beats}beats", params=p, extra_sources=SOURCES,
                            plusargs=plusargs, waves=False, testcase="stream_new_frames", top_signals_only=True)
     stimulus = json.loads(report_path.read_text())

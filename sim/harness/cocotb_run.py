@@ -23,7 +23,7 @@ from pathlib import Path
 
 from .paths import ROOT, build_dir, slug
 
-__all__ = ["setup_verilator", "emit_verilog", "run", "params", "VERILATOR_ARGS"]
+__all__ = ["setup_verilator", "emit_verilog", "converted", "run", "params", "VERILATOR_ARGS"]
 
 #: Amaranth's Verilog is wide-and-truncate by design: width lints are noise there; a payload-less
 #: stream (``stream.Signature(0)``) becomes a ``[-1:0]`` port nobody reads. Every other warning
@@ -65,6 +65,39 @@ def emit_verilog(component, name, path=None):
     return text
 
 
+def converted(make, name, recipe):
+    """The Verilog of the component ``make()`` returns, as module ``name``, converted once for
+    every process that asks with the same ``recipe`` while the sources stay the same.
+
+    Amaranth's conversion of a whole core takes about 20 s of Python, as long as Verilator's
+    build of it; tests that run one design in several ways, and ``make sim`` then the suite,
+    convert it once. ``recipe`` (JSON-able, with ``repr`` for other values) must name everything
+    ``make`` builds from; the key adds a digest of every Python source the conversion may read
+    (``gateware/``, ``spec/``, ``sim/``) and Amaranth's version. The text is kept under
+    ``build/verilog/``, written whole (write, then rename) so that parallel workers may share it.
+    """
+    key = hashlib.sha256(json.dumps([name, recipe, _sources_digest()], default=repr).encode()).hexdigest()[:24]
+    path = build_dir("verilog") / f"{name}-{key}.v"
+    if path.exists():
+        return path.read_text()
+    text = emit_verilog(make(), name)
+    staging = path.with_name(f".{path.name}.{os.getpid()}")
+    staging.write_text(text)
+    staging.rename(path)
+    return text
+
+
+@functools.cache
+def _sources_digest():
+    """A digest of the Python sources a conversion may read, and of Amaranth's version."""
+    import amaranth
+    digest = hashlib.sha256(amaranth.__version__.encode())
+    for folder in ("gateware", "spec", "sim"):
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            digest.update(str(path.relative_to(ROOT)).encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
 def _tokens(text):
     """The Verilog's words in sorted order: with several clock domains, the order of module
     ports follows Python's string hashing and changes from one process to the next."""
@@ -100,10 +133,11 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
         slower to run than an untraced one.
     top_signals_only : bool
         Make only the top module's signals visible to the testbench, not every signal of the
-        design (cocotb's default). Verilator must then re-evaluate only the logic that depends on
-        the top's inputs when the testbench drives one (a clock edge included), not all of it:
-        several times faster on a large design, and quicker to build. The default: testbenches
-        drive and watch ports; pass False for one that must see inside.
+        design (cocotb's default), and only its ports writable (:func:`_public_ports`).
+        Verilator must then re-evaluate only the logic that depends on the top's inputs when the
+        testbench drives one (a clock edge included), not all of it: several times faster on a
+        large design, and quicker to build. The default: testbenches drive ports and watch the
+        top's signals; pass False for one that must see inside.
     run_dir : path, optional
         Where the simulation runs (its working directory, ``results.xml``, waves). Default: a
         new directory under the build's ``runs/``, removed after a passing run without waves.
@@ -125,7 +159,7 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
     if text is not None:
         files[f"{toplevel}.v"] = text
     if top_signals_only:
-        files["public.vlt"] = f'`verilator_config\npublic_flat_rw -module "{toplevel}" -var "*"\n'
+        files["public.vlt"] = _public_ports(toplevel, text)
     sources = [build / name for name in sorted(files, key=lambda n: not n.endswith(".vlt"))]
     # the runner takes the last source for the top's language: the control file goes first
     sources += [Path(p) for p in extra_sources if Path(p).suffix != ".cpp"]
@@ -148,6 +182,20 @@ def run(component, *, toplevel, module, key, params=None, testcase=None, waves=N
     if passed and run_dir is None and not waves:
         shutil.rmtree(directory, ignore_errors=True)
     return build
+
+
+def _public_ports(toplevel, text):
+    """The Verilator control file that makes the top's ports writable from the testbench and its
+    other signals readable. Only ports are writable: Verilator must re-evaluate, on every change
+    of a top input (each clock edge), the combinational logic that reads a writable signal, and
+    with every signal of the top writable that is nearly all of the design's."""
+    lines = ["`verilator_config", f'public_flat_rd -module "{toplevel}" -var "*"']
+    header = re.search(rf"^module\s+{re.escape(toplevel)}\s*\(([^)]*)\)", text or "", re.MULTILINE)
+    # an escaped identifier (``\soft``, a keyword) is named without its backslash here
+    ports = [name.strip().lstrip("\\") for name in header.group(1).split(",")] if header else ["*"]
+    # sorted: the header's order changes from one process to the next (see :func:`_tokens`)
+    lines += [f'public_flat_rw -module "{toplevel}" -var "{name}"' for name in sorted(ports) if name]
+    return "\n".join(lines) + "\n"
 
 
 def _stamp(toplevel, files, extra_sources, waves, top_signals_only, build_args=()):
