@@ -253,6 +253,13 @@ class Projector(wiring.Component):
         ]
 
         # ---- Status: what the status reply reports, carried into sync ---------------------------
+        self._report(m, ethernet, phy, store, broker, seq, registers, trim)
+        return m
+
+    def _report(self, m, ethernet, phy, store, broker, seq, registers, trim):
+        """The status reply's fields: the sequencer's, the register crossing's and the clock
+        loop's counts carried from ``dmd`` into ``sync`` (:class:`CountSynchronizer`), the store's
+        counters, the DLPC410's and the PHY's state, and the frame shown last."""
         status = ethernet.status
         report_port(m, ethernet, status, self._sync_hz)
         for name, source in (("triggers", seq.status.triggers), ("trigger_overruns", seq.status.overruns),
@@ -294,7 +301,6 @@ class Projector(wiring.Component):
             state)
         m.d.comb += status.dlpc410_state.eq(Cat(state, phy.status.up, phy.status.speed))
         m.d.comb += status.shown_frame.eq(self._shown_frame(m, broker.frames, seq))
-        return m
 
     def _shown_frame(self, m, frames, seq):
         """The frame shown last (:attr:`shown`, ``dmd``) and its id in ``sync``: the frame the
