@@ -67,6 +67,27 @@ class Requester(wiring.Component):
             "idle": Out(1),
         })
 
+    def _releases(self, m, taken, head, last_group):
+        """Slots handed back, in order: a slot is released when the last group takes its first
+        job from a newer slot (no group reads the old one again). A release is written the cycle
+        after its job is taken, so a job is taken only with room for it and one more. Returns
+        (``releasing``, ``room``)."""
+        depth = 4
+        m.submodules.releases = releases = Queue(SLOT_BITS, depth)
+        wiring.connect(m, releases.r_stream, wiring.flipped(self.release))
+        last_slot = Signal(SLOT_BITS)
+        seen_slot = Signal()
+        releasing, released = Signal(), Signal(SLOT_BITS)
+        room = Signal()
+        m.d.sync += [releasing.eq(0), room.eq(~releases.fill[depth - 3])]
+        m.d.comb += [releases.w_stream.valid.eq(releasing), releases.w_stream.payload.eq(released)]
+        leaves = (head.group == last_group) & seen_slot & (head.slot != last_slot)
+        with m.If(taken & leaves):
+            m.d.sync += [releasing.eq(1), released.eq(last_slot)]
+        with m.If(taken & (head.group == last_group)):
+            m.d.sync += [last_slot.eq(head.slot), seen_slot.eq(1)]
+        return releasing, room
+
     def elaborate(self, platform):
         m = Module()
         dmd, regs, n_groups = self._dmd, self.regs, self.n_groups
@@ -108,19 +129,6 @@ class Requester(wiring.Component):
             self.requests.payload.row_count.eq(rows_per_block),
         ]
 
-        # slots handed back, in order
-        # (a release is written the cycle after its job is taken: a job is taken only with room
-        # for it and one more)
-        depth = 4
-        m.submodules.releases = releases = Queue(SLOT_BITS, depth)
-        wiring.connect(m, releases.r_stream, wiring.flipped(self.release))
-        last_slot = Signal(SLOT_BITS)
-        seen_slot = Signal()
-        releasing, released = Signal(), Signal(SLOT_BITS)
-        room = Signal()
-        m.d.sync += [releasing.eq(0), room.eq(~releases.fill[depth - 3])]
-        m.d.comb += [releases.w_stream.valid.eq(releasing), releases.w_stream.payload.eq(released)]
-
         # in IDLE, kept in a register of its own beside the state (set as the state goes to IDLE,
         # cleared as it leaves), so that taking a job does not wait on the state's decode
         idle = Signal(init=1)
@@ -131,16 +139,11 @@ class Requester(wiring.Component):
 
         # a job is taken in IDLE
         taken = self.jobs.valid & self.jobs.ready
+        releasing, room = self._releases(m, taken, head, last_group)
         m.d.comb += self.jobs.ready.eq(idle & room & ~releasing)
-        # the last group's first load from a new slot: no group reads the old one again
-        leaves = (head.group == last_group) & seen_slot & (head.slot != last_slot)
-        with m.If(taken & leaves):
-            m.d.sync += [releasing.eq(1), released.eq(last_slot)]
         # flushing: stale jobs are dropped here, through the same slot accounting
         with m.If(taken):
             m.d.sync += [entry.eq(head), span_first.eq(head_first), span_last.eq(head_last), plane.eq(head.plane)]
-            with m.If(head.group == last_group):
-                m.d.sync += [last_slot.eq(head.slot), seen_slot.eq(1)]
 
         with m.FSM(name="requester"):
             with m.State("IDLE"):

@@ -175,6 +175,25 @@ class Parser(wiring.Component):
             m.d.comb += cause.eq(1 + causes.index("value"))
         return cause
 
+    def _needed(self, m, header):
+        """The bytes of header a record of ``header.type`` needs before it can be checked: the
+        whole record, but for an image record's pixels."""
+        needed = Signal(range(_CAPTURED + 1))
+        with m.Switch(header.type):
+            with m.Case(RecordType.IMAGE):
+                m.d.comb += needed.eq(_IMAGE_END)
+            with m.Case(RecordType.DELTA):
+                m.d.comb += needed.eq(_DELTA_END)
+            with m.Case(RecordType.CONTROL):
+                m.d.comb += needed.eq(_CONTROL_END)
+            with m.Case(RecordType.SEQUENCER):
+                m.d.comb += needed.eq(_SEQUENCER_END)
+            with m.Case(RecordType.ENTRY):
+                m.d.comb += needed.eq(_ENTRY_END)
+            with m.Default():
+                m.d.comb += needed.eq(_HEADER)
+        return needed
+
     def _pixels(self, m, header, image, delta, length, needed):
         """Where an image or delta record's pixels go: ``offset``, ``until`` (one past the last),
         and the delta's ``base`` and ``carried`` (both 0 for a whole frame's image record; a
@@ -217,22 +236,7 @@ class Parser(wiring.Component):
 
         capture(m, self.datagrams, index, captured, peer, length)
 
-        # The header each record type needs before it can be checked (the whole record, but for
-        # an image record's pixels).
-        needed = Signal(range(_CAPTURED + 1))
-        with m.Switch(header.type):
-            with m.Case(RecordType.IMAGE):
-                m.d.comb += needed.eq(_IMAGE_END)
-            with m.Case(RecordType.DELTA):
-                m.d.comb += needed.eq(_DELTA_END)
-            with m.Case(RecordType.CONTROL):
-                m.d.comb += needed.eq(_CONTROL_END)
-            with m.Case(RecordType.SEQUENCER):
-                m.d.comb += needed.eq(_SEQUENCER_END)
-            with m.Case(RecordType.ENTRY):
-                m.d.comb += needed.eq(_ENTRY_END)
-            with m.Default():
-                m.d.comb += needed.eq(_HEADER)
+        needed = self._needed(m, header)
         pixels = self._pixels(m, header, image, delta, length, needed)
         cause = self._cause(m, header, pixels, delta, control, sequencer, entry, length, needed)
         causes = self._CAUSES
