@@ -24,7 +24,7 @@ def test_underruns_count_rows_not_cycles(test_name):
     async def bench(ctx):
         ctx.set(dut.regs.row_period, R)
         ctx.set(dut.running, 1)
-        ctx.set(dut.writable, (1 << DMD.blocks) - 1)
+        ctx.set(dut.planner.writable, (1 << DMD.blocks) - 1)
         ctx.set(dut.loads.payload, {"group": 0, "mask": 1, "first": 0, "last": 0, "first_row": 0, "first_occupied": 1,
                                     "single": 0})
         ctx.set(dut.loads.valid, 1)

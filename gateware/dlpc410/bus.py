@@ -37,7 +37,7 @@ from ..counter import Counter
 from ..registers import Registers, ResetMode
 from .due import lowest_due
 from .interface import BlockMode, RowMode
-from .layouts import COUNTER_BITS, Command, dark_load, group_bits, ready_load
+from .layouts import COUNTER_BITS, Command, PulseSignature, dark_load, group_bits, ready_load
 
 __all__ = ["Bus", "DECISION_TO_PINS"]
 
@@ -67,11 +67,11 @@ class Bus(wiring.Component):
         The frame control takes a frame while waiting: the next load starts afresh.
     rst_active : In(1)
         RST_ACTIVE, synchronised: with ``strict_rst`` no pulse while it is high.
-    due, writable, frees_soon, frees_soon_clear : In(blocks); imminent, imminent_clear : In(1)
-        From the planner (registered; ``frees_soon`` includes ``writable``).
-    due_fours : In(ceil(blocks / 4))
-        Bit q: some group of ``due[4q:4q + 4]`` is due (registered with it: the lowest due group
-        is found from these without a chain over every flag).
+    planner : In(PulseSignature(blocks))
+        The planner's flags (registered; ``frees_soon`` includes ``writable``), and this cycle's
+        decision back to it: ``choice`` (bit g, a clocking pulse of group g), ``pulsing`` (some
+        bit of ``choice``) and ``loaded`` (bit g: group g's load ends this cycle, its last
+        operation's last row cycle on the pins by the next decision).
     loads : In(stream.Signature(ready_load))
         Ready loads from the requester, taken when their last operation is applied.
     darks : In(stream.Signature(dark_load))
@@ -80,15 +80,8 @@ class Bus(wiring.Component):
     beats : In(stream.Signature(bits_per_dclk * beats)); row_ready : In(1)
         Row data, one cycle's beats taken per cycle of a row cycle that loads a row; whether a
         whole row is buffered.
-    choice : Out(blocks)
-        This cycle's decision: bit g, a clocking pulse of group g.
-    pulsing : Out(1)
-        Some bit of ``choice``.
     row_started : Out(1)
         The first beat of a row is taken this cycle.
-    loaded : Out(blocks)
-        Bit g: group g's load ends this cycle (its last operation's last row cycle is on the pins
-        by the next decision).
     dvalid : Out(1); command : Out(Command); beat : Out(bits_per_dclk * beats)
         The registered pins of the row cycles.
     underruns : Out(COUNTER_BITS)
@@ -105,21 +98,12 @@ class Bus(wiring.Component):
             "hold": In(1),
             "restart": In(1),
             "rst_active": In(1),
-            "due": In(dmd.blocks),
-            "due_fours": In(-(-dmd.blocks // 4)),
-            "writable": In(dmd.blocks),
-            "frees_soon": In(dmd.blocks),
-            "frees_soon_clear": In(dmd.blocks),
-            "imminent": In(1),
-            "imminent_clear": In(1),
+            "planner": In(PulseSignature(dmd.blocks)),
             "loads": In(stream.Signature(ready_load(dmd))),
             "darks": In(stream.Signature(dark_load(dmd))),
             "beats": In(stream.Signature(dmd.bits_per_dclk * beats)),
             "row_ready": In(1),
-            "choice": Out(dmd.blocks),
-            "pulsing": Out(1),
             "row_started": Out(1),
-            "loaded": Out(dmd.blocks),
             "dvalid": Out(1),
             "command": Out(Command),
             "beat": Out(dmd.bits_per_dclk * beats),
@@ -129,12 +113,12 @@ class Bus(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         dmd, regs = self._dmd, self.regs
-        R = row_cycles(dmd, self._beats)
+        cycles_per_row = row_cycles(dmd, self._beats)
         rows_per_block = dmd.rows_per_block
-        G = dmd.blocks
+        blocks = dmd.blocks
         group_index_bits = group_bits(dmd)
-        block_index_bits = ceil_log2(G) or 1
-        clear_cycles = dmd.clear_row_cycles * R
+        block_index_bits = ceil_log2(blocks) or 1
+        clear_cycles = dmd.clear_row_cycles * cycles_per_row
 
         # after an operation is applied: cycles until the next decision may be made (the next
         # operation's pins may follow its pins back to back)
@@ -148,11 +132,11 @@ class Bus(wiring.Component):
 
         # ---- pulses: the lowest due group, if the pin allows it ----
         pin_ok = ~(regs.strict_rst & self.rst_active)
-        due, fours = self.due, self.due_fours
-        pulse_choice = Signal(G)
+        due, fours = self.planner.due, self.planner.due_fours
+        pulse_choice = Signal(blocks)
         m.d.comb += pulse_choice.eq(Mux(free & pin_ok, lowest_due(due, fours), 0))
         do_pulse = free & pin_ok & fours.any()
-        m.d.comb += [self.choice.eq(pulse_choice), self.pulsing.eq(do_pulse)]
+        m.d.comb += [self.planner.choice.eq(pulse_choice), self.planner.pulsing.eq(do_pulse)]
 
         # ---- loads: the operation at the head ----
         # (the head's first operation, or the next of a load under way: whether it loads a row
@@ -176,21 +160,21 @@ class Bus(wiring.Component):
         dark_fresh = Signal(init=1)               # the dark's first block is next
         dark_block = Signal(block_index_bits)
         cur_dark = Mux(dark_fresh, dark.first, dark_block)
-        dark_ready = self.darks.valid & self.writable.bit_select(dark.group, 1)
-        do_dark = may_op & dark_ready & ~self.imminent_clear
+        dark_ready = self.darks.valid & self.planner.writable.bit_select(dark.group, 1)
+        do_dark = may_op & dark_ready & ~self.planner.imminent_clear
         # a load operation waits while the dark's clears go first, or would wait for it (the
         # ``frees_soon`` flags include ``writable``: one choice by the dark's group, not two)
-        can_load = may_op & self.loads.valid & self.writable.bit_select(head.group, 1)
-        dark_soon = self.darks.valid & self.frees_soon.bit_select(dark.group, 1)
-        dark_soon_clear = self.darks.valid & self.frees_soon_clear.bit_select(dark.group, 1)
-        wants_row = can_load & ~self.imminent & ~dark_soon & occupied & pace.done
+        can_load = may_op & self.loads.valid & self.planner.writable.bit_select(head.group, 1)
+        dark_soon = self.darks.valid & self.planner.frees_soon.bit_select(dark.group, 1)
+        dark_soon_clear = self.darks.valid & self.planner.frees_soon_clear.bit_select(dark.group, 1)
+        wants_row = can_load & ~self.planner.imminent & ~dark_soon & occupied & pace.done
         do_row = wants_row & self.row_ready
-        do_clear = (can_load & ~self.imminent_clear & ~dark_soon_clear & ~occupied) | do_dark
+        do_clear = (can_load & ~self.planner.imminent_clear & ~dark_soon_clear & ~occupied) | do_dark
 
         # ---- the decision, registered ----
         decision = Signal(data.StructLayout({
             "pulse": 1, "pulse_group": group_index_bits, "row": 1, "clear": 1, "dark": 1, "last": 1,
-            "load_group": G, "block": block_index_bits, "row_at": 11, "fresh": 1, "starved": 1, "block_last": 1,
+            "load_group": blocks, "block": block_index_bits, "row_at": 11, "fresh": 1, "starved": 1, "block_last": 1,
             "following": block_index_bits, "following_last": 1, "following_filled": 1}))
         following = (cur_block + 1)[:block_index_bits]
         m.d.sync += [decision.pulse.eq(do_pulse), decision.pulse_group.eq(_lowest(due, fours)),
@@ -254,9 +238,9 @@ class Bus(wiring.Component):
 
         # the group's load ends on the cycle before its last operation leaves room for the next
         # decision: a two-cycle operation's now, a longer one's registered the cycle before
-        length_two = Mux(clear, clear_cycles == 2, R == 2)
-        finishing = Signal(G)                  # this group's load ends at ``remain == 1``
-        ends = Signal(G)                       # the load of this group ends next cycle
+        length_two = Mux(clear, clear_cycles == 2, cycles_per_row == 2)
+        finishing = Signal(blocks)                  # this group's load ends at ``remain == 1``
+        ends = Signal(blocks)                       # the load of this group ends next cycle
         with m.If(op & decision.last & ~length_two):
             m.d.sync += finishing.eq(decision.load_group)
         with m.If(remain == 2):
@@ -265,7 +249,7 @@ class Bus(wiring.Component):
             m.d.sync += ends.eq(0)
         with m.If(self.restart):
             m.d.sync += [finishing.eq(0), ends.eq(0)]
-        m.d.comb += self.loaded.eq(ends | Mux(op & decision.last & length_two, decision.load_group, 0))
+        m.d.comb += self.planner.loaded.eq(ends | Mux(op & decision.last & length_two, decision.load_group, 0))
 
         # ---- the command registers ----
         self._command_registers(m, decision, row, clear, remain=remain, spent=spent)
@@ -278,14 +262,14 @@ class Bus(wiring.Component):
         be made (``spent``: none)."""
         dmd, regs = self._dmd, self.regs
         op = row | clear
-        R = row_cycles(dmd, self._beats)
-        clear_cycles = dmd.clear_row_cycles * R
+        cycles_per_row = row_cycles(dmd, self._beats)
+        clear_cycles = dmd.clear_row_cycles * cycles_per_row
         # the pins' row cycle: the cycles of the row still to come, a thermometer code (bit i:
         # more than i), so that whether there are more is a register and the row's beats are
         # read through one LUT
-        row_left = Signal(R - 1)
-        more = row_left[0] if R > 1 else Const(0)
-        whole_row = (1 << (R - 1)) - 1
+        row_left = Signal(cycles_per_row - 1)
+        more = row_left[0] if cycles_per_row > 1 else Const(0)
+        whole_row = (1 << (cycles_per_row - 1)) - 1
         noops = Signal(range(dmd.clear_row_cycles))
         cmd = self.command
         op_row = Signal()                      # the row cycle on the pins loads a row
@@ -295,7 +279,7 @@ class Bus(wiring.Component):
         with m.If(remain != 0):
             m.d.sync += [remain.eq(remain - 1), spent.eq(remain == 1)]
         with m.If(decision.pulse | op):
-            length = Mux(clear, clear_cycles, R)
+            length = Mux(clear, clear_cycles, cycles_per_row)
             m.d.sync += [self.dvalid.eq(1), remain.eq(length - 2), spent.eq(length == 2), row_left.eq(whole_row),
                          op_row.eq(row), noops.eq(Mux(clear, dmd.clear_row_cycles - 1, 0)),
                          cmd.rowmd.eq(RowMode.NOOP), cmd.blkmd.eq(BlockMode.NOOP),

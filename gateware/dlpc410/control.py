@@ -106,10 +106,10 @@ class FrameControl(wiring.Component):
     def __init__(self, dmd, *, beats=1):
         self._dmd, self._beats = dmd, beats
         group_index_bits = group_bits(dmd)
-        G = dmd.blocks
+        blocks = dmd.blocks
         super().__init__({
             "regs": In(Registers),
-            "n_groups": In(range(G + 1)),
+            "n_groups": In(range(blocks + 1)),
             "all_ready": In(1),
             "trigger_ready": In(1),
             "counting": In(1),
@@ -332,7 +332,7 @@ class FrameControl(wiring.Component):
         16-bit limbs; countdowns loaded at its end (their lag the pipeline's) answer them, from
         :data:`~spec.schedule.PACE_LAG` cycles after the trigger."""
         dmd, regs = self._dmd, self.regs
-        R = row_cycles(dmd, self._beats)
+        cycles_per_row = row_cycles(dmd, self._beats)
         periodic = regs.trigger == TriggerMode.PERIODIC
 
         # the reload bound (spec.schedule.reload_cycles), from the registers: a product and two
@@ -340,7 +340,7 @@ class FrameControl(wiring.Component):
         # product from the rows' low and high bytes, the sums in limbs
         rows = flush_rows(dmd) + dmd.rows
         row_period, by_low, by_high, product = Signal(8), Signal(16), Signal(12), Signal(21)
-        m.d.sync += [row_period.eq(Mux(regs.row_period > R, regs.row_period, R)),
+        m.d.sync += [row_period.eq(Mux(regs.row_period > cycles_per_row, regs.row_period, cycles_per_row)),
                      by_low.eq(row_period * (rows & 0xFF)), by_high.eq(row_period * (rows >> 8)),
                      product.eq(Cat(by_low[:8], by_low[8:] + by_high))]
         lead, _ = pipelined_sum(m, [regs.reload_lead] * 2, lambda k: Const(reload_cycles(dmd, self._beats, 0, 0), 16),

@@ -86,8 +86,8 @@ class FrameOffer(wiring.Component):
     def _shown_depths(self, m):
         """Bit d-1 high when the order in force shows frames of d planes (registered twice), and
         whether those bits follow the registers in force yet."""
-        regs, G = self.regs, min(self._groups, MAX_GROUPS)
-        tables = group_tables(regs, G)
+        regs, groups = self.regs, min(self._groups, MAX_GROUPS)
+        tables = group_tables(regs, groups)
 
         def prefixes(table, name):
             # bit d-1: the first d entries are all below d (a permutation's prefix names 0..d-1)
@@ -97,13 +97,13 @@ class FrameOffer(wiring.Component):
             return ok
 
         own = prefixes(regs.order_table.as_value(), "table_depths")
-        each = [prefixes(tables[g], f"group{g}_depths") for g in range(G)]
+        each = [prefixes(tables[g], f"group{g}_depths") for g in range(groups)]
         shown = Signal(8)
         with m.Switch(regs.order):
             with m.Case(PlaneOrder.TABLE):
                 m.d.sync += shown.eq(own)
             with m.Case(PlaneOrder.GROUPS):
-                m.d.sync += shown.eq(Cat(Cat(~self.active[g] | each[g][d] for g in range(G)).all()
+                m.d.sync += shown.eq(Cat(Cat(~self.active[g] | each[g][d] for g in range(groups)).all()
                                          for d in range(8)))
             with m.Default():
                 m.d.sync += shown.eq(0xFF)

@@ -56,22 +56,22 @@ class GroupFrames(wiring.Component):
 
     def __init__(self, dmd):
         self._dmd = dmd
-        G = dmd.blocks
+        blocks = dmd.blocks
         super().__init__({
-            "frame": Out(data.ArrayLayout(FRAME, G)),
+            "frame": Out(data.ArrayLayout(FRAME, blocks)),
             "next": Out(FRAME),
             "offered": In(FRAME),
             "take": In(1),
             "coming": Out(FRAME),
-            "advance": In(G),
-            "active": In(G),
-            "first": Out(G),
+            "advance": In(blocks),
+            "active": In(blocks),
+            "first": Out(blocks),
             "every": In(event(FRAME)),
         })
 
     def elaborate(self, platform):
         m = Module()
-        G = self._dmd.blocks
+        blocks = self._dmd.blocks
         next_frame = Signal(FRAME)
         m.d.comb += [self.next.eq(next_frame),
                      self.coming.eq(Mux(self.take, self.offered.as_value(), next_frame.as_value()))]
@@ -80,19 +80,19 @@ class GroupFrames(wiring.Component):
             kept = self.frame[g]
             return [kept.slot.eq(frame.slot), kept.depth.eq(frame.depth), kept.low_plane.eq(frame.low_plane),
                     *(kept.showing[name].eq(frame.showing[name]) for name in _KEPT)]
-        for g in range(G):
+        for g in range(blocks):
             with m.If(self.advance[g]):
                 m.d.sync += give(g, self.coming)
         with m.If(self.take):
             m.d.sync += next_frame.eq(self.offered)
         # groups still showing the frame before ``next``: set for the others when one leads
-        behind = Signal(G)
+        behind = Signal(blocks)
         led = (self.advance & ~behind).any()
         m.d.comb += self.first.eq(~behind)
-        for g in range(G):
+        for g in range(blocks):
             m.d.sync += behind[g].eq(~self.every.valid & ~self.advance[g] & Mux(led, self.active[g], behind[g]))
         with m.If(self.every.valid):
             m.d.sync += next_frame.eq(self.every.payload)
-            for g in range(G):
+            for g in range(blocks):
                 m.d.sync += give(g, self.every.payload)
         return m

@@ -104,16 +104,16 @@ class GroupTimes(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        regs, G = self.regs, self._dmd.blocks
+        regs, blocks = self.regs, self._dmd.blocks
         # each group's first pulse after the time of those at once: ``g * stagger`` (chained) or
         # its offset (registered: the registers, and so ``active``, hold still long before a
         # trigger is obeyed)
         offsets, stagger_zero = Signal(), Signal()
-        firsts = [Signal(24, name=f"first{g}") for g in range(G)]      # (group 0's: its offset)
+        firsts = [Signal(24, name=f"first{g}") for g in range(blocks)]      # (group 0's: its offset)
         m.d.sync += [offsets.eq(regs.order == PlaneOrder.GROUPS), stagger_zero.eq(regs.stagger == 0)]
         m.d.sync += [first.eq(Mux(offsets, regs.group_offsets[g], regs.stagger)) for g, first in enumerate(firsts)]
         # the groups a trigger obeyed times at once, and those it chains
-        at_once, chains = self.at_once, Signal(G)
+        at_once, chains = self.at_once, Signal(blocks)
         # (group 0 at once unless GROUPS offsets it: its offset is the least,
         # :func:`spec.records.register_faults`)
         unchained = Cat(Mux(offsets, first == 0, stagger_zero if g else 1) for g, first in enumerate(firsts))
@@ -127,9 +127,9 @@ class GroupTimes(wiring.Component):
         # out ahead (each group's delay, as it is set)
         m.submodules.rst_any = rst_any = Countdown(16, lag=LAG, within=(2,), flags="settled")
         m.d.comb += [rst_any.load.eq(self.pulse_any), rst_any.value.eq(regs.t_rst)]
-        chained = [Signal(name=f"chained{g}") for g in range(G)]
+        chained = [Signal(name=f"chained{g}") for g in range(blocks)]
         pulse_cds = []
-        for g in range(G):
+        for g in range(blocks):
             pulse_cd = Countdown(DURATION_BITS, lag=LAG, slack=1, within=(2, self._soon, self._soon_clear),
                                  flags="given")
             rst_cd = Countdown(16, lag=LAG, slack=1, within=(2,), flags="settled")

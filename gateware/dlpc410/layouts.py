@@ -6,7 +6,8 @@ offered), for example a clocking pulse made this cycle.
 """
 
 from amaranth import Const, Mux
-from amaranth.lib import data, stream
+from amaranth.lib import data, stream, wiring
+from amaranth.lib.wiring import In, Out
 from amaranth.utils import ceil_log2
 
 from ..registers import TIME_BITS, ResetMode
@@ -14,7 +15,7 @@ from ..store.layouts import COUNTER_BITS, SLOT_BITS
 from .interface import BlockMode, RowMode
 
 __all__ = ["group_bits", "block_bits", "group_span", "load_job", "ready_load", "dark_load", "event", "Command",
-           "Status", "COUNTER_BITS"]
+           "Status", "PulseSignature", "COUNTER_BITS"]
 
 
 def group_bits(dmd):
@@ -103,3 +104,53 @@ class Status(data.Struct):
     rst_longest: COUNTER_BITS
     period_short: COUNTER_BITS
     after_end: COUNTER_BITS
+
+
+class PulseSignature(wiring.Signature):
+    """The planner's flags to the bus and the bus's decision back, seen from the planner: each
+    cycle the bus decides from the flags (registered by the planner) whether a group pulses,
+    and the planner learns the decision and the loads that ended in the same cycle.
+
+    Members
+    -------
+    due : Out(blocks)
+        Bit g: group g is loaded, its pulse time has come and RST_ACTIVE's countdown allows it
+        (the pin's own check is the bus's).
+    due_fours : Out(ceil(blocks / 4))
+        Bit q: some group of ``due[4q:4q + 4]`` is due: the bus finds the lowest due group from
+        these without a chain over every flag.
+    imminent, imminent_clear : Out(1)
+        A loaded group's pulse falls due within a row, within a clear (and its no-op rows).
+    writable : Out(blocks)
+        Bit g: group g's memory may change (its settle time is over, counted from its pulse and
+        from RST_ACTIVE's fall, and the frame control's lead).
+    frees_soon, frees_soon_clear : Out(blocks)
+        Bit g: group g's memory may change (``writable``), or its RST_ACTIVE count is over and its
+        memory frees within a row, within a clear (and its no-op rows): a load operation would
+        hold up its dark pulse's clears.
+    choice : In(blocks)
+        The bus's decision this cycle: bit g, a clocking pulse of group g (one bit at most).
+    pulsing : In(1)
+        Some bit of ``choice``.
+    loaded : In(blocks)
+        Bit g: group g's load ends this cycle (its last operation's last row cycle is on the pins
+        by the next decision).
+    """
+
+    def __init__(self, blocks):
+        self._blocks = blocks
+        super().__init__({
+            "due": Out(blocks),
+            "due_fours": Out(-(-blocks // 4)),
+            "imminent": Out(1),
+            "imminent_clear": Out(1),
+            "writable": Out(blocks),
+            "frees_soon": Out(blocks),
+            "frees_soon_clear": Out(blocks),
+            "choice": In(blocks),
+            "pulsing": In(1),
+            "loaded": In(blocks),
+        })
+
+    def __eq__(self, other):
+        return isinstance(other, PulseSignature) and other._blocks == self._blocks

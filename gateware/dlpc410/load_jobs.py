@@ -45,14 +45,14 @@ class LoadJobs(wiring.Component):
 
     def __init__(self, dmd):
         self._dmd = dmd
-        G = dmd.blocks
+        blocks = dmd.blocks
         super().__init__({
             "regs": In(Registers),
-            "pulse": In(G),
+            "pulse": In(blocks),
             "pulse_any": In(1),
-            "pos": In(data.ArrayLayout(3, G)),
-            "dark": In(G),
-            "frame": In(data.ArrayLayout(FRAME, G)),
+            "pos": In(data.ArrayLayout(3, blocks)),
+            "dark": In(blocks),
+            "frame": In(data.ArrayLayout(FRAME, blocks)),
             "queue_first": In(event(group_bits(dmd))),
             "next": In(FRAME),
             "jobs": Out(event(load_job(dmd))),
@@ -61,15 +61,15 @@ class LoadJobs(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        dmd, G, group_index_bits = self._dmd, self._dmd.blocks, group_bits(self._dmd)
+        dmd, blocks, group_index_bits = self._dmd, self._dmd.blocks, group_bits(self._dmd)
         job = Signal(load_job(dmd))
         low_plane = Signal(3)                  # the job's frame's lowest stored plane
         table = Signal(24)                     # the job's group's order table (GROUPS)
-        tables = group_tables(self.regs, G)
+        tables = group_tables(self.regs, blocks)
         pulsed, group, formed = Signal(), Signal(group_index_bits), Signal()
         m.d.sync += [pulsed.eq(self.pulse_any),
                      # the pulsed group's index, bit by bit
-                     group.eq(Cat(Cat(self.pulse[g] for g in range(G) if g >> b & 1).any()
+                     group.eq(Cat(Cat(self.pulse[g] for g in range(blocks) if g >> b & 1).any()
                                   for b in range(group_index_bits))),
                      formed.eq(pulsed | self.queue_first.valid)]
         with m.If(pulsed):

@@ -60,35 +60,35 @@ class PlaneInfo(wiring.Component):
 
     def __init__(self, dmd):
         self._dmd = dmd
-        G = dmd.blocks
+        blocks = dmd.blocks
         super().__init__({
             "regs": In(Registers),
-            "pos": In(data.ArrayLayout(3, G)),
-            "dark": In(G),
-            "frame": In(data.ArrayLayout(FRAME, G)),
-            "changed": In(G),
-            "last": Out(G),
-            "big": Out(G),
-            "keeps_dark": Out(G),
-            "delay": Out(data.ArrayLayout(DURATION_BITS, G)),
-            "fresh": Out(G),
+            "pos": In(data.ArrayLayout(3, blocks)),
+            "dark": In(blocks),
+            "frame": In(data.ArrayLayout(FRAME, blocks)),
+            "changed": In(blocks),
+            "last": Out(blocks),
+            "big": Out(blocks),
+            "keeps_dark": Out(blocks),
+            "delay": Out(data.ArrayLayout(DURATION_BITS, blocks)),
+            "fresh": Out(blocks),
         })
 
     def elaborate(self, platform):
         m = Module()
-        regs, G = self.regs, self._dmd.blocks
+        regs, blocks = self.regs, self._dmd.blocks
         frame = FRAME
 
         # one group a cycle, in turn
-        turn = Signal(range(G))
-        m.d.sync += turn.eq(Mux(turn == G - 1, 0, turn + 1))
+        turn = Signal(range(blocks))
+        m.d.sync += turn.eq(Mux(turn == blocks - 1, 0, turn + 1))
         # each stage's group and whether its state is still the group's: a change applied on a
         # cycle (seen registered, the cycle after) makes every stage of that group stale that
         # read its state then or before (stages 0-5; the answers are kept from stage 5, STAGES
         # cycles after the state was read, unless the group changes on that cycle too)
-        tags = [Signal(range(G), name=f"tag{k}") for k in range(STAGES - 1)]
+        tags = [Signal(range(blocks), name=f"tag{k}") for k in range(STAGES - 1)]
         valid = [Signal(name=f"valid{k}") for k in range(STAGES - 1)]
-        changed = Signal(G)
+        changed = Signal(blocks)
         m.d.sync += changed.eq(self.changed)
         changed = Array(changed)
 
@@ -100,7 +100,7 @@ class PlaneInfo(wiring.Component):
         pos, dark, depth = Signal(3), Signal(), Signal(4)
         show = Signal(data.Layout.cast(frame)["showing"].shape)
         table = Signal(24)
-        m.d.sync += [tags[0].eq(turn), valid[0].eq(1), table.eq(group_tables(regs, G)[turn]),
+        m.d.sync += [tags[0].eq(turn), valid[0].eq(1), table.eq(group_tables(regs, blocks)[turn]),
                      pos.eq(Array(self.pos)[turn]), dark.eq(self.dark.bit_select(turn, 1)),
                      depth.eq(Array(f.depth for f in self.frame)[turn]),
                      show.eq(Array(f.showing for f in self.frame)[turn])]
@@ -147,7 +147,7 @@ class PlaneInfo(wiring.Component):
 
         # 5: the answers (and the group they are for, one-hot: each group's keep is one LUT)
         advance(5)
-        hot = Signal(G)
+        hot = Signal(blocks)
         m.d.sync += hot.eq(1 << tags[4])
         big, last4, nodark4 = Signal(), Signal(), Signal()
         delay = Signal(DURATION_BITS)
@@ -156,7 +156,7 @@ class PlaneInfo(wiring.Component):
                                   plane3))]
 
         # kept per group
-        for g in range(G):
+        for g in range(blocks):
             with m.If(valid[-1] & hot[g] & ~changed[g]):
                 m.d.sync += [self.last[g].eq(last4), self.big[g].eq(big), self.keeps_dark[g].eq(nodark4),
                              self.delay[g].eq(delay), self.fresh[g].eq(1)]

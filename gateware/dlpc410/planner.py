@@ -32,7 +32,7 @@ from .due import fours_of, lowest_due_has
 from .frame_offer import FrameOffer, Offer
 from .group_frames import GroupFrames
 from .group_times import GroupTimes
-from .layouts import COUNTER_BITS, event, group_bits, load_job
+from .layouts import COUNTER_BITS, PulseSignature, event, group_bits, load_job
 from .load_jobs import LoadJobs
 from .plane_info import PlaneInfo
 from .reset_watch import ResetWatch
@@ -71,12 +71,10 @@ class Planner(wiring.Component):
         (:data:`spec.schedule.OFFER_LAG`), for the frame control: ``valid`` unless a group's take
         of it is answered now (a start or retake the frame control applies now is its own to
         count in).
-    choice : In(blocks)
-        The bus's decision this cycle: bit g, a pulse of group g (one bit at most).
-    pulsing : In(1)
-        Some bit of ``choice``.
-    loaded : In(blocks)
-        Bit g: the bus ends group g's load this cycle.
+    bus : Out(PulseSignature(blocks))
+        To the bus, registered: which groups are due, may be written, free soon, and whether a
+        pulse is imminent; back from it: this cycle's decision (``choice``, ``pulsing``) and the
+        loads that end (``loaded``).
     start : In(event(START))
         Every group begins the frame ``slot`` of ``depth`` planes from stored plane ``low_plane``,
         shown as ``showing`` says, at its first plane; ``take``: that frame is the one offered.
@@ -94,21 +92,6 @@ class Planner(wiring.Component):
         loads' wait after initialisation).
     jobs : Out(event(load_job))
         Load jobs, in the order of the pulses that freed the groups (the queue always has room).
-    due : Out(blocks)
-        Bit g (registered): group g is loaded, its pulse time has come and RST_ACTIVE's countdown
-        allows it (the pin's own check is the bus's).
-    due_fours : Out(ceil(blocks / 4))
-        Bit q: some group of ``due[4q:4q + 4]`` is due (registered with it).
-    imminent, imminent_clear : Out(1)
-        (registered) A loaded group's pulse falls due within a row, within a clear (and its no-op
-        rows), decided now.
-    writable : Out(blocks)
-        Bit g (registered): group g's memory may change (its settle time is over, counted from
-        its pulse and from RST_ACTIVE's fall, and the frame control's lead).
-    frees_soon, frees_soon_clear : Out(blocks)
-        Bit g (registered): group g's memory may change (``writable``), or its RST_ACTIVE count
-        is over and its memory frees within a row, within a clear (and its no-op rows), decided
-        now: a load operation would hold up its dark pulse's clears.
     pending, holds : Out(blocks)
         Bit g: group g plays a frame; is loaded with the plane (or dark) its next pulse shows.
     all_ready : Out(1)
@@ -149,33 +132,24 @@ class Planner(wiring.Component):
 
     def __init__(self, dmd, *, beats=1):
         self._dmd, self._beats = dmd, beats
-        G = dmd.blocks
+        blocks = dmd.blocks
         gb = group_bits(dmd)
         super().__init__({
             "regs": In(Registers),
-            "active": In(G),
+            "active": In(blocks),
             "rst_active": In(1),
             "reload": In(1),
             "frames": In(stream.Signature(FrameInfo)),
             "offer": Out(Offer),
-            "choice": In(G),
-            "pulsing": In(1),
-            "loaded": In(G),
+            "bus": Out(PulseSignature(blocks)),
             "start": In(event(START)),
             "retake": In(event(data.StructLayout({"newer": 1, "abandon": 1}))),
             "trigger": In(1),
             "queue_first": In(event(gb)),
             "lead_over": In(1),
             "jobs": Out(event(load_job(dmd))),
-            "due": Out(G),
-            "due_fours": Out(-(-G // 4)),
-            "imminent": Out(1),
-            "imminent_clear": Out(1),
-            "writable": Out(G),
-            "frees_soon": Out(G),
-            "frees_soon_clear": Out(G),
-            "pending": Out(G),
-            "holds": Out(G),
+            "pending": Out(blocks),
+            "holds": Out(blocks),
             "all_ready": Out(1),
             "trigger_ready": Out(1),
             "job_due": Out(1),
@@ -197,23 +171,24 @@ class Planner(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         dmd, regs = self._dmd, self.regs
-        R = row_cycles(dmd, self._beats)
-        G = dmd.blocks
+        cycles_per_row = row_cycles(dmd, self._beats)
+        blocks = dmd.blocks
         use_prng = regs.source == Source.PRNG
         active = self.active
 
-        pending, loaded, dark = self.pending, self.holds, Signal(G)
-        pos = [Signal(3, name=f"pos{g}") for g in range(G)]
+        pending, loaded, dark = self.pending, self.holds, Signal(blocks)
+        pos = [Signal(3, name=f"pos{g}") for g in range(blocks)]
         m.submodules.frames = frames = GroupFrames(dmd)
         m.d.comb += frames.active.eq(active)
         m.submodules.info = info = PlaneInfo(dmd)
-        m.submodules.times = times = GroupTimes(dmd, soon=R, soon_clear=dmd.clear_row_cycles * R)
+        m.submodules.times = times = GroupTimes(dmd, soon=cycles_per_row,
+                                                soon_clear=dmd.clear_row_cycles * cycles_per_row)
         m.submodules.reset_watch = watch = ResetWatch(dmd)
         m.d.comb += [info.regs.eq(regs), times.regs.eq(regs), watch.regs.eq(regs),
                      watch.rst_active.eq(self.rst_active), times.active.eq(active),
                      self.rst_late.eq(watch.late), self.rst_faults.eq(watch.faults),
                      self.rst_longest.eq(watch.longest)]
-        for g in range(G):
+        for g in range(blocks):
             m.d.comb += [info.pos[g].eq(pos[g]), info.frame[g].eq(frames.frame[g]),
                          times.delay[g].eq(info.delay[g])]
         m.d.comb += info.dark.eq(dark)
@@ -222,7 +197,7 @@ class Planner(wiring.Component):
                      self.lsb.eq(first.showing.lsb_or(regs.lsb))]
 
         # ---- the frame offered: taken by a group (last cycle), or by a start or retake now ----
-        m.submodules.offers = offers = FrameOffer(G)
+        m.submodules.offers = offers = FrameOffer(blocks)
         wiring.connect(m, wiring.flipped(self.frames), offers.frames)
         m.d.comb += [offers.regs.eq(regs), offers.active.eq(active), offers.reload.eq(self.reload)]
         taking = Signal()                      # a group took the offered frame last cycle
@@ -235,45 +210,45 @@ class Planner(wiring.Component):
                      frames.offered.showing.eq(offers.offer.showing)]
 
         # ---- the decision: what the pulse the bus chooses does (registered) ----
-        P = self.choice
+        pulse = self.bus.choice
         usable = offers.offer.valid & ~use_prng
         # (the first group to move on to a new frame takes the one offered: ``frames.first``)
         hidden, final, takes = self._outcomes(
             m, info, frames, dark, usable, frames.first)
-        decided = Signal(G)                    # the pulse decided last cycle, applied now
+        decided = Signal(blocks)                    # the pulse decided last cycle, applied now
         decided_any = Signal()
         moves, ends_play, take, starts, camera, ends_seq, late_now = (
-            Signal(G), Signal(G), Signal(), Signal(), Signal(), Signal(), Signal(G))
-        ends_fours = Signal(-(-G // 4))        # bit q: some bit of ``ends_play[4q:4q + 4]``
+            Signal(blocks), Signal(blocks), Signal(), Signal(), Signal(), Signal(), Signal(blocks))
+        ends_fours = Signal(-(-blocks // 4))        # bit q: some bit of ``ends_play[4q:4q + 4]``
         ends_any = ends_fours.any()
         first_plane = ~dark[0] & (pos[0] == 0)
-        ending = P & final                     # the pulse decided ends its group's play
+        ending = pulse & final                     # the pulse decided ends its group's play
         m.d.sync += [
-            decided.eq(P), decided_any.eq(self.pulsing),
+            decided.eq(pulse), decided_any.eq(self.bus.pulsing),
             # (read only with ``decided``: no need to wait for the choice)
             moves.eq(dark | hidden),
             ends_play.eq(ending),
             # (by fours: whether the pulse applied ends a play is then no OR over every group)
             ends_fours.eq(fours_of(ending)),
             # (the bus pulses the lowest due group: whether that group takes is asked of the due
-            # flags themselves, the bus's gating added last, a shallower path than through P)
-            take.eq(self.pulsing & usable & lowest_due_has(self.due, self.due_fours, takes)),
-            starts.eq(P[0] & first_plane),
-            camera.eq(P[0] & first_plane & ~first.showing.camera_off),
-            ends_seq.eq(P[0] & first_plane & first.showing.last),
+            # flags themselves, the bus's gating added last, a shallower path than through pulse)
+            take.eq(self.bus.pulsing & usable & lowest_due_has(self.bus.due, self.bus.due_fours, takes)),
+            starts.eq(pulse[0] & first_plane),
+            camera.eq(pulse[0] & first_plane & ~first.showing.camera_off),
+            ends_seq.eq(pulse[0] & first_plane & first.showing.last),
             late_now.eq(times.late),
         ]
         m.d.comb += taking.eq(take)
 
         # ---- the pulse, applied (a load that ends now first) ----
-        ev = self.loaded
-        m.d.sync += loaded.eq(loaded | ev)
+        load_ends = self.bus.loaded
+        m.d.sync += loaded.eq(loaded | load_ends)
         every = frames.every
         m.d.comb += [frames.take.eq(take), times.pulse.eq(decided), times.pulse_any.eq(decided_any),
                      watch.pulse.eq(decided), watch.pulse_any.eq(decided_any),
-                     info.changed.eq(decided | Mux(every.valid, (1 << G) - 1, 0)),
+                     info.changed.eq(decided | Mux(every.valid, (1 << blocks) - 1, 0)),
                      self.frame_start.eq(starts), self.camera_start.eq(camera)]
-        for g in range(G):
+        for g in range(blocks):
             with m.If(decided[g]):
                 m.d.sync += loaded[g].eq(0)
                 with m.If(moves[g]):
@@ -303,7 +278,7 @@ class Planner(wiring.Component):
         wiring.connect(m, jobs.jobs, wiring.flipped(self.jobs))
         m.d.comb += [jobs.regs.eq(regs), jobs.pulse.eq(decided), jobs.pulse_any.eq(decided_any),
                      jobs.dark.eq(dark), jobs.next.eq(frames.next)]
-        for g in range(G):
+        for g in range(blocks):
             m.d.comb += [jobs.pos[g].eq(pos[g]), jobs.frame[g].eq(frames.frame[g])]
 
         # ---- the frame control's events ----
@@ -311,7 +286,7 @@ class Planner(wiring.Component):
             begin = self.start.payload
             m.d.comb += [every.valid.eq(1), every.payload.slot.eq(begin.slot), every.payload.depth.eq(begin.depth),
                          every.payload.low_plane.eq(begin.low_plane), every.payload.showing.eq(begin.showing)]
-            m.d.sync += [ended.eq(0), dark.eq(0)] + [pos[g].eq(0) for g in range(G)]
+            m.d.sync += [ended.eq(0), dark.eq(0)] + [pos[g].eq(0) for g in range(blocks)]
         abandon = self.retake.valid & self.retake.payload.abandon
         with m.If(self.retake.valid):
             newer = self.retake.payload.newer
@@ -321,11 +296,11 @@ class Planner(wiring.Component):
                          every.payload.eq(Mux(newer, frames.offered.as_value(), frames.next.as_value()))]
             m.d.sync += loaded.eq(0)
             with m.If(abandon):
-                m.d.sync += [dark.eq(0), self.sync_out.eq(0)] + [pos[g].eq(0) for g in range(G)]
+                m.d.sync += [dark.eq(0), self.sync_out.eq(0)] + [pos[g].eq(0) for g in range(blocks)]
         m.d.comb += [times.obey.eq(self.trigger), times.abandon.eq(abandon)]
         # (a trigger sets the groups of the mode playing; the registers change only while none
         # plays, so no group outside the mode ever plays)
-        pending_next = Signal(G)
+        pending_next = Signal(blocks)
         m.d.comb += pending_next.eq(Mux(self.trigger, pending | active, Mux(abandon, 0, pending & ~ends_play)))
         m.d.sync += pending.eq(pending_next)
 
@@ -348,14 +323,14 @@ class Planner(wiring.Component):
         trigger in GROUPS, group 0 alone loaded, and RST_ACTIVE allowing its pulse (the others'
         last pulses may be recent), if its offset leaves the bus time to end what it does when
         the trigger comes (else every group, the bus idle). ``decided``: the pulse applied now."""
-        G, active, regs = self._dmd.blocks, self.active, self.regs
-        pending, loaded, ev = self.pending, self.holds, self.loaded
+        blocks, active, regs = self._dmd.blocks, self.active, self.regs
+        pending, loaded, load_ends = self.pending, self.holds, self.bus.loaded
         waits = ~self.trigger & ~self.retake.valid & (~active | (~pending & ~decided)).all()
         groups = Signal()               # (the registers hold still long before a trigger)
         m.d.sync += groups.eq((regs.order == PlaneOrder.GROUPS) & (regs.group_offsets[0] != 0))
-        spared = Mux(groups, ((1 << G) - 1) & ~1, 0)
-        m.d.sync += [self.all_ready.eq(waits & (~active | loaded | ev).all()),
-                     self.trigger_ready.eq(waits & (~active | loaded | ev | spared).all()
+        spared = Mux(groups, ((1 << blocks) - 1) & ~1, 0)
+        m.d.sync += [self.all_ready.eq(waits & (~active | loaded | load_ends).all()),
+                     self.trigger_ready.eq(waits & (~active | loaded | load_ends | spared).all()
                                            & (~groups | times.rst_over[0]))]
 
     def _playing(self, m, abandon, ends_any):
@@ -366,34 +341,35 @@ class Planner(wiring.Component):
         a pulse that ends its group's play (``ends_any``; one pulse at a time, of a group that
         plays) one fewer. Some group plays if two do, or if one does and the pulse applied now
         does not end its play."""
-        G = self._dmd.blocks
-        plays = Signal(G)                      # bit i: more than i groups play
+        blocks = self._dmd.blocks
+        plays = Signal(blocks)                      # bit i: more than i groups play
         m.d.sync += plays.eq(Mux(self.trigger, self.active, Mux(abandon, 0, Mux(ends_any, plays >> 1, plays))))
-        return (plays[1] if G > 1 else 0) | (plays[0] & ~ends_any)
+        return (plays[1] if blocks > 1 else 0) | (plays[0] & ~ends_any)
 
     def _bus_flags(self, m, times, info, watch, decided):
         """The flags the bus decides from next cycle, registered: ``due``, ``imminent``,
         ``imminent_clear``, ``writable``, ``frees_soon`` (group by group, each one function of its group's
         registered state and its ``times``, ``info`` and ``watch`` flags; ``decided``: the pulse
         applied now)."""
-        G, active = self._dmd.blocks, self.active
-        pending, loaded, ev = self.pending, self.holds, self.loaded
-        armed = active & pending & ~decided & (loaded | ev)
+        blocks, active = self._dmd.blocks, self.active
+        pending, loaded, load_ends = self.pending, self.holds, self.bus.loaded
+        armed = active & pending & ~decided & (loaded | load_ends)
         ready_now = times.rst_over & info.fresh
-        due = Signal(G)
+        due = Signal(blocks)
         m.d.comb += due.eq((armed & times.due & ready_now)
-                           | Mux(self.trigger, times.at_once & (loaded | ev) & ready_now, 0))
+                           | Mux(self.trigger, times.at_once & (loaded | load_ends) & ready_now, 0))
         # (and none in the cycle a retake is applied: the lead's countdown loads then)
-        writable = times.settled & watch.free & ~decided & Mux(self.lead_over & ~self.retake.valid, (1 << G) - 1, 0)
+        writable = (times.settled & watch.free & ~decided
+                    & Mux(self.lead_over & ~self.retake.valid, (1 << blocks) - 1, 0))
         m.d.sync += [
-            self.due.eq(due), self.due_fours.eq(fours_of(due)),
-            self.imminent.eq((armed & times.soon).any()),
-            self.imminent_clear.eq((armed & times.soon_clear).any()),
-            self.writable.eq(writable),
+            self.bus.due.eq(due), self.bus.due_fours.eq(fours_of(due)),
+            self.bus.imminent.eq((armed & times.soon).any()),
+            self.bus.imminent_clear.eq((armed & times.soon_clear).any()),
+            self.bus.writable.eq(writable),
             # (writable too: the bus then asks one flag whether the dark's clears go first or
             # are about to)
-            self.frees_soon.eq(writable | (times.frees_soon & ~decided)),
-            self.frees_soon_clear.eq(writable | (times.frees_soon_clear & ~decided)),
+            self.bus.frees_soon.eq(writable | (times.frees_soon & ~decided)),
+            self.bus.frees_soon_clear.eq(writable | (times.frees_soon_clear & ~decided)),
         ]
 
     def _outcomes(self, m, info, frames, dark, usable, first):
@@ -403,11 +379,11 @@ class Planner(wiring.Component):
         to a new frame): bit g of ``takes``, at its frame's last dark pulse, or at a last plane
         that hides the next frame's first if the frame offered follows (one lookup by the
         lowest due group, not two)."""
-        regs, G = self.regs, self._dmd.blocks
+        regs, blocks = self.regs, self._dmd.blocks
         offered_follow = self.offer.showing.follow
-        hidden, final, takes = Signal(G), Signal(G), Signal(G)
+        hidden, final, takes = Signal(blocks), Signal(blocks), Signal(blocks)
         followed = regs.chain | offered_follow
-        for g in range(G):
+        for g in range(blocks):
             # the frame after this one starts without a trigger: chained, or it follows (the
             # first group to move on takes the one offered, if any); never after a sequence's
             # last frame

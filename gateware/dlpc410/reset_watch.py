@@ -94,7 +94,7 @@ class ResetWatch(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        regs, G = self.regs, self._dmd.blocks
+        regs, blocks = self.regs, self._dmd.blocks
         pulsed = self.pulse_any
 
         # the planned fall (t_rst after the pulse's decision), and t_rst + t_settle past it
@@ -114,12 +114,12 @@ class ResetWatch(wiring.Component):
             m.d.sync += stage.eq(2)
         overdue = (stage == 2) & past_settle.done
 
-        phase = [Signal(Phase, name=f"phase{g}") for g in range(G)]
+        phase = [Signal(Phase, name=f"phase{g}") for g in range(blocks)]
         # cycles after a group's pulse in which RST_ACTIVE still shows the pins before it
-        blind = [Signal(range(BLIND + 1), name=f"blind{g}") for g in range(G)]
+        blind = [Signal(range(BLIND + 1), name=f"blind{g}") for g in range(blocks)]
         high = self.rst_active
-        missing, stuck = Signal(G), Signal(G)
-        for g in range(G):
+        missing, stuck = Signal(blocks), Signal(blocks)
+        for g in range(blocks):
             waits = (phase[g] == Phase.FALL) | (phase[g] == Phase.STUCK)
             falls = waits & ~high
             # the settle time from the fall, dated FALL_LATENCY cycles before it is seen
@@ -155,7 +155,7 @@ class ResetWatch(wiring.Component):
 
         # the counters take registered events: one cycle late, as every status count may be
         falls_any = ~high & Cat((p == Phase.FALL) | (p == Phase.STUCK) for p in phase).any()
-        fell, faulty, fault = Signal(), Signal(G), Signal()
+        fell, faulty, fault = Signal(), Signal(blocks), Signal()
         m.d.sync += [fell.eq(falls_any), faulty.eq(missing | stuck), fault.eq(faulty.any())]
         # the fall is late when, at the cycle it is dated (FALL_LATENCY before it was seen), the
         # planned fall had passed: the flag of then, a cycle more for the registered event

@@ -76,13 +76,13 @@ class RowSource(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         dmd = self._dmd
-        R = row_cycles(dmd, self._beats)
+        cycles_per_row = row_cycles(dmd, self._beats)
         width = dmd.bits_per_dclk * self._beats
         wpc = width // 64                      # words per cycle
         use_prng = self.regs.source == Source.PRNG
 
         m.submodules.prng = prng = Prng(words=wpc)
-        m.submodules.fifo = buffer = Queue(width, depth=WORD_FIFO_ROWS * R)
+        m.submodules.fifo = buffer = Queue(width, depth=WORD_FIFO_ROWS * cycles_per_row)
         m.d.comb += [prng.seed.eq(self.seed), prng.reseed.eq(self.reseed)]
         transfers = wpc // self._store_words   # store transfers per cycle of the row
         if transfers == 1:
@@ -101,12 +101,12 @@ class RowSource(wiring.Component):
                     m.d.sync += held[count].eq(self.words.payload)
 
         out = buffer.r_stream
-        # owed: rows asked of the store, less the rows taken (``R`` beats take a row), counted
+        # owed: rows asked of the store, less the rows taken (``cycles_per_row`` beats take a row), counted
         # apart (a request's rows, a row) and compared
         # (both wrap; at most ``rows`` are owed at a time)
         rows = (dmd.blocks + 2) * dmd.rows_per_block
         asked, taken_rows = Signal(ceil_log2(rows) + 1), Signal(ceil_log2(rows) + 1)
-        beat = Signal(range(R))
+        beat = Signal(range(cycles_per_row))
         taken = out.ready & out.valid & ~use_prng
         discard = self.flushing & ~self.beats.ready & ~self.drained
         m.d.comb += [
@@ -121,19 +121,19 @@ class RowSource(wiring.Component):
         # least). A beat arriving now is readable by then. The flag is chosen among four
         # comparisons of ``free`` with constants, so that no sum lies on its path.
         arriving = buffer.w_stream.valid & buffer.w_stream.ready
-        free = Signal(range(WORD_FIFO_ROWS * R + 1))
+        free = Signal(range(WORD_FIFO_ROWS * cycles_per_row + 1))
         with m.If(self.flushing | use_prng):
             m.d.sync += free.eq(0)             # (the words owed are discarded as they arrive)
         with m.Else():
-            m.d.sync += free.eq(free + arriving - Mux(self.row_started, R, 0))
-        enough = Mux(self.row_started, Mux(arriving, free >= 2 * R - 1, free >= 2 * R),
-                     Mux(arriving, free >= R - 1, free >= R))
+            m.d.sync += free.eq(free + arriving - Mux(self.row_started, cycles_per_row, 0))
+        enough = Mux(self.row_started, Mux(arriving, free >= 2 * cycles_per_row - 1, free >= 2 * cycles_per_row),
+                     Mux(arriving, free >= cycles_per_row - 1, free >= cycles_per_row))
         m.d.sync += [self.row_ready.eq(use_prng | (enough & ~self.flushing)),
                      self.drained.eq((asked == taken_rows) & (beat == 0))]
         with m.If(self.asked):
             m.d.sync += asked.eq(asked + dmd.rows_per_block)
         with m.If(taken):
-            m.d.sync += beat.eq(Mux(beat == R - 1, 0, beat + 1))
-            with m.If(beat == R - 1):
+            m.d.sync += beat.eq(Mux(beat == cycles_per_row - 1, 0, beat + 1))
+            with m.If(beat == cycles_per_row - 1):
                 m.d.sync += taken_rows.eq(taken_rows + 1)
         return m

@@ -146,16 +146,16 @@ class Sequencer(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         dmd, regs, beats = self._dmd, self.regs, self._beats
-        G = dmd.blocks
+        blocks = dmd.blocks
 
         m.submodules.init = init = Init()
         m.submodules.trigger = trig = Trigger()
         m.submodules.planner = planner = Planner(dmd, beats=beats)
         m.submodules.control = control = FrameControl(dmd, beats=beats)
-        m.submodules.jobs = jobs = Queue(load_job(dmd), depth=G + 1)
+        m.submodules.jobs = jobs = Queue(load_job(dmd), depth=blocks + 1)
         m.submodules.requester = requester = Requester(dmd)
-        m.submodules.loads = loads = Queue(ready_load(dmd), depth=G + 1)
-        m.submodules.darks = darks = Queue(dark_load(dmd), depth=G + 1)
+        m.submodules.loads = loads = Queue(ready_load(dmd), depth=blocks + 1)
+        m.submodules.darks = darks = Queue(dark_load(dmd), depth=blocks + 1)
         m.submodules.row_source = source = RowSource(dmd, beats=beats, store_words=self._store_words)
         m.submodules.bus = bus = Bus(dmd, beats=beats)
         m.submodules.camera = camera = CameraTrigger()
@@ -174,20 +174,20 @@ class Sequencer(wiring.Component):
         # ---- the time base, and the groups of the reset mode ----
         m.submodules.time_base = time_base = Counter(len(self.status.now))
         m.d.comb += [time_base.inc.eq(init.running), self.status.now.eq(time_base.count)]
-        n_groups = Signal(range(G + 1))
+        n_groups = Signal(range(blocks + 1))
         size_log2 = Signal(3)
         with m.Switch(regs.reset_mode):
             with m.Case(ResetMode.GLOBAL):
                 m.d.comb += n_groups.eq(1)
             with m.Case(ResetMode.QUAD):
-                m.d.comb += [n_groups.eq((G + 3) // 4), size_log2.eq(2)]
+                m.d.comb += [n_groups.eq((blocks + 3) // 4), size_log2.eq(2)]
             with m.Case(ResetMode.DUAL):
-                m.d.comb += [n_groups.eq((G + 1) // 2), size_log2.eq(1)]
+                m.d.comb += [n_groups.eq((blocks + 1) // 2), size_log2.eq(1)]
             with m.Case(ResetMode.SINGLE):
-                m.d.comb += n_groups.eq(G)
+                m.d.comb += n_groups.eq(blocks)
         # (registered: the registers hold still while anything reads it)
-        active = Signal(G)
-        m.d.sync += active.eq(Cat(g < n_groups for g in range(G)))
+        active = Signal(blocks)
+        m.d.sync += active.eq(Cat(g < n_groups for g in range(blocks)))
         for part in (planner, control, requester, source, bus, camera, period_watch):
             m.d.comb += part.regs.eq(regs)
         for part in (control, requester):
@@ -244,12 +244,8 @@ class Sequencer(wiring.Component):
             bus.running.eq(control.running), bus.flushing.eq(control.flushing),
             bus.hold.eq(control.retake.valid), bus.restart.eq(control.retake.valid),
             bus.rst_active.eq(init.rst_active_synced),
-            bus.due.eq(planner.due), bus.due_fours.eq(planner.due_fours), bus.writable.eq(planner.writable),
-            bus.frees_soon.eq(planner.frees_soon), bus.frees_soon_clear.eq(planner.frees_soon_clear),
-            bus.imminent.eq(planner.imminent), bus.imminent_clear.eq(planner.imminent_clear),
-            planner.choice.eq(bus.choice), planner.pulsing.eq(bus.pulsing),
         ]
-        m.d.comb += planner.loaded.eq(bus.loaded)
+        wiring.connect(m, planner.bus, bus.planner)
 
         # ---- outputs and counters ----
         m.d.comb += [
