@@ -367,7 +367,7 @@ def streams_top(beats=1, init_to_dvalid=2):
 def rst_top(latency=2, init_to_dvalid=2, beats=1):
     """The RST_ACTIVE property's top; ``latency``: cycles from the pins to the decision it allows
     (the synchroniser's two; one is too few, and the check must then fail)."""
-    return _sequencer_top(lambda pulse: _no_pulse_while_rst_active(pulse, latency), ("Bus", "pulsing"),
+    return _sequencer_top(lambda pulse: _no_pulse_while_rst_active(pulse, latency), ("Bus", "planner.pulsing"),
                           init_to_dvalid=init_to_dvalid, beats=beats)
 
 
@@ -378,7 +378,7 @@ def settle_top(init_to_dvalid=2, extra=0, beats=1):
     from gateware.registers import ResetMode
     return _sequencer_top(lambda pulse: _settle_after_pulse(pulse, at_beats(DMD, beats), [ResetMode.GLOBAL], extra,
                                                             strict=False),
-                          ("Bus", "pulsing"), init_to_dvalid=init_to_dvalid, beats=beats)
+                          ("Bus", "planner.pulsing"), init_to_dvalid=init_to_dvalid, beats=beats)
 
 
 def phased_settle_top(modes=("QUAD", "DUAL", "SINGLE"), init_to_dvalid=2, extra=0, strict=True, dmd=DMD4,
@@ -389,7 +389,7 @@ def phased_settle_top(modes=("QUAD", "DUAL", "SINGLE"), init_to_dvalid=2, extra=
     from gateware.registers import ResetMode
     modes = [ResetMode[mode] for mode in modes]
     return _sequencer_top(lambda pulse: _settle_after_pulse(pulse, at_beats(dmd, beats), modes, extra, strict),
-                          ("Bus", "pulsing"), init_to_dvalid=init_to_dvalid, dmd=dmd, beats=beats)
+                          ("Bus", "planner.pulsing"), init_to_dvalid=init_to_dvalid, dmd=dmd, beats=beats)
 
 
 def clear_top(dmd=DMD, extra=0, init_to_dvalid=2, beats=1):
