@@ -145,7 +145,7 @@ def calibrate(key, dclk_hz=DCLK_HZ, faults=None, log=print, dmd=DMD):
 def top_verilog(the_plan, window=False, dmd=DMD):
     """The run's core as Verilog, converted once while the sources stay the same (``make sim``
     and the suite's run of the same plan share it)."""
-    return cocotb_run.converted(lambda: top(the_plan, window, dmd), TOPLEVEL,
+    return cocotb_run.converted(lambda: top(the_plan, bool(window), dmd), TOPLEVEL,
                                 ["FastSystem", dmd, the_plan.params, bool(window)])
 
 
