@@ -104,7 +104,7 @@ def plan(dclk_hz=DCLK_HZ, t_rst_cycles=None, dmd=DMD, group_orders=None):
     that later runs plan only that one choice."""
     kwargs = {"words_per_cycle": read_rate(McbTiming(), DMD_HZ), "trigger_hold": True, "t_rst_cycles": t_rst_cycles,
               **({"margin": GROUP_ORDERS_MARGIN} if group_orders else {"depth": 8})}
-    source = b"".join(path.read_bytes() for path in sorted((ROOT / "spec").glob("*.py")))
+    source = b"".join(path.read_bytes() for path in sorted((ROOT / "spec").rglob("*.py")))
     key = hashlib.sha256(json.dumps([dmd.name, dclk_hz, kwargs, group_orders]).encode() + source).hexdigest()[:16]
     path = build_dir("plans") / f"{key}.json"
     shipped = SHIPPED_PLANS / f"{key}.json"

@@ -299,7 +299,7 @@ def test_groups_trigger_waits_for_group_0s_load_only(lead, test_name, monkeypatc
         return
     # waiting for every group to be loaded, the same triggers start frames later
     starts = model.frame_starts
-    monkeypatch.setattr(schedule._Model, "needs_loaded", lambda self: self.st)
+    monkeypatch.setattr(schedule._Model, "needs_loaded", lambda self: self.states)
     slower = schedule.simulate(DMD, p, model_frames(frames, None), [t + PIN_TO_STROBE for t in pins]).frame_starts
     assert starts[1] - starts[0] < slower[1] - slower[0]
 

@@ -178,16 +178,16 @@ class _Model:
         self.dmd, self.p = dmd, p
         self.R = row_cycles(dmd, p.beats)
         self.row_period = p.row_period or self.R
-        self.grp = groups(dmd, p.reset_mode)
-        self.G = len(self.grp)
-        self.st = [_Group() for _ in range(self.G)]
-        self.res = Result([], [])
-        self.res.groups = self.st
+        self.group_blocks = groups(dmd, p.reset_mode)
+        self.G = len(self.group_blocks)
+        self.states = [_Group() for _ in range(self.G)]
+        self.result = Result([], [])
+        self.result.groups = self.states
         self.queue = []                     # loads: [group, ops, index]
         self.darks = []                     # dark clears, apart: [group, ops, index]
-        self.frames = _Frames([Frame(0, 1)] if p.source == Source.PRNG else frames, self.res, p, self.G)
+        self.frames = _Frames([Frame(0, 1)] if p.source == Source.PRNG else frames, self.result, p, self.G)
         self.strobes = sorted(strobes)
-        self.si = 0                         # strobes handled
+        self.strobes_taken = 0              # strobes handled
         self.next_row = 0
         self.rst_any = 0
         self.next_frame = None
@@ -215,20 +215,20 @@ class _Model:
     def exps_of(self, fi, g):
         p = self.p
         table = p.group_tables[g] if p.order == PlaneOrder.GROUPS else p.order_table
-        return exponents(p.order, table, self.res.shown[fi].depth, p.anchor)
+        return exponents(p.order, table, self.result.shown[fi].depth, p.anchor)
 
     def enqueue(self, g, fi, j):
         """Queue the load of frame ``fi``'s display position ``j`` (None: clears) for group g."""
-        dmd, frame = self.dmd, self.res.shown[fi]
-        self.st[g].loaded_at = None
+        dmd, frame = self.dmd, self.result.shown[fi]
+        self.states[g].loaded_at = None
         if j is None:
             # a dark pulse's clears: queued apart, served before any load once the group's
             # memory may change (they need no data, and their window is the shortest plane's)
-            self.darks.append([g, [("clear", b) for b in self.grp[g]], 0])
+            self.darks.append([g, [("clear", b) for b in self.group_blocks[g]], 0])
             return
         ops = []
         plane = frame.stored_plane(self.exps_of(fi, g)[j])
-        for b in self.grp[g]:
+        for b in self.group_blocks[g]:
             if self.p.source == Source.PRNG or frame.occupied(plane, b):
                 ops += [("row", r) for r in range(b * dmd.rows_per_block, (b + 1) * dmd.rows_per_block)]
             else:
@@ -250,19 +250,19 @@ class _Model:
         frame follows (the first group to move on: the one offered now, if any, else its own
         again; the others: the one the first took); never after the last frame of a sequence
         played once."""
-        p, frame = self.p, self.res.shown[self.st[g].pos[1]]
+        p, frame = self.p, self.result.shown[self.states[g].pos[1]]
         if frame.last:
             return False
-        after = self.res.shown[self.next_frame]
+        after = self.result.shown[self.next_frame]
         nxt = self.frames.offer() if g not in self.behind and p.source != Source.PRNG else None
         if nxt is not None and nxt[1] <= t:
             after = self.frames.offered[nxt[0]]
         return p.chain or after.follow
 
     def after_pulse(self, g, t):
-        p, s = self.p, self.st[g]
+        p, s = self.p, self.states[g]
         kind, fi, j = s.pos
-        frame = self.res.shown[fi]
+        frame = self.result.shown[fi]
         exps = self.exps_of(fi, g)
         last = j == len(exps) - 1
         follow = last and self.follows(g, t)
@@ -287,7 +287,7 @@ class _Model:
 
     def waiting(self, t):
         """Every group waits, loaded."""
-        return all(not s.pending and s.loaded_at is not None and s.loaded_at <= t for s in self.st)
+        return all(not s.pending and s.loaded_at is not None and s.loaded_at <= t for s in self.states)
 
     def steady(self):
         """In GROUPS with group 0 offset (its offset room for the bus to end an operation under
@@ -301,12 +301,12 @@ class _Model:
         """The groups that must be loaded for a trigger to be obeyed: every one, or when
         :meth:`steady` group 0 only (each other group's first pulse comes at its own offset, its
         load under way)."""
-        return self.st[:1] if self.steady() else self.st
+        return self.states[:1] if self.steady() else self.states
 
     def trigger_ready(self, t):
         """A trigger may be obeyed at ``t``: no group plays (each ended its play
         :data:`END_TO_TRIGGER` cycles ago at least), and :meth:`needs_loaded` are loaded."""
-        return (not self.playing() and all(s.ended_at + END_TO_TRIGGER <= t for s in self.st)
+        return (not self.playing() and all(s.ended_at + END_TO_TRIGGER <= t for s in self.states)
                 and all(s.loaded_at is not None and s.loaded_at <= t for s in self.needs_loaded())
                 and self.first_rst_free() <= t)
 
@@ -316,10 +316,10 @@ class _Model:
         group loaded: its last pulse is long past)."""
         if not self.steady():
             return -math.inf
-        return self.rst_any if self.p.strict_rst else self.st[0].rst_free
+        return self.rst_any if self.p.strict_rst else self.states[0].rst_free
 
     def playing(self):
-        return any(s.pending for s in self.st)
+        return any(s.pending for s in self.states)
 
     # -- the frame control -------------------------------------------------------------------
 
@@ -328,7 +328,7 @@ class _Model:
         fi = self.next_frame = self.frames.take(self.t)
         self.behind = set()
         for g in range(self.G):
-            self.st[g].pos = ("plane", fi, 0)
+            self.states[g].pos = ("plane", fi, 0)
             self.enqueue(g, fi, 0)
 
     def takes_idle(self, k):
@@ -377,15 +377,15 @@ class _Model:
         self.queue.clear()
         self.darks.clear()
         for g in range(self.G):
-            self.st[g].pos = ("plane", fi, 0)
-            self.st[g].writable = max(self.st[g].writable, t + self.p.reload_lead + wait)
+            self.states[g].pos = ("plane", fi, 0)
+            self.states[g].writable = max(self.states[g].writable, t + self.p.reload_lead + wait)
             self.enqueue(g, fi, 0)
 
     def obey(self, t):
         """Every group's first pulse due from ``t + 2``, staggered."""
-        self.res.accepted.append(t)
+        self.result.accepted.append(t)
         self.reloaded = False
-        for g, s in enumerate(self.st):
+        for g, s in enumerate(self.states):
             s.pending = True
             s.pulse_at = t + 2 + (self.p.group_offsets[g] if self.p.order == PlaneOrder.GROUPS else g * self.p.stagger)
 
@@ -403,21 +403,21 @@ class _Model:
         self.last_strobe = s_t
         self.paces.append((s_t + PACE_LAG, self.last_strobe, self.interval))
         if self.ended:
-            self.res.ended += 1
+            self.result.ended += 1
         elif self.trigger_ready(s_t):
             self.obey(s_t)
         elif self.p.trigger_hold and not self.holding:
             self.holding = True
-            self.res.held += 1
+            self.result.held += 1
         else:
-            self.res.overruns += 1
+            self.result.overruns += 1
 
     def ready_at(self):
         """The cycle a trigger may be obeyed from (:meth:`trigger_ready`) as things stand, or None."""
         need = self.needs_loaded()
         if self.playing() or any(s.loaded_at is None for s in need):
             return None
-        return max([s.loaded_at for s in need] + [s.ended_at + END_TO_TRIGGER for s in self.st]
+        return max([s.loaded_at for s in need] + [s.ended_at + END_TO_TRIGGER for s in self.states]
                    + [self.first_rst_free()])
 
     # -- the bus -----------------------------------------------------------------------------
@@ -427,23 +427,23 @@ class _Model:
         oldest dark pulse's group once its memory may change, else the next load operation
         (unless it would hold up those clears: :meth:`clears_soon`), else nothing. Returns True
         when a pulse was made."""
-        p, st, res, R = self.p, self.st, self.res, self.R
-        rst_ok = [t - (self.rst_any if p.strict_rst else st[g].rst_free) >= 0 for g in range(self.G)]
-        due = [g for g in range(self.G) if st[g].pending and st[g].loaded_at is not None
-               and st[g].loaded_at <= t and st[g].pulse_at <= t and rst_ok[g]]
+        p, states, result, R = self.p, self.states, self.result, self.R
+        rst_ok = [t - (self.rst_any if p.strict_rst else states[g].rst_free) >= 0 for g in range(self.G)]
+        due = [g for g in range(self.G) if states[g].pending and states[g].loaded_at is not None
+               and states[g].loaded_at <= t and states[g].pulse_at <= t and rst_ok[g]]
         if due:
             g = due[0]
-            s = st[g]
+            s = states[g]
             if even(s.pulse_at) < t:
-                res.late += 1
+                result.late += 1
             kind, fi, j = s.pos
-            res.commands.append((t, "pulse", tuple(self.grp[g])))
-            res.pulses.append((t, g, kind, fi, self.exps_of(fi, g)[j] if kind == "plane" else None))
+            result.commands.append((t, "pulse", tuple(self.group_blocks[g])))
+            result.pulses.append((t, g, kind, fi, self.exps_of(fi, g)[j] if kind == "plane" else None))
             if kind == "plane" and j == 0 and g == 0:
-                res.frame_starts.append(t)
-                frame = res.shown[fi]
+                result.frame_starts.append(t)
+                frame = result.shown[fi]
                 if not frame.camera_off:
-                    res.camera_starts.append(t)
+                    result.camera_starts.append(t)
                 self.ended = self.ended or frame.last
             s.rst_free = t + p.t_rst
             self.rst_any = t + p.t_rst
@@ -451,26 +451,26 @@ class _Model:
             self.bus_free = t + R
             self.after_pulse(g, t)
             return True
-        queue = self.darks if self.darks and t >= st[self.darks[0][0]].writable else self.queue
+        queue = self.darks if self.darks and t >= states[self.darks[0][0]].writable else self.queue
         if queue:
             g, ops, i = queue[0]
             op, arg = ops[i]
             length = R if op == "row" else self.dmd.clear_row_cycles * R
-            imminent = any(st[h].pending and st[h].loaded_at is not None and st[h].loaded_at <= t
-                           and even(st[h].pulse_at) < t + length for h in range(self.G))
+            imminent = any(states[h].pending and states[h].loaded_at is not None and states[h].loaded_at <= t
+                           and even(states[h].pulse_at) < t + length for h in range(self.G))
             held = queue is self.queue and self.clears_soon(t, length)
-            res.loads_held += held and t >= st[g].writable and not imminent
-            if t >= st[g].writable and not imminent and not held and (op != "row" or t >= self.next_row):
-                res.commands.append((t, op, arg))
+            result.loads_held += held and t >= states[g].writable and not imminent
+            if t >= states[g].writable and not imminent and not held and (op != "row" or t >= self.next_row):
+                result.commands.append((t, op, arg))
                 for k in range(1, self.dmd.clear_row_cycles if op == "clear" else 1):
-                    res.commands.append((t + k * R, "noop", None))
+                    result.commands.append((t + k * R, "noop", None))
                 if op == "row":
                     self.next_row = t + self.row_period
                 self.bus_free = t + length
                 queue[0][2] += 1
                 if queue[0][2] == len(ops):
                     queue.pop(0)
-                    st[g].loaded_at = t + length
+                    states[g].loaded_at = t + length
         return False
 
     def clears_soon(self, t, length):
@@ -479,7 +479,7 @@ class _Model:
         operation ends (the clears' deadline is the shortest plane's, a load's is a long one's)."""
         if not self.darks:
             return False
-        s = self.st[self.darks[0][0]]
+        s = self.states[self.darks[0][0]]
         return t >= s.rst_free + CLEAR_HOLD_AFTER_RST and s.writable <= t + length - 2
 
     # -- time --------------------------------------------------------------------------------
@@ -487,18 +487,18 @@ class _Model:
     def next_time(self):
         """The next cycle at which anything can happen, and the cycle a waiting frame is taken
         (None if none)."""
-        t, p, st = self.t, self.p, self.st
+        t, p, states = self.t, self.p, self.states
         cands = []
-        if self.si < len(self.strobes):
-            cands.append(self.strobes[self.si])
-        for s in st:
+        if self.strobes_taken < len(self.strobes):
+            cands.append(self.strobes[self.strobes_taken])
+        for s in states:
             if s.pending and s.loaded_at is not None:
                 cands.append(max(s.pulse_at, s.rst_free if not p.strict_rst else self.rst_any))
         if self.darks:
-            cands.append(st[self.darks[0][0]].writable)
+            cands.append(states[self.darks[0][0]].writable)
         if self.queue:
             g, ops, i = self.queue[0]
-            cands.append(max(st[g].writable, self.next_row) if ops[i][0] == "row" else st[g].writable)
+            cands.append(max(states[g].writable, self.next_row) if ops[i][0] == "row" else states[g].writable)
         nxt = self.frames.offer()
         take_at = None
         if self.idle_take and nxt is not None and not self.playing() and self.takes_idle(nxt[0]):
@@ -513,11 +513,11 @@ class _Model:
         nt = max(t + 1, min(cands), self.bus_free)
         # (a strobe, a take or a held trigger's release is seen on its cycle, the bus busy or
         # not: the bus's next decision knows of the pulses it times)
-        strobe_at = self.strobes[self.si] if self.si < len(self.strobes) else None
+        strobe_at = self.strobes[self.strobes_taken] if self.strobes_taken < len(self.strobes) else None
         for exact in (take_at, hold_at, strobe_at):
             if exact is not None and t < exact < nt:
                 nt = exact
-        strobe_next = self.si < len(self.strobes) and self.strobes[self.si] == nt
+        strobe_next = self.strobes_taken < len(self.strobes) and self.strobes[self.strobes_taken] == nt
         if nt % 2 and not strobe_next and nt not in (take_at, hold_at):
             nt += 1
         return nt
@@ -530,19 +530,19 @@ class _Model:
             take_now = (self.idle_take and nxt is not None and nxt[1] <= t and t >= self.queued_at
                         and not self.playing() and self.takes_idle(nxt[0]) and self.fits(t))
             if t % 2 == 0 and t >= self.bus_free and self.decide(t):
-                if max_frames is not None and len(self.res.frame_starts) > max_frames:
+                if max_frames is not None and len(self.result.frame_starts) > max_frames:
                     break
             if take_now:
                 self.take_while_waiting(t)
             self.release_held(t)
-            while self.si < len(self.strobes) and self.strobes[self.si] <= t:
-                self.si += 1
-                self.strobe(self.strobes[self.si - 1])
+            while self.strobes_taken < len(self.strobes) and self.strobes[self.strobes_taken] <= t:
+                self.strobes_taken += 1
+                self.strobe(self.strobes[self.strobes_taken - 1])
             nt = self.next_time()
             if nt is None or (until is not None and nt >= until):
                 break
             self.t = nt
-        return self.res
+        return self.result
 
 
 def simulate(dmd, p, frames, strobes=(), *, until=None, max_frames=None):
@@ -573,13 +573,13 @@ def level_light(dmd, p, result, images):
     """On-cycles per pixel from the model's pulses: {frame index: (rows, columns) int array},
     ``images[i]`` being the 8-bit image of the i-th frame taken (the planes it shows:
     :meth:`Frame.stored_plane`)."""
-    grp = groups(dmd, p.reset_mode)
+    group_blocks = groups(dmd, p.reset_mode)
     light = {}
     by_group = {}
     for (t, g, kind, fi, e) in result.pulses:
         by_group.setdefault(g, []).append((t, kind, fi, e))
     for g, seq in by_group.items():
-        rows = slice(grp[g][0] * dmd.rows_per_block, (grp[g][-1] + 1) * dmd.rows_per_block)
+        rows = slice(group_blocks[g][0] * dmd.rows_per_block, (group_blocks[g][-1] + 1) * dmd.rows_per_block)
         for (t, kind, fi, e), (t2, *_rest) in zip(seq, seq[1:], strict=False):
             if kind != "plane":
                 continue
@@ -593,7 +593,7 @@ def level_light(dmd, p, result, images):
 def ready_cycle(dmd, p, fr):
     """First cycle at which a trigger strobe is obeyed after initialisation."""
     r = simulate(dmd, p, [fr])
-    return max(st.loaded_at for st in r.groups)
+    return max(group.loaded_at for group in r.groups)
 
 
 def on_time(dmd, p, fr):
@@ -624,7 +624,7 @@ def frame_period(dmd, p, fr):
         # trigger as soon as ready: a second strobe is obeyed once every group, its frame
         # played, is loaded again (the last thing each group does)
         r = simulate(dmd, p, [fr], [first])
-        return max(st.loaded_at for st in r.groups) - first
+        return max(group.loaded_at for group in r.groups) - first
     # GROUPS: the trigger after a trigger's frame waits for less than the first one (group 0's
     # load, not every group's): the period between the second and third
     accepted = back_to_back(dmd, p, fr, 3).accepted
