@@ -10,6 +10,7 @@ from sim.tb.plane_source import ramp_image
 from spec import prng, schedule
 from spec.facts import DMDS, TEST_DMD
 from spec.registers import DURATION_BITS, LSB_BITS, PlaneOrder, ResetMode, Source
+from spec.schedule.planner import _distance_to_nearest
 
 XGA = DMDS["dlp7000"]
 
@@ -198,7 +199,7 @@ def test_distance_to_nearest_equals_every_pair_compared(values, points):
     pulse difference, from its neighbours in order, equals the least over every difference."""
     values, points = np.unique(values), np.array(points, np.int64)
     brute = np.abs(values[None, :] - points[:, None]).min(axis=1) if len(points) else points
-    assert np.array_equal(schedule._distance_to_nearest(values, points), brute)
+    assert np.array_equal(_distance_to_nearest(values, points), brute)
 
 
 @pytest.mark.parametrize("mode", [ResetMode.QUAD, ResetMode.DUAL])

@@ -5,10 +5,11 @@ command stream must equal this model's, cycle for cycle). It runs the very algor
 :class:`gateware.dlpc410.sequencer.Sequencer`, event by event instead of cycle by cycle.
 
 The package reads bottom to top: :mod:`.terms` (the clock, the pipeline's latencies, the
-parameters), :mod:`.model` (the algorithm, run event by event) and :mod:`.plan` (the plan finder
+parameters), :mod:`.model` (the algorithm, run event by event) and :mod:`.planner` (the plan finder
 and the bound). Its names are all here.
 """
 
+from . import model, planner, terms
 from .model import (  # noqa: F401
     _Model,
     back_to_back,
@@ -19,9 +20,8 @@ from .model import (  # noqa: F401
     shows_depth,
     simulate,
 )
-from .plan import (  # noqa: F401
+from .planner import (  # noqa: F401
     Plan,
-    _distance_to_nearest,
     bound,
     paper_eq_rate_hz,
     plan,
@@ -56,11 +56,4 @@ from .terms import (  # noqa: F401
     trigger_lead,
 )
 
-__all__ = [
-    "Params", "Frame", "Result", "Plan", "exponents", "groups", "pulse_encoding", "simulate",
-    "FABRIC_HZ", "back_to_back", "beats_at", "row_cycles", "row_rate_words", "plan", "bound",
-    "paper_eq_rate_hz", "level_light", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS",
-    "flush_rows", "PAPER_SETTLE_CYCLES", "MIN_SETTLE", "RST_MARGIN", "FALL_LATENCY",
-    "DECISION_TO_PINS", "PACE_LAG", "even", "trigger_lead", "shows_depth", "ready_cycle",
-    "reload_bound", "reload_cycles", "on_time", "frame_period", "timeline",
-]
+__all__ = [*terms.__all__, *model.__all__, *planner.__all__]
