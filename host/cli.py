@@ -149,12 +149,26 @@ def _master(args):
             _print_status(master.status())
 
 
-def main(argv=None):
+def _parser():
+    """The command line's parser: the projector's address, then one subcommand."""
     parser = argparse.ArgumentParser(prog="python -m host", description=__doc__)
     parser.add_argument("--address", default="192.168.1.10", help="projector IPv4 address")
     parser.add_argument("--port", type=int, default=DEFAULT_PORT)
     parser.add_argument("--timeout", type=float, default=1.0, help="seconds to wait for a reply")
     sub = parser.add_subparsers(dest="command", required=True)
+    _send_parser(sub)
+    _sequence_parser(sub)
+    _configure_parser(sub)
+    for name, text in (("arm", "let triggers reach the sequencer"), ("disarm", "ignore every trigger"),
+                       ("trigger", "a software trigger (the sequencer's trigger mode must be software)")):
+        sub.add_parser(name, help=text)
+    sub.add_parser("status", help="print the projector's counters")
+    _master_parser(sub)
+    return parser
+
+
+def _send_parser(sub):
+    """``send``: images as consecutive frames."""
     send = sub.add_parser("send", help="send images as consecutive frames")
     send.add_argument("--mtu", type=int, default=None,
                       help="IP MTU of the path to the projector (default: what the system knows)")
@@ -170,6 +184,10 @@ def main(argv=None):
                            f"sent when at most this fraction of its rows changed (e.g. {DELTA_ROWS}); "
                            "default 0: whole frames")
     send.add_argument("--no-check", action="store_true", help="do not check the status after each frame")
+
+
+def _sequence_parser(sub):
+    """``sequence``: images stored as a sequence, played by an entry table."""
     play = sub.add_parser("sequence", help="store images as a sequence and play it by an entry table")
     play.add_argument("images", nargs="+", help=".npy or image files, grey: frame k goes to slot k")
     play.add_argument("--entries", required=True,
@@ -180,6 +198,10 @@ def main(argv=None):
     play.add_argument("--depth", type=int, default=None, help="bit depth, 1..8 (default: as send chooses)")
     play.add_argument("--rate", type=float, default=100e6, help="pacing in bytes per second")
     play.add_argument("--mtu", type=int, default=None, help="IP MTU of the path to the projector")
+
+
+def _configure_parser(sub):
+    """``configure``: what the plan is made of, and what it may search."""
     configure = sub.add_parser("configure", help="plan a schedule, say the rate it reaches, send it")
     configure.add_argument("--dmd", default="dlp7000", choices=sorted(DMDS))
     configure.add_argument("--dclk", type=float, default=400e6,
@@ -229,10 +251,10 @@ def main(argv=None):
                                 "'loose' (a pulse of the blocks whose own RST_ACTIVE window is open, as TI's "
                                 "phased rates suggest; docs/dlpc410_model.md)")
     configure.add_argument("--dry-run", action="store_true", help="say the rate, send nothing")
-    for name, text in (("arm", "let triggers reach the sequencer"), ("disarm", "ignore every trigger"),
-                       ("trigger", "a software trigger (the sequencer's trigger mode must be software)")):
-        sub.add_parser(name, help=text)
-    sub.add_parser("status", help="print the projector's counters")
+
+
+def _master_parser(sub):
+    """``master``: a tiled display's sync master, at an address of its own."""
     master = sub.add_parser("master", help="a tiled display's sync master: set its trigger, fire it, "
                                            "print its status (the default)")
     master.add_argument("address", help="the sync master's IPv4 address")
@@ -250,7 +272,43 @@ def main(argv=None):
     master.add_argument("--width", type=float, metavar="S", help="seconds each sync and camera pulse lasts")
     master.add_argument("--trigger", action="store_true", help="fire a software trigger (after the settings)")
     master.add_argument("--status", action="store_true", help="print the master's counters and settings")
-    args = parser.parse_args(argv)
+
+
+def _send(client, args):
+    """``send``: each image as a frame, then what each took and how well it shows."""
+    images = [_load(path) for path in args.images]
+    sent = client.send_sequence(images, args.frame, depth=args.depth, tolerance=args.tolerance,
+                                delta=args.delta)
+    for path, frame in zip(args.images, sent, strict=True):
+        kind = f", delta of frame {frame.base} carrying {frame.rows} rows" if frame.delta else ""
+        if frame.refused:
+            kind = f", whole: its delta was refused ({frame.refused})"
+        print(f"frame {frame.frame}: {path}, {frame.depth}-bit, {frame.records} records, "
+              f"rounding error {frame.error_lsb:.3g} LSB{kind}")
+    print(f"sent {len(images)} frame(s) in {sum(f.records for f in sent)} records "
+          f"of at most {client.limit} bytes (MTU {client.mtu})")
+
+
+def _sequence(client, args):
+    """``sequence``: store the images, then play the entries the JSON file lists."""
+    with open(args.entries) as f:
+        entries = json.load(f)
+    sent = client.play_sequence([_load(path) for path in args.images], entries, loop=not args.once,
+                                depth=args.depth)
+    print(f"sequence of {len(sent)} frames stored; {len(entries)} entries played "
+          f"{'once' if args.once else 'in a loop'} from the next trigger")
+
+
+def _configure(client, args, dmd, plan):
+    """``configure``: send the plan :func:`_plan` made, and the bit depth it was made for."""
+    client.configure(plan, dmd)
+    client.control(bit_depth=args.depth)
+    print("sent; the sequencer takes it when no frame is playing")
+
+
+def main(argv=None):
+    """Run one command; 0 on success, 1 with the error on stderr."""
+    args = _parser().parse_args(argv)
 
     try:
         if args.command == "master":
@@ -264,28 +322,11 @@ def main(argv=None):
         with Client(args.address, args.port, timeout=args.timeout, rate=getattr(args, "rate", None),
                     mtu=getattr(args, "mtu", None), check=not getattr(args, "no_check", False)) as client:
             if args.command == "send":
-                images = [_load(path) for path in args.images]
-                sent = client.send_sequence(images, args.frame, depth=args.depth, tolerance=args.tolerance,
-                                            delta=args.delta)
-                for path, frame in zip(args.images, sent, strict=True):
-                    kind = f", delta of frame {frame.base} carrying {frame.rows} rows" if frame.delta else ""
-                    if frame.refused:
-                        kind = f", whole: its delta was refused ({frame.refused})"
-                    print(f"frame {frame.frame}: {path}, {frame.depth}-bit, {frame.records} records, "
-                          f"rounding error {frame.error_lsb:.3g} LSB{kind}")
-                print(f"sent {len(images)} frame(s) in {sum(f.records for f in sent)} records "
-                      f"of at most {client.limit} bytes (MTU {client.mtu})")
+                _send(client, args)
             elif args.command == "sequence":
-                with open(args.entries) as f:
-                    entries = json.load(f)
-                sent = client.play_sequence([_load(path) for path in args.images], entries, loop=not args.once,
-                                            depth=args.depth)
-                print(f"sequence of {len(sent)} frames stored; {len(entries)} entries played "
-                      f"{'once' if args.once else 'in a loop'} from the next trigger")
+                _sequence(client, args)
             elif args.command == "configure":
-                client.configure(plan, dmd)
-                client.control(bit_depth=args.depth)
-                print("sent; the sequencer takes it when no frame is playing")
+                _configure(client, args, dmd, plan)
             elif args.command in ("arm", "disarm"):
                 client.control(armed=int(args.command == "arm"))
             elif args.command == "trigger":

@@ -129,38 +129,70 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
     overlap, are whatever the first plan found has)."""
     from ortools.sat.python import cp_model
 
-    m = cp_model.CpModel()
-    frozen = t.t_rst + t.t_settle
-    lengths = [t.lsb << e for e in range(t.depth)]
-    dark = [n < t.reload for n in lengths]
-    span = sum(lengths) + t.reload * sum(dark)             # a group's planes, dark gaps included
-    H = limit or 4 * (span + t.G * t.reload)
-    F = m.new_int_var(0, H, "frame")
-    rst, bus, keep = [], [], []
+    problem = _Problem(cp_model.CpModel(), t, limit)
+    for g in range(t.G):
+        problem.group(g, chained)
+    m = problem.m
+    if not chained and t.guard:
+        problem.trigger()
+    m.add_no_overlap(problem.rst)
+    m.add_no_overlap(problem.bus)
+    # (chained, the frame is each group's span: the shortest, the last plane a dark one)
+    m.minimize(problem.F)
+    solver = cp_model.CpSolver()
+    solver.parameters.max_time_in_seconds = seconds
+    solver.parameters.num_workers = workers
+    solver.parameters.random_seed = seed
+    if solver.solve(m) not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
+        return None
+    return problem.solution(solver, chained)
 
-    def var(name, lo=-H, hi=3 * H):
-        return m.new_int_var(lo, hi, name)
 
-    def on_bus(start, size, name, present=None):
+class _Problem:
+    """The constraint model :func:`solve` hands the solver, built a group at a time: the
+    variables, and the intervals that must not overlap (RST_ACTIVE windows and the bus's
+    operations), gathered as the groups add them."""
+
+    def __init__(self, m, t, limit):
+        self.m, self.t = m, t
+        self.frozen = t.t_rst + t.t_settle
+        self.lengths = [t.lsb << e for e in range(t.depth)]
+        self.dark = [n < t.reload for n in self.lengths]
+        self.span = sum(self.lengths) + t.reload * sum(self.dark)     # a group's planes, dark gaps included
+        self.H = limit or 4 * (self.span + t.G * t.reload)
+        self.F = m.new_int_var(0, self.H, "frame")
+        self.rst, self.bus, self.keep = [], [], []
+        self.firsts = []
+
+    def var(self, name, lo=None, hi=None):
+        H = self.H
+        return self.m.new_int_var(-H if lo is None else lo, 3 * H if hi is None else hi, name)
+
+    def on_bus(self, start, size, name, present=None):
+        m, F = self.m, self.F
         # the interval and its copy a frame later: a periodic schedule
         for k in (0, 1):
-            s = var(f"{name}@{k}")
+            s = self.var(f"{name}@{k}")
             m.add(s == start + k * F)
-            e = var(f"{name}@{k}e")
-            bus.append(m.new_interval_var(s, size, e, name) if present is None else
-                       m.new_optional_interval_var(s, size, e, present, name))
+            e = self.var(f"{name}@{k}e")
+            self.bus.append(m.new_interval_var(s, size, e, name) if present is None else
+                            m.new_optional_interval_var(s, size, e, present, name))
 
-    def pulse(at, name, present=None):
+    def pulse(self, at, name, present=None):
+        m, F, t = self.m, self.F, self.t
         for k in (0, 1):
-            s = var(f"{name}@{k}")
+            s = self.var(f"{name}@{k}")
             m.add(s == at + k * F)
-            rst.append(m.new_fixed_size_interval_var(s, t.t_rst, name) if present is None else
-                       m.new_optional_fixed_size_interval_var(s, t.t_rst, present, name))
-        on_bus(at, t.row, name + "/bus", present)
+            self.rst.append(m.new_fixed_size_interval_var(s, t.t_rst, name) if present is None else
+                            m.new_optional_fixed_size_interval_var(s, t.t_rst, present, name))
+        self.on_bus(at, t.row, name + "/bus", present)
 
-    N = t.depth                                             # the circuit's frame-boundary node
-    firsts = []
-    for g in range(t.G):
+    def group(self, g, chained):
+        """Group ``g``'s frame: its offset, its planes in an order the solver picks (a circuit
+        through them), their pulses, loads and clears, and the next frame's start."""
+        m, t, F, H, var = self.m, self.t, self.F, self.H, self.var
+        frozen, lengths, dark, span, firsts = self.frozen, self.lengths, self.dark, self.span, self.firsts
+        N = t.depth                                             # the circuit's frame-boundary node
         o = 2 * var(f"o{g}/2", 0, H // 2) if g else m.new_constant(0)     # even: decisions on even cycles
         # groups but the first are alike: their offsets in rising order, first pulses a
         # RST_ACTIVE apart as any two pulses (a symmetry the search need not explore)
@@ -192,7 +224,7 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
             for a in range(N):
                 if a != e:
                     m.add(s[e] == s[a] + occupied[a]).only_enforce_if(x[a, e])
-            pulse(s[e], f"p{g}.{e}")
+            self.pulse(s[e], f"p{g}.{e}")
             # the load: after the group's pulse before it (plane a's, or its dark pulse; the
             # first plane's: the frame before's last dark pulse) and t_rst + t_settle, done by
             # its own pulse
@@ -213,52 +245,49 @@ def solve(t, *, limit=None, seconds=60.0, workers=2, seed=0, chained=False):
                 # own slack), not the one a load behind a plane keeps
                 done.only_enforce_if(~x[N, e])
                 m.add(ld + t.reload - frozen <= s[e]).only_enforce_if(x[N, e])
-            on_bus(ld, t.load, f"l{g}.{e}")
+            self.on_bus(ld, t.load, f"l{g}.{e}")
             loads.append(ld)
             if dark[e]:
                 # its dark pulse, and the clears before it (the frame's last: at the end)
-                pulse(s[e] + lengths[e], f"d{g}.{e}")
+                self.pulse(s[e] + lengths[e], f"d{g}.{e}")
                 c = var(f"c{g}.{e}", 0, H)
                 m.add(c >= s[e] + frozen)
                 m.add(c + t.clear <= s[e] + lengths[e])
-                on_bus(c, t.clear, f"c{g}.{e}")
+                self.on_bus(c, t.clear, f"c{g}.{e}")
                 clears.append((e, c))
         # the frame's last dark pulse when the last plane hides loads: it needs clears too
-        pulse(end, f"f{g}", ~last_dark)
+        self.pulse(end, f"f{g}", ~last_dark)
         c = var(f"cf{g}", 0, 2 * H)
         m.add(c + t.clear <= end)
         for a in range(N):
             m.add(c >= s[a] + frozen).only_enforce_if(x[a, N])
-        on_bus(c, t.clear, f"cf{g}", ~last_dark)
-        keep.append((o, s, loads, clears, c))
-    if not chained and t.guard:
-        # the trigger, its guard before group 0's pulse: RST_ACTIVE over for that pulse by then
+        self.on_bus(c, t.clear, f"cf{g}", ~last_dark)
+        self.keep.append((o, s, loads, clears, c))
+
+    def trigger(self):
+        """Triggered, the trigger's guard before group 0's pulse: RST_ACTIVE over for that pulse
+        by then."""
+        m, t, F = self.m, self.t, self.F
         for k in (0, 1):
-            at = var(f"trigger@{k}")
+            at = self.var(f"trigger@{k}")
             m.add(at == k * F - t.guard)
-            rst.append(m.new_fixed_size_interval_var(at, t.guard, f"trigger@{k}"))
-    m.add_no_overlap(rst)
-    m.add_no_overlap(bus)
-    # (chained, the frame is each group's span: the shortest, the last plane a dark one)
-    m.minimize(F)
-    solver = cp_model.CpSolver()
-    solver.parameters.max_time_in_seconds = seconds
-    solver.parameters.num_workers = workers
-    solver.parameters.random_seed = seed
-    if solver.solve(m) not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
-        return None
-    v = solver.value
-    offsets, orders, all_loads, all_clears = [], [], [], []
-    for o, s, loads, clears, c in keep:
-        order = sorted(range(N), key=lambda e: v(s[e]))
-        offsets.append(v(o))
-        orders.append(tuple(order))
-        all_loads.append([v(loads[e]) for e in order])
-        cl = {e: v(ce) for e, ce in clears}
-        # clears in dark-pulse order, the frame's last dark pulse's last
-        all_clears.append([cl[e] for e in order[:-1] if e in cl] + [cl.get(order[-1], v(c))])
-    return GroupPlan(t, v(F), offsets, orders, all_loads, all_clears, math.ceil(solver.best_objective_bound),
-                     chained)
+            self.rst.append(m.new_fixed_size_interval_var(at, t.guard, f"trigger@{k}"))
+
+    def solution(self, solver, chained):
+        """The :class:`GroupPlan` the solver's values give: each group's order by its pulses'
+        times, its loads in that order, its clears in dark-pulse order."""
+        v, N = solver.value, self.t.depth
+        offsets, orders, all_loads, all_clears = [], [], [], []
+        for o, s, loads, clears, c in self.keep:
+            order = sorted(range(N), key=lambda e: v(s[e]))
+            offsets.append(v(o))
+            orders.append(tuple(order))
+            all_loads.append([v(loads[e]) for e in order])
+            cl = {e: v(ce) for e, ce in clears}
+            # clears in dark-pulse order, the frame's last dark pulse's last
+            all_clears.append([cl[e] for e in order[:-1] if e in cl] + [cl.get(order[-1], v(c))])
+        return GroupPlan(self.t, v(self.F), offsets, orders, all_loads, all_clears,
+                         math.ceil(solver.best_objective_bound), chained)
 
 
 def find(dmd, dclk_hz, reset_mode, *, seconds=60.0, workers=2, extra_rows=4, margin=0, chained=False,

@@ -5,18 +5,20 @@ command stream must equal this model's, cycle for cycle). It runs the very algor
 :class:`gateware.dlpc410.sequencer.Sequencer`, event by event instead of cycle by cycle.
 
 The package reads bottom to top: :mod:`.terms` (the clock, the pipeline's latencies, the
-parameters), :mod:`.model` (the algorithm, run event by event) and :mod:`.planner` (the plan finder
-and the bound). Its names are all here.
+parameters), :mod:`.model` (the algorithm, run event by event), :mod:`.measures` (what a run of it
+says of a plan) and :mod:`.planner` (the plan finder and the bound). Its names are all here.
 """
 
-from . import model, planner, terms
-from .model import (  # noqa: F401
-    _Model,
+from . import measures, model, planner, terms
+from .measures import (  # noqa: F401
     back_to_back,
     frame_period,
     level_light,
     on_time,
     ready_cycle,
+)
+from .model import (  # noqa: F401
+    _Model,
     shows_depth,
     simulate,
 )
@@ -56,4 +58,4 @@ from .terms import (  # noqa: F401
     trigger_lead,
 )
 
-__all__ = [*terms.__all__, *model.__all__, *planner.__all__]
+__all__ = [*terms.__all__, *model.__all__, *measures.__all__, *planner.__all__]

@@ -15,7 +15,7 @@ from ..registers import (
     ResetMode,
     Source,
 )
-from .model import (
+from .measures import (
     frame_period,
     on_time,
 )
