@@ -184,7 +184,8 @@ def main(frames=None, dclk_hz=xga.DCLK_HZ, faults=None, window=False, dmd="dlp70
                            markers=r["waves_markers"])
     print(f"waves: {vcd} (DLPC410 pins, trigger, sync and camera outputs of the first frame triggered, "
           f"written from the pin trace; the full design is not dumped at XGA)\n"
-          f"  GTKWave save file: {save} (opens on the trigger; markers A trigger, B first pulse, C last pulse)")
+          f"  GTKWave save file: {save} (opens on the trigger and the first pulse, in a 1600x900 window; "
+          f"markers A trigger, B first pulse, C last pulse)")
     if window:
         print_window(r["window"])
     exact = all(f["max_error_lsb"] == 0 for f in shown) and len(shown) == XGA_ONE_BY_ONE + XGA_BACK_TO_BACK
@@ -264,10 +265,46 @@ PIN_GROUPS = {
 }
 
 
+#: The GTKWave window the save files ask for (``[size]``), the width of its signal name pane
+#: (``[signals_width]``) and the width of the wave pane that leaves, less a margin, that the view
+#: is fitted to: GTKWave 3.3 at 1600 pixels wide, its tree pane (SST) open, shows 1040 pixels of
+#: waves beside a 260-pixel name pane (measured under Xvfb: 1600 less ~280 for the tree, 260 for
+#: the names and ~20 for borders and the scroll bar). Without ``[size]`` GTKWave opens about
+#: 1000 pixels wide whatever the screen, and the name pane is as wide as the longest name; with
+#: ``[signals_width]`` it is at least that wide (values are cut to fit it, names never: a name of
+#: more than ~30 characters widens it and the view ends that many pixels short of ``end``).
+GTKWAVE_SIZE = (1600, 900)
+GTKWAVE_SIGNALS_WIDTH = 260
+GTKWAVE_WAVE_PIXELS = 1000
+#: GTKWave's pixels per "frame" of its zoom: a zoom ``z`` puts ``2 ** -z`` time units in this
+#: many pixels (GTKWave 3.3, zoom base 2; measured: zoom -15 shows 163.8 ps a pixel of a 1 ps
+#: dump, -13.7 shows 66.5).
+GTKWAVE_PIXELS_PER_FRAME = 200
+
+
+def gtkwave_zoom(span, pixels=GTKWAVE_WAVE_PIXELS):
+    """The GTKWave zoom that shows ``span`` time units of the dump in ``pixels`` of its wave
+    pane. GTKWave's time unit is the dump's (ps for both of make sim's dumps, whose timescale is
+    1 ps; a dump at 10 ps would count its times ten times over): a zoom ``z`` is ``2 ** -z`` units
+    per :data:`GTKWAVE_PIXELS_PER_FRAME` pixels, so ``span / pixels`` units a pixel is
+    ``z = -log2(span * 200 / pixels)``. (Without the 200 the view is 200 times too close: 81 ns
+    of a 16.25 us view in 1200 pixels.)"""
+    return -math.log2(max(1, span) * GTKWAVE_PIXELS_PER_FRAME / pixels)
+
+
+def gtkwave_span(zoom, pixels=GTKWAVE_WAVE_PIXELS):
+    """The time units ``pixels`` of GTKWave's wave pane show at ``zoom``: :func:`gtkwave_zoom`
+    inverted."""
+    return 2 ** -zoom * pixels / GTKWAVE_PIXELS_PER_FRAME
+
+
 def write_save_file(vcd, groups=None, scope="projector", *, widths=None, view=None, markers=None):
     """A GTKWave save file beside ``vcd``: ``groups`` of signals (``widths``: ``{name: bits}``
     to name them as GTKWave does, ``name[n-1:0]``), buses in hex; ``view``: ``(start, end)`` the
-    window it opens on, ``markers``: ``{name: time}`` named markers A, B, .. (VCD time units)."""
+    window it opens on, ``markers``: ``{name: time}`` named markers A, B, .. (VCD time units).
+    GTKWave opens a :data:`GTKWAVE_SIZE` window with ``start`` at the left edge of the wave pane
+    (``[timestart]``) and ``end`` :data:`GTKWAVE_WAVE_PIXELS` to the right of it, the rest of the
+    pane past ``end``; a smaller window shows less past ``start``."""
     def label(name):
         bits = (widths or {}).get(name, 1)
         return f"{name}[{bits - 1}:0]" if bits > 1 else name
@@ -277,10 +314,12 @@ def write_save_file(vcd, groups=None, scope="projector", *, widths=None, view=No
         save = GTKWSave(f)
         save.dumpfile(str(vcd))
         save.savefile(str(path))
+        save.size(*GTKWAVE_SIZE)
+        save.pos(-1, -1)                            # where the window manager puts it
+        save.signals_width(GTKWAVE_SIGNALS_WIDTH)   # the wave pane's width does not hang on names
         if view is not None:
             save.timestart(view[0])
-        # GTKWave's zoom is a power of two of time units per pixel: fit ``view`` in ~1200 pixels
-        zoom = -math.log2(max(1, view[1] - view[0]) / 1200) if view is not None else 0.0
+        zoom = gtkwave_zoom(view[1] - view[0]) if view is not None else 0.0
         save.zoom_markers(zoom, named[0][1] if named else -1,
                           **{chr(ord("a") + k): t for k, (_name, t) in enumerate(named)})
         for k, (name, _t) in enumerate(named):

@@ -81,9 +81,14 @@ FAULTS = {"stalls": _STALLS, "rst": _RST, "all": {**_STALLS, **_RST}}
 #: and in the dark gap that covers a reload (:func:`spec.group_orders.sequencer_terms`).
 GROUP_ORDERS_MARGIN = 300
 #: The VCD of the pins covers the first triggered frame, from this many cycles before its trigger
-#: to this many after its last pulse; its save file opens on this many cycles from the trigger.
+#: to this many after its last pulse.
 WAVE_WINDOW = (1000, 2000)
-WAVE_VIEW = 3000
+#: Its save file opens on the trigger and the frame's first clocking pulse: from a margin before
+#: the trigger to two after the pulse (the pulse's command, RST_ACTIVE rising and sync and camera
+#: out follow it), the margin the trigger-to-pulse latency but at least this many cycles, so that
+#: the two edges (7 cycles apart at the default run) are tens of pixels apart, not one or two as
+#: in a view of the whole RST_ACTIVE and the next load.
+WAVE_MARGIN = 20
 #: The plan finder's choices for the default runs, keyed as :func:`plan` keys them (copied from
 #: ``build/plans`` after a run): a fresh clone plans without the search.
 SHIPPED_PLANS = ROOT / "sim" / "plans"
@@ -419,13 +424,20 @@ def analyse(the_plan, images, stimulus, files, *, one_by_one, back_to_back, buil
         "trace_records": len(pins),
         "waves": str(waves),
         # the save file's view and named markers (ps in the VCD), the VCD's fields and widths
-        "waves_view": (ps(triggers[0] - WAVE_WINDOW[0] // 4), ps(triggers[0] + WAVE_VIEW)),
+        "waves_view": _waves_view(triggers[0], frames[0][0], ps),
         "waves_markers": {"trigger": ps(triggers[0]), "first pulse": ps(frames[0][0]),
                           "last pulse": ps(frames[0][1])},
         "waves_fields": {name: mask.bit_length() for name, _, mask in trace.fields(layout)},
         "check_wall_s": time.monotonic() - t0,
         "build": str(build) if build else None,
     }
+
+
+def _waves_view(trigger, first_pulse, ps):
+    """The pin VCD's save file view, ``(start, end)`` in ps of the VCD (``ps`` of a cycle): see
+    :data:`WAVE_MARGIN`."""
+    margin = max(first_pulse - trigger, WAVE_MARGIN)
+    return max(0, ps(trigger - margin)), ps(first_pulse + 2 * margin)
 
 
 def _scene_rate(images, sends, status):
