@@ -71,13 +71,15 @@ def pin_layout(buses, beats=1):
     })
 
 
-def read_rate(timing, dmd_hz):
+def read_rate(timing, dmd_hz, ingest_bytes_per_s=INGEST_BYTES_PER_S):
     """64-bit words per ``dmd`` cycle the plane reader can count on: the DDR2's sustained
     bandwidth (refresh taken off) less the store's writes at the GMII line rate. The memory
     model gives the reader this much under that ingest (``store.read_words_per_dmd_cycle_with_
     ingest``, :mod:`sim.bench.store`; a test holds the two together). On the Atlys (DDR2-800 x16,
-    1.6 GB/s peak) it is under one word a cycle at 200 MHz whatever the port's width."""
-    return (timing.sustained_bytes_per_s - INGEST_BYTES_PER_S) / 8 / dmd_hz
+    1.6 GB/s peak) it is under one word a cycle at 200 MHz whatever the port's width.
+    ``ingest_bytes_per_s``: the store's writes; frames of fewer planes write less (a pixel byte
+    of a 1-bit frame makes one bit)."""
+    return (timing.sustained_bytes_per_s - ingest_bytes_per_s) / 8 / dmd_hz
 
 
 def dlpc410_side(m, dmd, dlpc, *, rst_active_cycles, init_cycles, init_grace_cycles, flush,

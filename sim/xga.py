@@ -46,7 +46,7 @@ from scapy.layers.l2 import Ether
 from scapy.packet import Raw
 
 from host import codec
-from sim.fast_top import PLUSARGS, SOURCES, WINDOW_SOURCES, FastSystem, pin_layout, read_rate
+from sim.fast_top import INGEST_BYTES_PER_S, PLUSARGS, SOURCES, WINDOW_SOURCES, FastSystem, pin_layout, read_rate
 from sim.harness import cocotb_run
 from sim.harness.paths import ROOT, build_dir
 from sim.models import bitplane, gmii, trace
@@ -552,6 +552,111 @@ def stream(key="stream", frames=6, *, whole=False, dclk_hz=DCLK_HZ, log=print, d
     report["new_frames_per_s"] = (frames - 1) * DMD_HZ / (starts[-1] - starts[0])
     report["wire_ms"] = [s["end_ns"] / 1e6 - s["start_ns"] / 1e6 for s in stimulus["sends"]]
     return report
+
+
+#: Binary patterns from the store: frames sent (the first before the trigger, the others while
+#: the patterns play) and the simulated time after the last one's last byte.
+BINARY_FRAMES, BINARY_TAIL_US = 3, 600
+#: The store's writes while 1-bit frames arrive at the GMII line rate: a bit per pixel byte.
+BINARY_INGEST_BYTES_PER_S = INGEST_BYTES_PER_S / 8
+
+
+def binary_plan(dclk_hz=DCLK_HZ, reset_mode=ResetMode.QUAD, dmd=DMD):
+    """The plan of binary patterns from the store: 1-bit frames chained (each follows the one
+    before with no trigger), rows paced to the read bandwidth the memory leaves the plane reader
+    while GigE writes 1-bit frames at line rate (a pixel byte makes one bit of a plane), as
+    :func:`plan` paces the 8-bit run's for 8-bit frames."""
+    return schedule.plan(dmd, dclk_hz, depth=1, chain=True, reset_mode=reset_mode,
+                         words_per_cycle=read_rate(McbTiming(), DMD_HZ, BINARY_INGEST_BYTES_PER_S))
+
+
+def _binary_files(directory, images, the_plan, dmd):
+    """GMII replay files of the binary run: the setup (a control record for a bit depth of 1, a
+    sequencer record with the plan's registers, checked as the projector checks them), then
+    each frame whole. Returns (sends, query)."""
+    p = the_plan.params
+    setup = [codec.control_record(0, bit_depth=1),
+             codec.sequencer_record(p.registers(dmd), 1, dmd=dmd, beats=p.beats)]
+    path = directory / "binary_setup.bin"
+    gmii.replay_file(path, _datagrams(setup))
+    sends, sequence = [{"path": str(path), "what": "bit depth 1 and the binary plan's registers",
+                        "kind": "control"}], len(setup)
+    for index, image in enumerate(images):
+        payloads = codec.image_records(image, frame=index, sequence=sequence)
+        sequence += len(payloads)
+        path = directory / f"binary{index}.bin"
+        gmii.replay_file(path, _datagrams(payloads))
+        sends.append({"path": str(path), "what": f"frame {index + 1}/{len(images)}", "kind": "whole"})
+    query = directory / "status_query.bin"
+    gmii.replay_file(query, _datagrams([codec.status_query(sequence)]))
+    return sends, str(query)
+
+
+def binary_stream(key="binary", frames=BINARY_FRAMES, *, reset_mode=ResetMode.QUAD, dclk_hz=DCLK_HZ, log=print,
+                  dmd=DMD):
+    """Binary patterns played from the store while GigE writes: the run's core (the 8-bit plan's
+    build, as ``make sim``) is set over GMII to a bit depth of 1 and the binary plan's registers
+    (:func:`binary_plan`); the first frame is stored and triggered once, and the chain of 1-bit
+    patterns begins; the other frames follow over GMII at line rate, each written to the memory
+    while the one before it repeats, and each taken at a pattern boundary once complete. The
+    memory model serves both ports with its own timing (refresh, the ports sharing its
+    bandwidth); nothing paces the rows but the plane reader and the sequencer.
+
+    On the pins: every DLPC410 rule (the rule model); every pattern (block 0's clocking pulses)
+    shows the most significant plane of one of the frames sent, exact in every pixel, the frames
+    in the order sent, each at least once; the pattern periods. Returns the report; raises when a
+    pattern shows anything else or a counter says something was lost."""
+    the_plan = binary_plan(dclk_hz, reset_mode, dmd)
+    build_plan = plan(dclk_hz, None, dmd)
+    directory = build_dir("system", key)
+    images = default_scene(frames, dmd.rows, dmd.columns)
+    planes = [(image >> 7).astype(bool) for image in images]
+    assert all(not np.array_equal(a, b) for k, a in enumerate(planes) for b in planes[:k]), \
+        "the frames' patterns must differ, or a repeat or a skip would not be seen"
+    sends, query = _binary_files(directory, images, the_plan, dmd)
+    files = {name: directory / f"{name}.txt" for name in ("pins", "tx")}
+    report_path = directory / "stimulus.json"
+    p = {"sends": sends, "status_query": query, "replay": str(directory / "replay.bin"), "settle_us": 250,
+         "tail_us": BINARY_TAIL_US, "margin_us": 20, "reply_us": 30, "progress_us": 2000, "report": str(report_path)}
+    start = time.monotonic()
+    build = cocotb_run.run(top_verilog(build_plan, False, dmd), toplevel=TOPLEVEL, module="sim.tb.system_fast",
+                           key=f"{_name(dmd)}-{build_plan.params.beats}beats", params=p, extra_sources=SOURCES,
+                           plusargs=_trace_plusargs(p["replay"], files), waves=False,
+                           testcase="stream_binary_patterns", top_signals_only=True)
+    stimulus = json.loads(report_path.read_text())
+    log(f"simulation done: build and run {time.monotonic() - start:.0f} s; checking the pins")
+    _layout, _pins, model = _pins_checked(dmd, the_plan.params.beats, files["pins"])
+    starts = [c.cycle for c in model.log if c.kind == "pulse" and 0 in c.blocks]
+    shown = []
+    for k in range(len(starts) - 1):
+        # each block's state latched by its pulse of pattern k (phased groups pulse a stagger
+        # apart, all before the next pattern's first pulse)
+        state = np.concatenate([next(s for c, s in reversed(history) if c < starts[k + 1])
+                                for history in model.history])
+        matches = [j for j, plane in enumerate(planes) if np.array_equal(state[:, :plane.shape[1]], plane)]
+        if not matches:
+            differs = [int((state[:, :plane.shape[1]] != plane).sum()) for plane in planes]
+            raise AssertionError(f"pattern {k} at cycle {starts[k]} shows none of the frames sent "
+                                 f"(pixels differing from each: {differs})")
+        shown.append(matches[0])
+    assert shown == sorted(shown) and sorted(set(shown)) == list(range(frames)), \
+        f"frames shown in the patterns: {shown}"
+    status = _status(trace.read(files["tx"]))
+    counted = ("drop_overflow", "mac_rx_dropped", "rows_incomplete", "store_rows_refused", "store_frames_abandoned",
+               "pulses_late", "frames_bad_depth")
+    lost = {name: status[name] for name in counted if status.get(name)}
+    assert not lost, lost
+    assert status["store_frames_complete"] == frames and status["registers_applied"] == 1, status
+    periods = [b - a for a, b in zip(starts, starts[1:], strict=False)]
+    # the patterns played while GigE wrote: from the second frame's first byte to the last's last
+    sent = stimulus["sends"]
+    first_ns, last_ns = sent[2]["start_ns"], sent[-1]["end_ns"]
+    ns = 1e9 / DMD_HZ
+    during = [b - a for a, b in zip(starts, starts[1:], strict=False) if first_ns <= a * ns and b * ns <= last_ns]
+    return {"plan": the_plan, "patterns": len(starts), "frames_shown": shown, "periods": periods,
+            "periods_during_ingest": during, "period_cycles": the_plan.frame_cycles, "status": status,
+            "ingest_ns": (first_ns, last_ns), "build": str(build),
+            "sim_wall_s": stimulus["wall_s"]}
 
 
 if __name__ == "__main__":

@@ -3,7 +3,8 @@ timing, DCLK 400 MHz, the default scene stored as a sequence played by an entry 
 then back to back: DCLK, the frame period measured on the pins, latency, grey error, simulation
 speed. Beside it the streamed runs (:func:`streamed`): a new frame of the scene at every trigger.
 
-``python -m sim.bench.system_xga streamed`` prints the streamed runs' figures alone."""
+``python -m sim.bench.system_xga streamed`` prints the streamed runs' figures alone, ``.. binary`` the
+binary patterns' from the store (:func:`binary_memory`)."""
 
 from sim import xga
 from sim.system import XGA_BACK_TO_BACK, XGA_ENTRIES, XGA_FRAMES, XGA_ONE_BY_ONE, latency
@@ -39,6 +40,7 @@ def run():
         **faulty(),
         **dlp9500(),
         **streamed(),
+        **binary_memory(),
     }
 
 
@@ -69,6 +71,53 @@ def streamed():
         for counter in ("row_underruns", "pulses_late", "triggers_held"):
             figures[f"sys.xga_streamed{suffix}_{counter}"] = (r["status"][counter], "count", run + ", status reply")
     return figures
+
+
+def binary_memory():
+    """Binary patterns from the store with the memory in the loop (:func:`sim.xga.binary_stream`):
+    the core's plane reader and the MCB model feed the sequencer while GigE writes the next
+    1-bit frame at line rate; every pattern exact and in order. The headline is the slowest
+    pattern period while GigE wrote; beside it what the memory allows, worked out from the MCB
+    timing model alone (its sustained bandwidth less the writes, over a pattern's bytes)."""
+    from sim.fast_top import read_rate
+    from sim.models.mcb import McbTiming
+    from spec import schedule
+    name = "bench-binary"
+    r = xga.binary_stream(name, log=lambda _text: None)
+    during, status = r["periods_during_ingest"], r["status"]
+    dmd, timing = xga.DMD, McbTiming()
+    pattern_bytes = dmd.rows * dmd.columns / 8
+    allowed = (timing.sustained_bytes_per_s - xga.BINARY_INGEST_BYTES_PER_S) / pattern_bytes
+    mode = r["plan"].params.reset_mode.name.lower()
+    run = XGA_SOURCE.format(what=f"DLP7000, 1-bit patterns chained from the store ({mode} reset), "
+                                 f"{len(r['frames_shown'])} patterns of {xga.BINARY_FRAMES} frames, the later frames "
+                                 f"sent over GMII at line rate while the patterns play, each pattern exact", name=name)
+    allowed_source = ("model: the MCB timing model's sustained bandwidth (sim.models.mcb.McbTiming: peak x efficiency, "
+                      "refresh taken off) less the store's writes of 1-bit frames at the GMII line rate "
+                      "(sim.xga.BINARY_INGEST_BYTES_PER_S), over a DLP7000 pattern's bytes")
+    words = read_rate(timing, xga.DMD_HZ, xga.BINARY_INGEST_BYTES_PER_S)
+    return {
+        "seq.binary_rate_hz_memory": (xga.DMD_HZ / max(during), "Hz",
+                                      run + ", the slowest pattern period (block 0's pulses) while GigE wrote"),
+        "seq.binary_rate_hz_memory_median": (xga.DMD_HZ / sorted(during)[len(during) // 2], "Hz",
+                                             run + ", the median pattern period while GigE wrote"),
+        "seq.binary_memory_periods_during_ingest": (len(during), "period", run),
+        "seq.binary_memory_periods_off_plan": (sum(period != r["period_cycles"] for period in r["periods"]), "period",
+                                               run + ", periods other than the plan's"),
+        "seq.binary_memory_row_underruns": (status["row_underruns"], "row", run + ", status reply"),
+        "seq.binary_memory_pulses_late": (status["pulses_late"], "pulse", run + ", status reply"),
+        "seq.binary_memory_row_period_cycles_model": (r["plan"].params.row_period, "cycle",
+                                                      f"model: the plan's row period (sim.xga.binary_plan), "
+                                                      f"{words:.3f} words a cycle left to the reader"),
+        "seq.binary_rate_hz_memory_model": (r["plan"].rate_hz, "Hz", PLAN_SOURCE.format(name=name)),
+        "store.binary_rate_hz_allowed_model": (allowed, "Hz", allowed_source),
+        "seq.binary_rate_memory_fraction_of_allowed_model": (
+            xga.DMD_HZ / max(during) / allowed, "",
+            "arithmetic: seq.binary_rate_hz_memory / store.binary_rate_hz_allowed_model"),
+        "seq.binary_rate_memory_fraction_of_plan_model": (
+            xga.DMD_HZ / max(during) / schedule.FABRIC_HZ * r["period_cycles"], "",
+            "arithmetic: seq.binary_rate_hz_memory / seq.binary_rate_hz_memory_model"),
+    }
 
 
 def dlp9500():
@@ -123,6 +172,6 @@ def _median_period(r):
 
 if __name__ == "__main__":
     import sys
-    only = {"streamed": streamed, "faulty": faulty, "dlp9500": dlp9500}
+    only = {"streamed": streamed, "faulty": faulty, "dlp9500": dlp9500, "binary": binary_memory}
     for figure, (value, unit, source) in (only[sys.argv[1]]() if sys.argv[1:] else run()).items():
         print(f"{figure:55s} {value:12.1f} {unit:10s} {source}")

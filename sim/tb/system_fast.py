@@ -225,3 +225,26 @@ async def stream_new_frames(dut):
             sending = cocotb.start_soon(run.send(following["path"], following["what"], following["kind"]))
     await run.frames_ended(len(sends), run.now_ns() + 2 * period_ns)
     await run.finish()
+
+
+@cocotb.test()
+async def stream_binary_patterns(dut):
+    """Binary patterns from the store while GigE writes (:func:`sim.xga.binary_stream`): the setup
+    records (a bit depth of 1, a register set of chained 1-bit frames), the first frame, one
+    trigger that starts the chain; then the other frames back to back over GMII, each written
+    while the one before it repeats on the DMD; ``tail_us`` more after the last, then the
+    status query."""
+    p = params()
+    run = Run(dut, p)
+    await run.start()
+    cocotb.start_soon(run.progress(p["progress_us"]))
+    sends = p["sends"]
+    for send in sends[:2]:
+        await run.send(send["path"], send["what"], send["kind"])
+    await Timer(p["settle_us"], "us")
+    await run.trigger(0)
+    run.log("the chain of patterns triggered")
+    for send in sends[2:]:
+        await run.send(send["path"], send["what"], send["kind"])
+    await Timer(p["tail_us"], "us")
+    await run.finish()
