@@ -299,3 +299,22 @@ def test_every_figure_a_bench_module_gives_has_a_source(name):
         if kind == "model" and isinstance(key, (ast.Constant, ast.JoinedStr, ast.BinOp)):
             assert any("_model" in s for s in _strings(key)), \
                 f"{where}: a model's figure without _model in its name ({ast.unparse(key)})"
+
+
+def test_figures_write_the_readmes_headline_block_only(tmp_path):
+    """``make figures`` writes the README's headline figures between its markers and leaves the
+    rest of the page alone; a headline the run did not give is said to be missing."""
+    data = {"sys.xga_rate_hz_measured": {"value": 280.89, "unit": "Hz", "source": "gateware: run"}}
+    bench_json = tmp_path / "bench.json"
+    bench_json.write_text(json.dumps(data))
+    readme = tmp_path / "README.md"
+    readme.write_text(f"before\n{figures_doc.README_BEGIN}\nstale\n{figures_doc.README_END}\nafter\n")
+    figures_doc.write(bench_json, tmp_path / "figures.md", readme)
+    text = readme.read_text()
+    assert text.startswith("before\n") and text.endswith(f"{figures_doc.README_END}\nafter\n")
+    assert "stale" not in text and "| `sys.xga_rate_hz_measured` | 280.89 Hz |" in text
+    assert text.count("missing from the last make bench") == len(figures_doc.HEADLINES) - 1
+    # the page's figures read back as they were written
+    page = figures_doc.parse((tmp_path / "figures.md").read_text())
+    assert page == {"sys.xga_rate_hz_measured": {"value": "280.89", "unit": "Hz", "source": "gateware: run"}}
+
