@@ -1,4 +1,4 @@
-"""The camera misalignment experiment (:mod:`sim.bench.camera`) on the sequencer's generated
+"""The camera misalignment experiment (:mod:`sim.bench.camera_figures`) on the sequencer's generated
 Verilog: a window holding the frame sees every level exact; a window lagging an MSB-first frame
 by a tenth of it loses the MSB's share from every level of 128 and up (the jump at 128), much
 less below; leading it loses only the low planes' share at the end of the frame."""
@@ -6,7 +6,7 @@ less below; leading it loses only the low planes' share at the end of the frame.
 import numpy as np
 import pytest
 
-from sim.bench.camera import misalignment
+from sim.bench.camera_figures import misalignment
 from spec.registers import PlaneOrder
 
 

@@ -9,5 +9,5 @@ from sim.tb.ethernet_pins import TOPLEVEL, build
 
 @pytest.mark.verilog
 def test_ethernet_verilog():
-    cocotb_run.run(build("dlp7000"), toplevel=TOPLEVEL, module="sim.tb.ethernet", key="dlp7000",
+    cocotb_run.run(build("dlp7000"), toplevel=TOPLEVEL, module="sim.tb.ethernet_tb", key="dlp7000",
                    params={"dmd": "dlp7000"})

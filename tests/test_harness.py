@@ -52,7 +52,7 @@ class Counter(wiring.Component):
 @pytest.mark.verilog
 def test_failing_cocotb_test_fails_pytest():
     with pytest.raises(AssertionError, match="1 of 1 cocotb tests failed"):
-        cocotb_run.run(Counter(), toplevel="counter", module="sim.tb.selfcheck", key="selfcheck",
+        cocotb_run.run(Counter(), toplevel="counter", module="sim.tb.selfcheck_tb", key="selfcheck",
                        testcase="wrong_expectation")
 
 
@@ -66,7 +66,7 @@ def test_concurrent_runs_of_one_build_report_their_own_results(tmp_path):
     def run(name, fail):
         start.wait()
         try:
-            cocotb_run.run(Counter(), toplevel="counter", module="sim.tb.selfcheck", key="selfcheck",
+            cocotb_run.run(Counter(), toplevel="counter", module="sim.tb.selfcheck_tb", key="selfcheck",
                            testcase="fail_as_told", params={"cycles": 20_000, "fail": fail},
                            run_dir=tmp_path / name)
             outcome[name] = "passed"

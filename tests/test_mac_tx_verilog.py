@@ -8,4 +8,4 @@ from sim.harness import cocotb_run
 
 @pytest.mark.verilog
 def test_mac_tx_verilog():
-    cocotb_run.run(AxisTransmitter(), toplevel="mac_axis_tx", module="sim.tb.mac_tx", key="default")
+    cocotb_run.run(AxisTransmitter(), toplevel="mac_axis_tx", module="sim.tb.mac_tx_tb", key="default")

@@ -12,7 +12,7 @@ SOURCE = ROOT / "sim" / "hdl" / "mcb_model.v"
 
 
 def run(testcase, plusargs=(), **params):
-    cocotb_run.run(None, toplevel="mcb_model", module="sim.tb.mcb_model", key="default", testcase=testcase,
+    cocotb_run.run(None, toplevel="mcb_model", module="sim.tb.mcb_model_tb", key="default", testcase=testcase,
                    extra_sources=[SOURCE], params=params, plusargs=plusargs)
 
 

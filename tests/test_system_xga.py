@@ -8,7 +8,7 @@ checked on the recorded pins, the image the camera sees exact. Shares its Verila
 
 import pytest
 
-from sim import xga
+from sim.rigs import xga_run as xga
 
 
 @pytest.mark.verilog
@@ -74,7 +74,7 @@ def test_window_holds_back_the_first_frames_last_datagram(tmp_path):
     import numpy as np
 
     from host import codec
-    from sim.scene import default_scene
+    from sim.rigs.scene import default_scene
 
     images = default_scene(3, 96, 128)
     sends, held, query, _ = xga._replay_files(tmp_path, images, hold_last=True)

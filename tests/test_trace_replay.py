@@ -6,14 +6,15 @@ responder and recorder, on replayed sequences, agree with the model."""
 import numpy as np
 import pytest
 
-from sim.fast_top import PLUSARGS, SOURCES, ResponderBench, pin_layout
 from sim.harness import cocotb_run
 from sim.harness.layout import pack
 from sim.harness.paths import build_dir
-from sim.models import gmii, trace
-from sim.models.dlpc410 import RULES, Dlpc410, RuleBreak
+from sim.models import gmii_stim as gmii
+from sim.models import trace
+from sim.models.dlpc410_model import RULES, Dlpc410, RuleBreak
 from sim.models.dlpc410_replay import MODEL_PARAMS, sequences
 from sim.models.dlpc410_replay import NAMES as NAMES_OF_SEQUENCES
+from sim.rigs.fast_system_rig import PLUSARGS, SOURCES, ResponderBench, pin_layout
 from spec.facts import TEST_DMD
 
 LAYOUT = pin_layout(TEST_DMD.buses)
@@ -84,7 +85,7 @@ def test_rising_edges_and_vcd(tmp_path):
 def test_save_file_opens_on_the_markers(tmp_path):
     """The XGA run's GTKWave save file: it opens on the given window (zoomed to fit it), with
     named markers, buses named with their widths as GTKWave names them, in hex."""
-    from sim.system import write_save_file
+    from sim.rigs.system_run import write_save_file
     records = [(0, pack(LAYOUT, {"trigger_in": 0})), (5, pack(LAYOUT, {"trigger_in": 1}))]
     vcd = trace.write_vcd(tmp_path / "w.vcd", records, LAYOUT, start=0, end=10, ns_per_cycle=5)
     save = write_save_file(vcd, {"pins": ["trigger_in", "rowad"]}, "dlpc410", widths={"trigger_in": 1, "rowad": 11},
@@ -118,7 +119,7 @@ def test_responder_and_recorder_verilog(name):
     path = build_dir("cocotb", "responder_bench-test") / f"{name}.txt"
     path.unlink(missing_ok=True)
     bench = ResponderBench(TEST_DMD, [seqs[n] for n in NAMES_OF_SEQUENCES], **RESPONDER_TIMING)
-    cocotb_run.run(bench, toplevel="responder_bench", module="sim.tb.dlpc410_responder", key="test",
+    cocotb_run.run(bench, toplevel="responder_bench", module="sim.tb.dlpc410_responder_tb", key="test",
                    extra_sources=SOURCES, plusargs=[f"+{PLUSARGS['pins']}={path}"],
                    params={"select": NAMES_OF_SEQUENCES.index(name)}, top_signals_only=True)
     reference, replayed = Dlpc410(TEST_DMD, **MODEL_PARAMS), Dlpc410(TEST_DMD, **MODEL_PARAMS)

@@ -1,4 +1,4 @@
-"""The virtual projector (:mod:`sim.virtual`): real host software, installed in a fresh virtual
+"""The virtual projector (:mod:`sim.rigs.virtual_run`): real host software, installed in a fresh virtual
 environment without Amaranth, talks through the operating system's network stack (a namespace
 of its own) to the core's generated Verilog on a TAP device, and the frame it sends is the frame
 the DMD shows. Skipped, with the reason, where the machine does not allow a network namespace and
@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from sim import virtual
+from sim.rigs import virtual_run as virtual
 
 REASON = virtual.unavailable()
 ROOT = Path(__file__).resolve().parents[1]
