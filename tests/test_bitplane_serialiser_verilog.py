@@ -1,4 +1,5 @@
-"""The bit-plane serialiser's generated Verilog under cocotb and Verilator."""
+"""The bit-plane serialiser's generated Verilog under cocotb and Verilator
+(:mod:`sim.tb.serialiser_tb`)."""
 
 import pytest
 

@@ -1,5 +1,6 @@
 """Both adapters of the DLPC410 model: the Amaranth simulator process and the cocotb coroutine on
-the generated Verilog, each fed by the replay component, agree with the model fed directly."""
+the generated Verilog, each fed by the replay component, agree with the model fed directly (the
+cocotb side's testbench: :mod:`sim.tb.dlpc410_replay_tb`)."""
 
 import numpy as np
 import pytest

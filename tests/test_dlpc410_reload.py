@@ -1,7 +1,7 @@
 """The sequencer takes new registers while it rests (:attr:`Sequencer.at_rest`) and, told to
 ``reload``, loads its waiting frame's first plane again under them: the next trigger shows the
 frame exactly as the new registers say, under the rule-checking DLPC410 model (on the generated
-Verilog, :mod:`sim.rigs.seq_rig`, TEST_DMD)."""
+Verilog, :mod:`sim.rigs.seq_rig`, testbench :mod:`sim.tb.seq_rig_tb`, TEST_DMD)."""
 
 import numpy as np
 import pytest

@@ -1,9 +1,9 @@
 """The sequencer (TEST_DMD, TEST_DMD4; at DCLK 400 MHz TEST_DMD_400, TEST_DMD4_400): its command
-stream equals the schedule model's cycle for cycle, and every pixel receives exactly its grey
-level in LSB units, under the rule-checking DLPC410 model. The runs are on the generated Verilog
-(:mod:`sim.rigs.seq_rig`: one Verilator build per geometry, the trace replayed through the model after
-the run); the Amaranth simulator keeps the short tests it is the right tool for, and one scenario
-run on both must give the same run."""
+stream equals the schedule model's cycle for cycle, and every pixel receives exactly its grey level
+in LSB units, under the rule-checking DLPC410 model. The runs are on the generated Verilog
+(:mod:`sim.rigs.seq_rig`, testbench :mod:`sim.tb.seq_rig_tb`: one Verilator build per geometry, the
+trace replayed through the model after the run); the Amaranth simulator keeps the short tests it is
+the right tool for, and one scenario run on both must give the same run."""
 
 from dataclasses import replace
 

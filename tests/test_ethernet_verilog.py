@@ -1,5 +1,6 @@
 """The whole Ethernet side (:class:`gateware.protocol.port.EthernetPort`) on its generated Verilog:
-GMII pins to image rows and counters, replies back to GMII pins, under cocotb and Verilator."""
+GMII pins to image rows and counters, replies back to GMII pins, under cocotb and Verilator
+(:mod:`sim.tb.ethernet_tb`)."""
 
 import pytest
 

@@ -1,4 +1,5 @@
-"""The simulation's fast GMII stimulus: file writer (against scapy and zlib) and Verilog replay."""
+"""The simulation's fast GMII stimulus: file writer (against scapy and zlib) and Verilog replay
+(:mod:`sim.tb.gmii_replay_tb`)."""
 
 import zlib
 

@@ -1,5 +1,6 @@
-"""The harnesses themselves: layouts round-trip, a failing cocotb test fails pytest, and runs of
-one build at the same time (pytest-xdist workers) each report their own result."""
+"""The harnesses themselves: layouts round-trip, a failing cocotb test fails pytest
+(:mod:`sim.tb.selfcheck_tb`), and runs of one build at the same time (pytest-xdist workers) each
+report their own result."""
 
 import random
 import threading

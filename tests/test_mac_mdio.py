@@ -1,4 +1,5 @@
-"""PHY management: reset, then status polls over MDIO, against the clause-22 PHY model."""
+"""PHY management: reset, then status polls over MDIO, against the clause-22 PHY model; on the
+generated Verilog, :mod:`sim.tb.mdio_tb`."""
 
 import pytest
 

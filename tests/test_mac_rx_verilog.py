@@ -1,4 +1,5 @@
-"""The receive MAC's generated Verilog (AXI-Stream wrapper) under cocotb and Verilator."""
+"""The receive MAC's generated Verilog (AXI-Stream wrapper) under cocotb and Verilator
+(:mod:`sim.tb.mac_rx_tb`)."""
 
 import pytest
 

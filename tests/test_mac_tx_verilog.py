@@ -1,4 +1,5 @@
-"""The transmit MAC's generated Verilog (AXI-Stream wrapper) under cocotb and Verilator."""
+"""The transmit MAC's generated Verilog (AXI-Stream wrapper) under cocotb and Verilator
+(:mod:`sim.tb.mac_tx_tb`)."""
 
 import pytest
 

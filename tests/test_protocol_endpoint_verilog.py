@@ -1,4 +1,4 @@
-"""The endpoint's generated Verilog under cocotb and Verilator."""
+"""The endpoint's generated Verilog under cocotb and Verilator (:mod:`sim.tb.endpoint_tb`)."""
 
 import pytest
 

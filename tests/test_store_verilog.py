@@ -1,5 +1,5 @@
 """The store's generated Verilog (serialiser, frame slots, writer, reader) under cocotb and
-Verilator, with the MCB model's cocotb adapter on both ports."""
+Verilator, with the MCB model's cocotb adapter on both ports (:mod:`sim.tb.store_tb`)."""
 
 import pytest
 

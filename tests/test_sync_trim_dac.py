@@ -1,7 +1,7 @@
-"""The VCXO DAC writer (:class:`gateware.sync.trim_dac.TrimDac`) seen through the AD5662's
-interface (:mod:`sim.models.ad5662_model`, written from the data sheet): every write carries the trim
-word of the cycle it began on, whole, in offset binary, within the DAC's timing, at 200 MHz and
-at a slower clock; in the Amaranth simulation and on the generated Verilog."""
+"""The VCXO DAC writer (:class:`gateware.sync.trim_dac.TrimDac`) seen through the AD5662's interface
+(:mod:`sim.models.ad5662_model`, written from the data sheet): every write carries the trim word of
+the cycle it began on, whole, in offset binary, within the DAC's timing, at 200 MHz and at a slower
+clock; in the Amaranth simulation and on the generated Verilog (:mod:`sim.tb.trim_dac_tb`)."""
 
 import random
 

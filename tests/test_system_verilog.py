@@ -1,5 +1,6 @@
 """The projector's core end to end on its generated Verilog: configured, armed and fed over GMII,
-the DLPC410 model out, the status reply read back; faults interleaved (see ``sim/tb/system_tb.py``)."""
+the DLPC410 model out, the status reply read back; faults interleaved (the testbench:
+:mod:`sim.tb.system_tb`)."""
 
 import pytest
 

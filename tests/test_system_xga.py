@@ -4,7 +4,7 @@ stored as a sequence played by an entry table (the second frame, then the first 
 three triggers faster than frames can be shown: the first finds the sequencer ready, the others
 are held and played back to back at the frame starts of the schedule model; every DLPC410 rule
 checked on the recorded pins, the image the camera sees exact. Shares its Verilator build with
-``make sim``."""
+``make sim`` (:func:`sim.rigs.xga_run.run`; the testbench :mod:`sim.tb.fast_system_rig_tb`)."""
 
 import pytest
 

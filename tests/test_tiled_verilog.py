@@ -1,6 +1,6 @@
 """The tiled display on the generated Verilog: a sync master and four boards, each on its own
 crystal (+-100 ppm, one drifting, two jittering), in one Verilator simulation
-(:mod:`sim.rigs.tiled_rig`).
+(:mod:`sim.rigs.tiled_rig`, testbench :mod:`sim.tb.tiled_rig_tb`).
 
 Every board must obey every pulse and play its tile exactly under the rule model, and the
 spread of the boards' clocking pulses must stay inside what the clocks explain: the board's

@@ -1,7 +1,7 @@
 """Pin traces of the fast system run, read back: the DLPC410 replay gives what stepping the model
-every cycle gives, catches a responder that disagrees with the model, and keeps rule breaks;
-GMII transmit traces give back their frames; a window of a trace becomes a VCD. The Verilog
-responder and recorder, on replayed sequences, agree with the model."""
+every cycle gives, catches a responder that disagrees with the model, and keeps rule breaks; GMII
+transmit traces give back their frames; a window of a trace becomes a VCD. The Verilog responder and
+recorder, on replayed sequences, agree with the model (:mod:`sim.tb.dlpc410_responder_tb`)."""
 
 import numpy as np
 import pytest

@@ -1,7 +1,8 @@
-"""The wave window of ``make sim WINDOW=1`` (``sim/hdl/wave_window.v``) on a small design built
-as the XGA run's window build is (tracing, the DPI close): the dump holds value changes only
-while the window is open, every signal inside the design included, and the save file made for it
-(:func:`sim.rigs.system_run.window_groups`) names only signals the dump declares."""
+"""The wave window of ``make sim WINDOW=1`` (``sim/hdl/wave_window.v``) on a small design built as
+the XGA run's window build is (tracing, the DPI close): the dump holds value changes only while the
+window is open, every signal inside the design included, and the save file made for it
+(:func:`sim.rigs.system_run.window_groups`) names only signals the dump declares. The testbench:
+:mod:`sim.tb.wave_window_tb`."""
 
 import re
 

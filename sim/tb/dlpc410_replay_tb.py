@@ -2,6 +2,8 @@
 
 The same cycles fed straight to the model give the reference; through the adapter the legal
 sequence must give the same command log and mirrors, the illegal one the same named rule break.
+
+Run by ``tests/test_dlpc410_adapters.py``.
 """
 
 import cocotb

@@ -1,5 +1,7 @@
-"""cocotb: the DLPC410 responder and the pin recorder (:class:`sim.rigs.fast_system_rig.ResponderBench`) on a
-replayed cycle sequence; the trace is checked by the test afterwards (:mod:`sim.models.trace`)."""
+"""cocotb: the DLPC410 responder and the pin recorder
+(:class:`sim.rigs.fast_system_rig.ResponderBench`) on a replayed cycle sequence; the trace is
+checked afterwards (:mod:`sim.models.trace`) by the test that runs it,
+``tests/test_trace_replay.py``."""
 
 import cocotb
 from cocotb.clock import Clock

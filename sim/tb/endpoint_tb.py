@@ -2,6 +2,8 @@
 
 Frames are MAC byte beats fed with :class:`~sim.harness.cocotb_stream.StreamSource`; the
 expectations come from the reference model; replies are parsed by scapy.
+
+Run by ``tests/test_protocol_endpoint_verilog.py``.
 """
 
 import random

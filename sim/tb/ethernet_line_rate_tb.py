@@ -4,6 +4,9 @@ sent back to back at the minimum gap on the GMII receive pins, then the first re
 ``sync`` at 125 MHz shifted 0.7 ns from the PHY clock, the pixel consumer always ready. Writes
 its figures as JSON to the ``out`` parameter.
 
+Run by the benchmark (:func:`sim.bench.net_figures.port_at_line_rate`, ``make bench``), by no pytest
+test: the Ethernet side's test is ``tests/test_ethernet_verilog.py`` (:mod:`sim.tb.ethernet_tb`).
+
 Payload rate: the pixels of one image over the time from the second image's first pixel handed
 on to the third's: a stream's period, the line's time for every record of a whole image
 (preamble, FCS and gap included, the last short record too). It is taken between the second and

@@ -1,12 +1,14 @@
 """cocotb testbench of the whole Ethernet side (:class:`gateware.protocol.port.EthernetPort`) on its
 generated Verilog: GMII pins in, image rows, counters and GMII replies out.
 
-cocotbext-eth's ``GmiiSource`` drives the receive pins (frames built by scapy and the host
-encoder), ``GmiiSink`` reads the transmit pins. What must come out is predicted by chaining the
-reference models: :func:`sim.models.mac_model.receive` makes of the GMII symbols what the receive MAC
-must hand on, and :class:`sim.models.net_model.Model` what the stack and protocol must do with that.
-Three clocks, none sharing edges with another: ``gmii_rx`` 8 ns, ``gmii_tx`` 8 ns shifted by
-0.3 ns, ``sync`` 7.5 ns (133 MHz) by default.
+cocotbext-eth's ``GmiiSource`` drives the receive pins (frames built by scapy and the host encoder),
+``GmiiSink`` reads the transmit pins. What must come out is predicted by chaining the reference
+models: :func:`sim.models.mac_model.receive` makes of the GMII symbols what the receive MAC must
+hand on, and :class:`sim.models.net_model.Model` what the stack and protocol must do with that.
+Three clocks, none sharing edges with another: ``gmii_rx`` 8 ns, ``gmii_tx`` 8 ns shifted by 0.3 ns,
+``sync`` 7.5 ns (133 MHz) by default.
+
+Run by ``tests/test_ethernet_verilog.py``.
 """
 
 import logging

@@ -4,7 +4,8 @@ Python does not run per cycle here: the clocks are cocotb's C clocks, GMII comes
 file, the memory and the DLPC410 responder are Verilog, the pins go to trace files. This
 testbench only starts each replay, raises the trigger at chosen instants and waits on edges of
 ``replay_busy`` or on timers; the checks are made after the run on the traces
-(:mod:`sim.rigs.xga_run`).
+(:mod:`sim.rigs.xga_run`). Run by :func:`sim.rigs.xga_run.run` and :func:`~sim.rigs.xga_run.stream`
+(``make sim``) and so by ``tests/test_system_xga.py``.
 
 Sequence: a control record makes the store keep the frames as a sequence; the frames are sent;
 ``one_by_one`` frames are triggered, each once the one before has been shown and the next one
@@ -198,8 +199,8 @@ async def stream_frames(dut):
 
 @cocotb.test()
 async def stream_new_frames(dut):
-    """A new frame at every trigger (:func:`sim.rigs.xga_run.stream`): the first frame sent and left to
-    settle, then a trigger every ``trigger_period_cycles``; right after each trigger the next
+    """A new frame at every trigger (:func:`sim.rigs.xga_run.stream`): the first frame sent and left
+    to settle, then a trigger every ``trigger_period_cycles``; right after each trigger the next
     frame goes over GMII, while the one triggered is shown."""
     p = params()
     run = Run(dut, p)

@@ -1,4 +1,4 @@
-"""cocotb: the GMII replay plays its file cycle for cycle."""
+"""cocotb: the GMII replay plays its file cycle for cycle (run by ``tests/test_gmii_replay.py``)."""
 
 import cocotb
 from cocotb.clock import Clock

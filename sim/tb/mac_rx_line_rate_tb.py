@@ -1,7 +1,10 @@
 """cocotb benchmark run of the receive path's Verilog: hundreds of frames, jumbo ones among them,
 at line rate with the minimum gap, into a ``sync`` consumer that is always ready but clocked
 250 ppm slower than the PHY (beyond the worst crystal pairing). Writes its figures as JSON to the
-``out`` parameter."""
+``out`` parameter.
+
+Run by the benchmark (:func:`sim.bench.mac_figures.line_rate`, ``make bench``), by no pytest test:
+the receive MAC's test is ``tests/test_mac_rx_verilog.py`` (:mod:`sim.tb.mac_rx_tb`)."""
 
 import json
 

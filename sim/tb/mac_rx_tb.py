@@ -1,6 +1,10 @@
-"""cocotb testbench of the receive MAC's generated Verilog (:class:`gateware.mac.axis.AxisReceiver`):
-cocotbext-eth's GmiiSource on the pins, cocotbext-axi's AxiStreamSink on ``m_axis_*``, frames built
-by scapy, verdicts checked against :func:`sim.models.mac_model.receive`."""
+"""cocotb testbench of the receive MAC's generated Verilog
+(:class:`gateware.mac.axis.AxisReceiver`): cocotbext-eth's GmiiSource on the pins, cocotbext-axi's
+AxiStreamSink on ``m_axis_*``, frames built by scapy, verdicts checked against
+:func:`sim.models.mac_model.receive`.
+
+Run by ``tests/test_mac_rx_verilog.py``.
+"""
 
 import itertools
 

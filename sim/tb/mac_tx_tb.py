@@ -3,6 +3,8 @@ cocotbext-axi's AxiStreamSource on ``s_axis_*`` (``sync``), cocotbext-eth's Gmii
 
 GmiiSink does not keep the first byte of a burst (the first preamble byte), so frames are
 compared by their payload after the SFD, never by raw offsets.
+
+Run by ``tests/test_mac_tx_verilog.py``.
 """
 
 import itertools

@@ -13,6 +13,8 @@ records the master must drop (each cause, every bad value, each with the trigger
 pulse, nothing applied), one to another UDP port, one with a sequence gap; the periodic mode
 (the pulses ``period`` apart); the trigger pin; the button. The status reply then equals the
 model's, field by field.
+
+Run by ``tests/test_sync_master_port.py``.
 """
 
 import cocotb

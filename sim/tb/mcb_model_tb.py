@@ -5,6 +5,8 @@ ports (64 bits on port 0, 128 on port 1): the words it reads back must agree. Sc
 breaks, one per port and run (the Verilog fault code is sticky), must give the rule the Python
 model names; so must a calibration loss (:class:`sim.models.mcb_client.LossClient`), with the
 same FIFOs before and after it and the same words read back.
+
+Run by ``tests/test_mcb_verilog_model.py``.
 """
 
 import cocotb

@@ -1,4 +1,5 @@
-"""cocotb: the PHY management block's Verilog against the clause-22 PHY model."""
+"""cocotb: the PHY management block's Verilog against the clause-22 PHY model (run by
+``tests/test_mac_mdio.py``)."""
 
 import cocotb
 from cocotb.clock import Clock

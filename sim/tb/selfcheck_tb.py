@@ -1,5 +1,6 @@
 """cocotb tests that fail: proof that a failing cocotb test fails the pytest that ran it, and that
-concurrent runs of one build report their own results."""
+concurrent runs of one build report their own results. Run by
+``tests/test_harness.py``."""
 
 import cocotb
 from cocotb.clock import Clock

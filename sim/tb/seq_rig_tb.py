@@ -6,6 +6,11 @@ and the responder's timing, then plays a short script of steps, each one await o
 an edge of a port, and writes what it observed to the report; the checks are made afterwards on
 the trace (:func:`sim.rigs.seq_rig.analyse`).
 
+Run through :func:`sim.rigs.seq_rig.run_rig` by the sequencer's tests on its generated Verilog:
+``tests/test_dlpc410_sequencer.py``, ``tests/test_dlpc410_sequencer_verilog.py``,
+``tests/test_dlpc410_entries.py``, ``tests/test_dlpc410_ready.py``, ``tests/test_dlpc410_reload.py``
+and ``tests/test_camera_misalignment.py``; and by the rate benchmarks.
+
 Steps (the script's entries), written as the Amaranth testbench they replace would do them;
 between steps the testbench stands in the middle of a cycle, where the cycle's values are
 settled and an input set is sampled at the cycle's end:

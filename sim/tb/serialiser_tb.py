@@ -1,4 +1,5 @@
-"""cocotb testbench of the bit-plane serialiser's generated Verilog."""
+"""cocotb testbench of the bit-plane serialiser's generated Verilog (run by
+``tests/test_bitplane_serialiser_verilog.py``)."""
 
 import random
 

@@ -1,5 +1,5 @@
 """cocotb testbench of the store's generated Verilog (serialiser, slots, writer, reader) with the
-MCB model on both ports, against numpy."""
+MCB model on both ports, against numpy. Run by ``tests/test_store_verilog.py``."""
 
 import cocotb
 from amaranth.lib import data

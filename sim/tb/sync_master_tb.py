@@ -1,7 +1,9 @@
 """cocotb testbench of the sync master's generated Verilog: random software triggers and ready
 lines, each board not ready now and then; every obeyed trigger must give one pulse of ``width``
-cycles on every board's line at once and on the camera line, the cycle after the trigger, and
-every refused one must be counted under its cause (:class:`sim.models.sync_master_model.SyncMasterModel`).
+cycles on every board's line at once and on the camera line, the cycle after the trigger, and every
+refused one must be counted under its cause (:class:`sim.models.sync_master_model.SyncMasterModel`).
+
+Run by ``tests/test_sync_master_verilog.py``.
 """
 
 import random

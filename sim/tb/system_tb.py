@@ -1,6 +1,7 @@
 """cocotb testbench of the projector's core (generated Verilog): configured, armed and fed over
-GMII, triggered, the DLPC410 model on the pins, the camera's image compared with what was sent,
-and the status reply read back from the GMII transmit pins.
+GMII, triggered, the DLPC410 model on the pins, the camera's image compared with what was sent, and
+the status reply read back from the GMII transmit pins. Run through :func:`sim.rigs.system_run.run`
+by ``tests/test_system_verilog.py``.
 
 Clocks: ``sync``, ``gmii_rx``, ``gmii_tx`` at 125 MHz and ``dmd`` at 200 MHz, started at
 fractions of a nanosecond from each other so that no two domains' edges coincide. The MCB model

@@ -5,6 +5,9 @@ the boards' registers and responders, waits for every board to be ready (initial
 plane loaded), arms the master and then looks in once a frame period until the master has sent
 its pulses; a frame period later (the last frame played out) it flushes the recorders and writes
 the counters to the report. The figures are made afterwards from the recorded times.
+
+Run through :func:`sim.rigs.tiled_rig.run_tiled` by ``tests/test_tiled_verilog.py`` and the sync
+benchmark (:mod:`sim.bench.sync_figures`).
 """
 
 import json

@@ -1,6 +1,8 @@
 """cocotb testbench of the VCXO DAC writer's generated Verilog: trim words changing now and then
 (some during a write), the lines sampled every cycle through the AD5662's interface model
 (:class:`sim.models.ad5662_model.TrimWrites`): every write whole, the word of the cycle it began on.
+
+Run by ``tests/test_sync_trim_dac.py``.
 """
 
 import random

@@ -1,9 +1,12 @@
 """cocotb testbench: the sync master's core (:class:`gateware.top.sync_master.SyncMasterCore`,
-generated Verilog) as a virtual sync master on a TAP interface (:mod:`sim.rigs.virtual_run` makes the
-namespace and the TAP; the frames cross as :func:`sim.tb.virtual_projector_tb.bridge` carries them). Every
-board is ready; the pulses on the sync and camera lines are read every cycle
+generated Verilog) as a virtual sync master on a TAP interface (:mod:`sim.rigs.virtual_run` makes
+the namespace and the TAP; the frames cross as :func:`sim.tb.virtual_projector_tb.bridge` carries
+them). Every board is ready; the pulses on the sync and camera lines are read every cycle
 (:class:`sim.tb.master_core_tb.Pulses`: all at once, each as long as the others) and reported with
-their lengths when the run stops."""
+their lengths when the run stops.
+
+Run by :func:`sim.rigs.virtual_run.master_demo` and so by ``tests/test_virtual_projector.py``.
+"""
 
 import json
 from pathlib import Path

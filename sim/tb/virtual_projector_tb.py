@@ -18,6 +18,9 @@ the mirrors from the frame's first clocking pulse, and the frame is written as a
 frame's bit depth; both are those of the newest sequencer and control records seen on the wire).
 The testbench ends when the wall-clock time ``seconds`` has passed or the file ``stop`` exists,
 and writes a report.
+
+Run by :mod:`sim.rigs.virtual_run` (``make sim VIRTUAL=...``) and so by
+``tests/test_virtual_projector.py``.
 """
 
 import fcntl
