@@ -1,6 +1,7 @@
-"""Rigs and runs: whole simulations of generated Verilog with no Python per cycle.
+"""Rigs and runs: whole-system simulations.
 
-A rig (``*_rig``) is a generated top with its surroundings in Verilog, built once with Verilator
-and driven by a cocotb testbench of ``sim/tb`` (``<rig>_tb``); a run (``*_run``) is what
-``make sim`` plays on them; :mod:`.scene` is the scene the runs show.
+A rig (``*_rig``) is a generated top with its surroundings in Verilog, built once with Verilator,
+no Python per cycle, and driven by a cocotb testbench of ``sim/tb`` (``<rig>_tb``); a run
+(``*_run``) is a whole-system simulation as ``make sim`` makes it; :mod:`.scene` is the scene the
+runs show.
 """
