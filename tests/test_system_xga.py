@@ -4,11 +4,11 @@ stored as a sequence played by an entry table (the second frame, then the first 
 three triggers faster than frames can be shown: the first finds the sequencer ready, the others
 are held and played back to back at the frame starts of the schedule model; every DLPC410 rule
 checked on the recorded pins, the image the camera sees exact. Shares its Verilator build with
-``make sim``."""
+``make sim`` (:func:`sim.rigs.xga_run.run`; the testbench :mod:`sim.tb.fast_system_rig_tb`)."""
 
 import pytest
 
-from sim import xga
+from sim.rigs import xga_run as xga
 
 
 @pytest.mark.verilog
@@ -74,7 +74,7 @@ def test_window_holds_back_the_first_frames_last_datagram(tmp_path):
     import numpy as np
 
     from host import codec
-    from sim.scene import default_scene
+    from sim.rigs.scene import default_scene
 
     images = default_scene(3, 96, 128)
     sends, held, query, _ = xga._replay_files(tmp_path, images, hold_last=True)

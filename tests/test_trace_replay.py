@@ -1,7 +1,7 @@
 """Pin traces of the fast system run, read back: the DLPC410 replay gives what stepping the model
-every cycle gives, catches a responder that disagrees with the model, and keeps rule breaks;
-GMII transmit traces give back their frames; a window of a trace becomes a VCD. The Verilog
-responder and recorder, on replayed sequences, agree with the model."""
+every cycle gives, catches a responder that disagrees with the model, and keeps rule breaks; GMII
+transmit traces give back their frames; a window of a trace becomes a VCD. The Verilog responder and
+recorder, on replayed sequences, agree with the model (:mod:`sim.tb.dlpc410_responder_tb`)."""
 
 import os
 import shutil
@@ -10,14 +10,15 @@ import subprocess
 import numpy as np
 import pytest
 
-from sim.fast_top import PLUSARGS, SOURCES, ResponderBench, pin_layout
 from sim.harness import cocotb_run
 from sim.harness.layout import pack
 from sim.harness.paths import build_dir
-from sim.models import gmii, trace
-from sim.models.dlpc410 import RULES, Dlpc410, RuleBreak
+from sim.models import gmii_stim as gmii
+from sim.models import trace
+from sim.models.dlpc410_model import RULES, Dlpc410, RuleBreak
 from sim.models.dlpc410_replay import MODEL_PARAMS, sequences
 from sim.models.dlpc410_replay import NAMES as NAMES_OF_SEQUENCES
+from sim.rigs.fast_system_rig import PLUSARGS, SOURCES, ResponderBench, pin_layout
 from spec.facts import TEST_DMD
 
 LAYOUT = pin_layout(TEST_DMD.buses)
@@ -93,7 +94,7 @@ def _pins_vcd(tmp_path):
 def test_save_file_opens_on_the_markers(tmp_path):
     """The XGA run's GTKWave save file: it opens on the given window (zoomed to fit it), with
     named markers, buses named with their widths as GTKWave names them, in hex."""
-    from sim.system import GTKWAVE_WAVE_PIXELS, write_save_file
+    from sim.rigs.system_run import GTKWAVE_WAVE_PIXELS, write_save_file
     span = 5 * 2**12                                 # 1000 pixels of 20.48 units: zoom -12
     save = write_save_file(_pins_vcd(tmp_path), {"pins": ["trigger_in", "rowad"]}, "dlpc410",
                            widths={"trigger_in": 1, "rowad": 11}, view=(1000, 1000 + span),
@@ -111,7 +112,7 @@ def test_save_file_opens_on_the_markers(tmp_path):
 
 @pytest.mark.parametrize("span", [1, 335_000, 16_250_000, 3_550_000_000])
 def test_gtkwave_zoom_fits_the_span(span):
-    from sim.system import gtkwave_span, gtkwave_zoom
+    from sim.rigs.system_run import gtkwave_span, gtkwave_zoom
     assert gtkwave_span(gtkwave_zoom(span)) == pytest.approx(span)
     assert gtkwave_span(gtkwave_zoom(span, 500), 500) == pytest.approx(span)
 
@@ -119,7 +120,7 @@ def test_gtkwave_zoom_fits_the_span(span):
 def test_pin_view_holds_the_trigger_and_the_first_pulse_apart():
     """The XGA run's view: the trigger and the first pulse with a margin each side, far enough
     apart in 1000 pixels to tell them apart, whether the pulse comes 7 or 5000 cycles after."""
-    from sim.xga import WAVE_MARGIN, WAVE_WINDOW, _waves_view
+    from sim.rigs.xga_run import WAVE_MARGIN, WAVE_WINDOW, _waves_view
 
     def ps(cycle):
         return cycle * 5000
@@ -135,7 +136,7 @@ def test_pin_view_holds_the_trigger_and_the_first_pulse_apart():
 def test_gtkwave_opens_on_the_view(tmp_path):
     """GTKWave itself (under Xvfb, when both are installed) opens the save file with the view's
     start at the wave pane's left edge and its end inside the pane, at most a tenth more past it."""
-    from sim.system import write_save_file
+    from sim.rigs.system_run import write_save_file
     if not (shutil.which("gtkwave") and shutil.which("Xvfb")):
         pytest.skip("gtkwave or Xvfb not installed")
     records = [(0, pack(LAYOUT, {"trigger_in": 0})), (1000, pack(LAYOUT, {"trigger_in": 1})),
@@ -183,7 +184,7 @@ def test_responder_and_recorder_verilog(name):
     path = build_dir("cocotb", "responder_bench-test") / f"{name}.txt"
     path.unlink(missing_ok=True)
     bench = ResponderBench(TEST_DMD, [seqs[n] for n in NAMES_OF_SEQUENCES], **RESPONDER_TIMING)
-    cocotb_run.run(bench, toplevel="responder_bench", module="sim.tb.dlpc410_responder", key="test",
+    cocotb_run.run(bench, toplevel="responder_bench", module="sim.tb.dlpc410_responder_tb", key="test",
                    extra_sources=SOURCES, plusargs=[f"+{PLUSARGS['pins']}={path}"],
                    params={"select": NAMES_OF_SEQUENCES.index(name)}, top_signals_only=True)
     reference, replayed = Dlpc410(TEST_DMD, **MODEL_PARAMS), Dlpc410(TEST_DMD, **MODEL_PARAMS)
