@@ -220,8 +220,9 @@ def binary():
     allowed = schedule.FABRIC_HZ / (dmd.rows * row_period)
     figures = {
         "seq.binary_row_period_cycles_memory_model": (
-            row_period, "cycle", "model: the system run's plan (sim.rigs.xga_run.plan) at DCLK 400 MHz, its row period from "
-                                 "the MCB timing model's read rate under GigE ingest (sim.rigs.fast_system_rig.read_rate)"),
+            row_period, "cycle", "model: the system run's plan (sim.rigs.xga_run.plan) at DCLK 400 MHz, its row period "
+                                 "from the MCB timing model's read rate under GigE ingest "
+                                 "(sim.rigs.fast_system_rig.read_rate)"),
         # (the stand-in's own pace: a bound of the plan's, not of the memory's)
         "seq.binary_rate_hz_at_plan_row_period_model": (
             allowed, "Hz", "arithmetic: 200 MHz / (DLP7000 rows x seq.binary_row_period_cycles_memory_model)"),

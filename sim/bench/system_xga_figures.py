@@ -92,8 +92,8 @@ def binary_memory():
     run = XGA_SOURCE.format(what=f"DLP7000, 1-bit patterns chained from the store ({mode} reset), "
                                  f"{len(r['frames_shown'])} patterns of {xga.BINARY_FRAMES} frames, the later frames "
                                  f"sent over GMII at line rate while the patterns play, each pattern exact", name=name)
-    allowed_source = ("model: the MCB timing model's sustained bandwidth (sim.models.mcb_model.McbTiming: peak x efficiency, "
-                      "refresh taken off) less the store's writes of 1-bit frames at the GMII line rate "
+    allowed_source = ("model: the MCB timing model's sustained bandwidth (sim.models.mcb_model.McbTiming: peak x "
+                      "efficiency, refresh taken off) less the store's writes of 1-bit frames at the GMII line rate "
                       "(sim.rigs.xga_run.BINARY_INGEST_BYTES_PER_S), over a DLP7000 pattern's bytes")
     words = read_rate(timing, xga.DMD_HZ, xga.BINARY_INGEST_BYTES_PER_S)
     return {
