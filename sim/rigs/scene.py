@@ -26,3 +26,24 @@ def default_scene(frames, rows=768, columns=1024, seed=0):
         image = np.clip(np.maximum(background + texture, target), 0, 255)
         images.append(np.rint(image).astype(np.uint8))
     return images
+
+
+def main(argv=None):
+    """``python -m sim.rigs.scene scene.png [rows columns]``: the scene's first frame as a PNG, for
+    the host quick start (the virtual projector is 96 x 128)."""
+    import argparse
+
+    from PIL import Image
+
+    parser = argparse.ArgumentParser(prog="python -m sim.rigs.scene", description=main.__doc__)
+    parser.add_argument("path")
+    parser.add_argument("rows", type=int, nargs="?", default=96)
+    parser.add_argument("columns", type=int, nargs="?", default=128)
+    args = parser.parse_args(argv)
+    Image.fromarray(default_scene(1, args.rows, args.columns)[0]).save(args.path)
+    print(f"wrote {args.path}: {args.rows} x {args.columns}, 8-bit grey")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
