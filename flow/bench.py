@@ -34,7 +34,7 @@ KINDS = ("gateware", "synthesis", "formal", "host", "document", "model")
 ARITHMETIC = "arithmetic"
 #: Sources of benchmark modules that give ``(value, unit)`` and have no ``SOURCE`` of their own.
 SOURCES = {
-    "sim.bench.formal": "formal: SymbiYosys on the gateware, every property of sim.formal.suite at its full "
+    "sim.bench.formal_figures": "formal: SymbiYosys on the gateware, every property of sim.formal.suite at its full "
                         "depth (as make formal)",
 }
 #: The figures :func:`collect` adds about the others' sources (both must be 0).

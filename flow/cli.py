@@ -41,7 +41,8 @@ def main(argv=None):
     sim.add_argument("--dmd", default="dlp7000", choices=("dlp7000", "dlp9500"),
                      help="the DMD the core is built for (default dlp7000; dlp9500: four buses)")
     sim.add_argument("--faults", choices=("stalls", "rst", "all"), default=None,
-                     help="memory stalls at random, RST_ACTIVE held longer than planned, or both (sim.xga.FAULTS)")
+                     help="memory stalls at random, RST_ACTIVE held longer than planned, or both "
+                          "(sim.rigs.xga_run.FAULTS)")
     sim.add_argument("--group-orders", type=float, default=None, metavar="SECONDS",
                      help="play the constraint solver's plan, dual reset's groups each in a plane order of its own "
                           "(spec.group_orders), searched this long (kept in build/plans for later runs)")
@@ -51,7 +52,7 @@ def main(argv=None):
                           "a GTKWave save file grouped by block")
     sim.add_argument("--virtual", default=None, metavar="SECONDS|demo",
                      help="the virtual projector: the small core on a TAP in a network namespace of its own, for "
-                          "that many seconds, or 'demo' (the host CLI talks to it); needs root (sim.virtual)")
+                          "that many seconds, or 'demo' (the host CLI talks to it); needs root (sim.rigs.virtual_run)")
     sub.add_parser("waves", help="say where the latest VCD and its GTKWave save file are")
     args = parser.parse_args(argv)
 
@@ -79,7 +80,7 @@ def main(argv=None):
             print(error, file=sys.stderr)
             return 2
     if args.command == "sim" and args.virtual:
-        from sim import virtual
+        from sim.rigs import virtual_run as virtual
         if args.virtual != "demo":
             return virtual.main(float(args.virtual))
         try:
@@ -89,7 +90,7 @@ def main(argv=None):
             return 2
         return 0 if report.get("max_error_lsb") == 0 else 1
     if args.command == "sim":
-        from sim.system import main as run
+        from sim.rigs.system_run import main as run
         return run(frames=args.frames, dclk_hz=args.dclk * 1e6, faults=args.faults, window=args.window,
                    dmd=args.dmd, group_orders=args.group_orders)
     if args.command == "waves":

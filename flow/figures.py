@@ -1,18 +1,60 @@
-"""``make figures``: ``docs/figures.md`` from ``build/bench.json``, a table per figure prefix.
+"""``make figures``: ``docs/figures.md`` from ``build/bench.json``, a table per figure prefix,
+and the README's headline figures.
 
 ``build/bench.json`` is what ``make bench`` writes (:mod:`flow.bench`): every figure with its
 value, unit and source. The prefix is a figure name's part before its first dot (``eth``,
 ``seq``, ``sys``, ``store``, ...); each table lists its figures in name order with their value,
-unit and source.
+unit and source. The README quotes a few of them (:data:`HEADLINES`) between its markers, so that
+no figure in it is copied by hand; a test holds the README's block to ``docs/figures.md``.
 """
 
 import json
+import re
 from pathlib import Path
 
-__all__ = ["render", "write", "main", "HEADER"]
+__all__ = ["render", "write", "main", "HEADER", "HEADLINES", "headlines", "parse", "README_BEGIN", "README_END"]
 
 HEADER = ("Written by `python -m flow figures` from `build/bench.json` (the output of `make bench`); "
           "do not edit by hand.")
+
+
+#: The figures the README quotes: (what it is, figure name).
+HEADLINES = (
+    ("8-bit frames back to back on the DLP7000 at DCLK 400 MHz, on the pins", "sys.xga_rate_hz_measured"),
+    ("the same, the schedule model's period for the plan", "sys.xga_rate_hz_model"),
+    ("trigger pin to the first clocking pulse, worst", "sys.xga_trigger_latency_cycles_worst"),
+    ("grey error of every frame under the camera model, largest", "sys.xga_gray_error_lsb_max"),
+    ("a new frame at every trigger, streamed as deltas over GigE", "sys.xga_new_frames_per_s_streamed"),
+    ("the same, every frame whole (GigE-bound)", "sys.xga_new_frames_per_s_streamed_whole"),
+    ("binary patterns from the store while GigE writes, slowest period", "seq.binary_rate_hz_memory"),
+    ("8-bit frames back to back on the DLP9500 (one memory bank), on the pins", "sys.dlp9500_rate_hz_measured"),
+)
+README_BEGIN, README_END = "<!-- headline figures: written by make figures -->", "<!-- end of headline figures -->"
+
+
+def headlines(figures):
+    """The README's block of :data:`HEADLINES` from ``figures`` (as :func:`render` takes them);
+    a figure the run did not give is said to be missing."""
+    lines = ["| what | figure | value |", "|---|---|---|"]
+    for what, name in HEADLINES:
+        entry = figures.get(name)
+        value = "missing from the last make bench" if entry is None else \
+            f"{_cell(_value(entry.get('value')))} {_cell(entry.get('unit', ''))}".strip()
+        lines.append(f"| {what} | `{name}` | {value} |")
+    return "\n".join(lines)
+
+
+def parse(markdown):
+    """The figures of a page :func:`render` wrote: ``{name: {"value", "unit", "source"}}``, the
+    values as the page shows them (text)."""
+    figures = {}
+    for line in markdown.splitlines():
+        if line.startswith("| `"):
+            cells = [cell.strip() for cell in re.split(r"(?<!\\)\|", line)[1:-1]]
+            if len(cells) == 4:
+                name, value, unit, source = cells
+                figures[name.strip("`")] = {"value": value, "unit": unit, "source": source}
+    return figures
 
 
 def _cell(text):
@@ -42,9 +84,10 @@ def render(figures):
     return "\n".join(lines)
 
 
-def write(bench="build/bench.json", out="docs/figures.md"):
-    """Read ``bench`` and write ``out``; returns its path. FileNotFoundError if ``bench`` is
-    missing (``make bench`` writes it)."""
+def write(bench="build/bench.json", out="docs/figures.md", readme=None):
+    """Read ``bench`` and write ``out``, and the headline block of ``readme`` if given (between
+    its markers); returns the path of ``out``. FileNotFoundError if ``bench`` is missing (``make
+    bench`` writes it)."""
     bench, out = Path(bench), Path(out)
     if not bench.is_file():
         raise FileNotFoundError(f"{bench} not found: run `make bench` (python -m flow bench) first, it writes "
@@ -54,10 +97,17 @@ def write(bench="build/bench.json", out="docs/figures.md"):
         raise ValueError(f"{bench} is not a bench.json of make bench: {{figure: {{value, unit, source}}}}")
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(render(figures))
+    if readme is not None and Path(readme).is_file():
+        readme = Path(readme)
+        text = readme.read_text()
+        if README_BEGIN in text and README_END in text:
+            head, rest = text.split(README_BEGIN, 1)
+            _, tail = rest.split(README_END, 1)
+            readme.write_text(f"{head}{README_BEGIN}\n{headlines(figures)}\n{README_END}{tail}")
     return out
 
 
-def main(bench="build/bench.json", out="docs/figures.md"):
-    path = write(bench, out)
-    print(f"wrote {path}")
+def main(bench="build/bench.json", out="docs/figures.md", readme="README.md"):
+    path = write(bench, out, readme)
+    print(f"wrote {path} and the headline figures of {readme}")
     return 0

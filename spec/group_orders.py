@@ -21,12 +21,12 @@ CP-SAT, the ``solver`` extra) under :class:`Terms`:
 
 :func:`terms` gives the facts table's terms (no margins: the solver's figures beside the bound);
 :func:`sequencer_terms` the sequencer's own (its RST_ACTIVE with margin, hide threshold and dark
-gap). :func:`find` searches under the sequencer's terms and hands the plan to the schedule
-model's sequencer (:func:`spec.schedule.simulate`: its load queue as it is, row by row), which
-must play it with no pulse late: the register set it returns is one the gateware plays cycle for
-cycle as the model does. The search is parallel with a time limit: what it finds may differ
-from run to run; its lower bound is proved. ``sim.bench.group_orders`` checks the solver's plans
-with code that shares nothing with it.
+gap). :func:`find` searches under the sequencer's terms and hands the plan to the schedule model's
+sequencer (:func:`spec.schedule.simulate`: its load queue as it is, row by row), which must play it
+with no pulse late: the register set it returns is one the gateware plays cycle for cycle as the
+model does. The search is parallel with a time limit: what it finds may differ from run to run; its
+lower bound is proved. ``sim.bench.group_orders_figures`` checks the solver's plans with code that
+shares nothing with it.
 """
 
 import math

@@ -1,8 +1,8 @@
 """The network headers the stack reads and writes: one table each, and their constants.
 
 Tables as in :mod:`spec.wire` (``(name, width in bits)``, wire order); offsets are bytes from the
-first byte of the Ethernet frame. The gateware's checkers and reply builders
-(:mod:`gateware.net`) and the reference model (:mod:`sim.models.net`) both take them from here.
+first byte of the Ethernet frame. The gateware's checkers and reply builders (:mod:`gateware.net`)
+and the reference model (:mod:`sim.models.net_model`) both take them from here.
 """
 
 from .wire import size

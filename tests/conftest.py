@@ -25,6 +25,7 @@ _started = time.monotonic()
 #: last long one.
 LONGEST_FIRST = (
     "test_system_xga.py::test_xga_frames_end_to_end",
+    "test_system_xga.py::test_binary_patterns_from_the_store_while_gige_writes",
     "test_system_verilog.py::test_system_small_geometry",
     "test_tiled_verilog.py::test_tiled_boards_follow_the_master",
     "test_system_verilog.py::test_system_sequence_entries",

@@ -215,7 +215,7 @@ def test_figures_doc_needs_bench_json(tmp_path, monkeypatch, capsys):
 # -- the real modules, read with ast -------------------------------------------------------------
 
 #: Every module whose figures ``make bench`` collects (group orders' through the rates bench).
-BENCH_MODULES = [*MODULES, "sim.bench.group_orders"]
+BENCH_MODULES = [*MODULES, "sim.bench.group_orders_figures"]
 _FIGURE = re.compile(r"^[a-z_0-9]+\.")
 
 
@@ -283,7 +283,7 @@ def test_every_figure_a_bench_module_gives_has_a_source(name):
         return                      # (its figures come from elsewhere; its SOURCE is here)
     tree = ast.parse(inspect.getsource(module))
     sites = [(key, value) for key, value in _figure_sites(tree) if _is_figure(key, value)]
-    if name != "sim.bench.group_orders":
+    if name != "sim.bench.group_orders_figures":
         assert sites, f"{name}: no figure found"
     for key, value in sites:
         where = f"{name}:{value.lineno}"
@@ -299,3 +299,22 @@ def test_every_figure_a_bench_module_gives_has_a_source(name):
         if kind == "model" and isinstance(key, (ast.Constant, ast.JoinedStr, ast.BinOp)):
             assert any("_model" in s for s in _strings(key)), \
                 f"{where}: a model's figure without _model in its name ({ast.unparse(key)})"
+
+
+def test_figures_write_the_readmes_headline_block_only(tmp_path):
+    """``make figures`` writes the README's headline figures between its markers and leaves the
+    rest of the page alone; a headline the run did not give is said to be missing."""
+    data = {"sys.xga_rate_hz_measured": {"value": 280.89, "unit": "Hz", "source": "gateware: run"}}
+    bench_json = tmp_path / "bench.json"
+    bench_json.write_text(json.dumps(data))
+    readme = tmp_path / "README.md"
+    readme.write_text(f"before\n{figures_doc.README_BEGIN}\nstale\n{figures_doc.README_END}\nafter\n")
+    figures_doc.write(bench_json, tmp_path / "figures.md", readme)
+    text = readme.read_text()
+    assert text.startswith("before\n") and text.endswith(f"{figures_doc.README_END}\nafter\n")
+    assert "stale" not in text and "| `sys.xga_rate_hz_measured` | 280.89 Hz |" in text
+    assert text.count("missing from the last make bench") == len(figures_doc.HEADLINES) - 1
+    # the page's figures read back as they were written
+    page = figures_doc.parse((tmp_path / "figures.md").read_text())
+    assert page == {"sys.xga_rate_hz_measured": {"value": "280.89", "unit": "Hz", "source": "gateware: run"}}
+

@@ -7,7 +7,8 @@ import pytest
 
 from gateware.bitplane import Serialiser
 from sim.harness.amaranth_sim import simulate, stream_collect, stream_feed
-from sim.models import bitplane, serialiser_stim
+from sim.models import bitplane_model as bitplane
+from sim.models import serialiser_stim
 from spec.facts import TEST_DMD
 
 
@@ -89,7 +90,7 @@ def test_full_throughput_8_lanes(test_name):
 def test_pixels_per_cycle_figure():
     """The figure ``serialiser.pixels_per_cycle`` as the benchmark measures it, checked here
     against what 8 lanes must give (one 64-pixel run = 8 cycles in, 8 words out)."""
-    from sim.bench.bitplane import serialiser_throughput
+    from sim.bench.bitplane_figures import serialiser_throughput
     figure = serialiser_throughput(lanes=8, rows=4)
     # 4 rows of 1024 pixels = 512 input beats, plus the last run's 8 words draining after it
     assert figure["cycles"] == 512 + 8

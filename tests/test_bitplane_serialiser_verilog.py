@@ -1,4 +1,5 @@
-"""The bit-plane serialiser's generated Verilog under cocotb and Verilator."""
+"""The bit-plane serialiser's generated Verilog under cocotb and Verilator
+(:mod:`sim.tb.serialiser_tb`)."""
 
 import pytest
 
@@ -12,5 +13,5 @@ from spec.facts import DMDS
 def test_serialiser_verilog(lanes):
     dmd = "test"
     cocotb_run.run(Serialiser(DMDS[dmd], lanes=lanes), toplevel="bitplane_serialiser",
-                   module="sim.tb.serialiser", key=f"{dmd}-{lanes}",
+                   module="sim.tb.serialiser_tb", key=f"{dmd}-{lanes}",
                    params={"dmd": dmd, "lanes": lanes})

@@ -1,12 +1,13 @@
-"""The camera misalignment experiment (:mod:`sim.bench.camera`) on the sequencer's generated
-Verilog: a window holding the frame sees every level exact; a window lagging an MSB-first frame
-by a tenth of it loses the MSB's share from every level of 128 and up (the jump at 128), much
-less below; leading it loses only the low planes' share at the end of the frame."""
+"""The camera misalignment experiment (:mod:`sim.bench.camera_figures`) on the sequencer's generated
+Verilog (the sequencer rig, testbench :mod:`sim.tb.seq_rig_tb`): a window holding the frame sees
+every level exact; a window lagging an MSB-first frame by a tenth of it loses the MSB's share from
+every level of 128 and up (the jump at 128), much less below; leading it loses only the low planes'
+share at the end of the frame."""
 
 import numpy as np
 import pytest
 
-from sim.bench.camera import misalignment
+from sim.bench.camera_figures import misalignment
 from spec.registers import PlaneOrder
 
 

@@ -8,10 +8,10 @@ gives the error an independent integration of the same schedule predicts.
 import numpy as np
 import pytest
 
-from sim.models import bitplane
-from sim.models.camera import Camera, ramp_integral, to_lsb
-from sim.models.dlpc410 import Dlpc410, timing_cycles
+from sim.models import bitplane_model as bitplane
+from sim.models.camera_model import Camera, ramp_integral, to_lsb
 from sim.models.dlpc410_driver import Driver
+from sim.models.dlpc410_model import Dlpc410, timing_cycles
 from spec.facts import TEST_DMD
 
 T = timing_cycles(200e6)

@@ -1,12 +1,13 @@
 """Both adapters of the DLPC410 model: the Amaranth simulator process and the cocotb coroutine on
-the generated Verilog, each fed by the replay component, agree with the model fed directly."""
+the generated Verilog, each fed by the replay component, agree with the model fed directly (the
+cocotb side's testbench: :mod:`sim.tb.dlpc410_replay_tb`)."""
 
 import numpy as np
 import pytest
 
 from sim.harness import cocotb_run
 from sim.harness.amaranth_sim import simulate
-from sim.models.dlpc410 import RULES, Dlpc410, RuleBreak, amaranth_process
+from sim.models.dlpc410_model import RULES, Dlpc410, RuleBreak, amaranth_process
 from sim.models.dlpc410_replay import MODEL_PARAMS, NAMES, replay, sequences
 from spec.facts import TEST_DMD
 
@@ -81,7 +82,7 @@ def test_amaranth_adapter_drives_outputs(test_name):
 
 @pytest.mark.verilog
 def test_cocotb_adapter():
-    cocotb_run.run(replay(), toplevel="dlpc410_replay", module="sim.tb.dlpc410_replay", key="test",
+    cocotb_run.run(replay(), toplevel="dlpc410_replay", module="sim.tb.dlpc410_replay_tb", key="test",
                    params={"dmd": "test"})
 
 
@@ -89,7 +90,7 @@ def test_cocotb_adapter_names():
     """The prefix and the name map pick the DUT's signals; absent members are left out."""
     from types import SimpleNamespace
 
-    from sim.models.dlpc410 import CocotbAdapter
+    from sim.models.dlpc410_model import CocotbAdapter
 
     dut = SimpleNamespace(**{name: object() for name in
                              ["top_din_a", "top_din_b", "top_dvalid", "dmd_arstz", "top_rst_active"]})

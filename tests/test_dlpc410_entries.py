@@ -1,18 +1,18 @@
 """Frames shown as a sequence entry says (:class:`gateware.store.layouts.Showing`) on the
-sequencer's generated Verilog (:mod:`sim.seq_rig`, TEST_DMD): each frame's own least significant
-plane's time, frames that follow the one before with no trigger after its dark time, a frame
-without a camera trigger, and the last frame of a sequence played once, after which a trigger is
-ignored and counted; and entries that show some of their frame's planes (``skip``). The command
-stream equals the schedule model's cycle for cycle (the model takes the same settings,
-:class:`spec.schedule.Frame`), every DLPC410 rule holds, and the camera sees each frame's every
-level at its own exposure."""
+sequencer's generated Verilog (:mod:`sim.rigs.seq_rig`, testbench :mod:`sim.tb.seq_rig_tb`,
+TEST_DMD): each frame's own least significant plane's time, frames that follow the one before with
+no trigger after its dark time, a frame without a camera trigger, and the last frame of a sequence
+played once, after which a trigger is ignored and counted; and entries that show some of their
+frame's planes (``skip``). The command stream equals the schedule model's cycle for cycle (the model
+takes the same settings, :class:`spec.schedule.Frame`), every DLPC410 rule holds, and the camera
+sees each frame's every level at its own exposure."""
 
 import numpy as np
 import pytest
 
 from gateware.dlpc410.trigger import PIN_TO_STROBE
-from sim.models import bitplane
-from sim.seq_rig import run_rig
+from sim.models import bitplane_model as bitplane
+from sim.rigs.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import frame_lights
 from spec import schedule

@@ -4,8 +4,8 @@ break injected on purpose raises that rule's named error."""
 import numpy as np
 import pytest
 
-from sim.models.dlpc410 import RULES, Command, Dlpc410, RuleBreak, timing_cycles
 from sim.models.dlpc410_driver import Driver, Idle
+from sim.models.dlpc410_model import RULES, Command, Dlpc410, RuleBreak, timing_cycles
 from spec.facts import DMDS, TEST_DMD, BlockMode, RowMode
 
 INIT = 20          # INIT_ACTIVE cycles after ARSTZ (the facts' 220 ms is 44 M cycles)

@@ -1,15 +1,15 @@
-"""The sequencer's ready line (the line a tiled display's sync master reads, ``Sequencer.ready``)
-on its generated Verilog (:mod:`sim.seq_rig`, TEST_DMD): high exactly while a trigger would be
-obeyed at once. It rises when every group holds the frame's first plane, the cycle the schedule
-model's groups are all loaded; it is low while a frame plays and while a trigger is held; a
-trigger that finds it high starts the frame within the usual latency, and one that finds it low
-is held (``trigger_hold``) and obeyed on the cycle the groups are ready again, with the line
-staying low."""
+"""The sequencer's ready line (the line a tiled display's sync master reads, ``Sequencer.ready``) on
+its generated Verilog (:mod:`sim.rigs.seq_rig`, testbench :mod:`sim.tb.seq_rig_tb`, TEST_DMD): high
+exactly while a trigger would be obeyed at once. It rises when every group holds the frame's first
+plane, the cycle the schedule model's groups are all loaded; it is low while a frame plays and while
+a trigger is held; a trigger that finds it high starts the frame within the usual latency, and one
+that finds it low is held (``trigger_hold``) and obeyed on the cycle the groups are ready again,
+with the line staying low."""
 
 import pytest
 
 from gateware.dlpc410.trigger import PIN_TO_STROBE
-from sim.seq_rig import run_rig
+from sim.rigs.seq_rig import run_rig
 from spec import schedule
 from spec.facts import TEST_DMD
 

@@ -1,15 +1,15 @@
 """The sequencer takes new registers while it rests (:attr:`Sequencer.at_rest`) and, told to
 ``reload``, loads its waiting frame's first plane again under them: the next trigger shows the
 frame exactly as the new registers say, under the rule-checking DLPC410 model (on the generated
-Verilog, :mod:`sim.seq_rig`, TEST_DMD)."""
+Verilog, :mod:`sim.rigs.seq_rig`, testbench :mod:`sim.tb.seq_rig_tb`, TEST_DMD)."""
 
 import numpy as np
 import pytest
 
 from gateware.registers import Registers
 from sim.harness.layout import pack
-from sim.models.camera import Camera, to_lsb
-from sim.seq_rig import run_script
+from sim.models.camera_model import Camera, to_lsb
+from sim.rigs.seq_rig import run_script
 from sim.tb.plane_source import ramp_image
 from spec import schedule
 from spec.facts import TEST_DMD

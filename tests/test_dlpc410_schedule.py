@@ -144,7 +144,7 @@ def test_prng_patterns_follow_commands():
 @pytest.mark.parametrize("dmd", [TEST_DMD, XGA, DMDS["dlp9500"]])
 def test_pulse_encodings_decode_to_their_groups(dmd):
     """The model's block commands and the DLPC410 model's reading of them agree for every group."""
-    from sim.models.dlpc410 import Dlpc410
+    from sim.models.dlpc410_model import Dlpc410
     controller = Dlpc410(dmd)
     for mode in ResetMode:
         for g, blocks in enumerate(schedule.groups(dmd, mode)):
@@ -171,9 +171,9 @@ def test_fastest_plans_obey_every_rule_at_the_facts_timing(mode, strict, order):
 def played_exactly(dmd, p):
     """One 8-bit ramp frame of ``p`` through the rule model at the facts' timing (raises on
     any rule break); the camera sees every grey level exactly."""
-    from sim.models.camera import Camera, to_lsb
-    from sim.models.dlpc410 import Dlpc410
+    from sim.models.camera_model import Camera, to_lsb
     from sim.models.dlpc410_driver import Driver, play_schedule
+    from sim.models.dlpc410_model import Dlpc410
 
     frame = schedule.Frame(0, 8)
     result = schedule.simulate(dmd, p, [frame], [schedule.ready_cycle(dmd, p, frame)])

@@ -1,9 +1,9 @@
 """The sequencer (TEST_DMD, TEST_DMD4; at DCLK 400 MHz TEST_DMD_400, TEST_DMD4_400): its command
-stream equals the schedule model's cycle for cycle, and every pixel receives exactly its grey
-level in LSB units, under the rule-checking DLPC410 model. The runs are on the generated Verilog
-(:mod:`sim.seq_rig`: one Verilator build per geometry, the trace replayed through the model after
-the run); the Amaranth simulator keeps the short tests it is the right tool for, and one scenario
-run on both must give the same run."""
+stream equals the schedule model's cycle for cycle, and every pixel receives exactly its grey level
+in LSB units, under the rule-checking DLPC410 model. The runs are on the generated Verilog
+(:mod:`sim.rigs.seq_rig`, testbench :mod:`sim.tb.seq_rig_tb`: one Verilator build per geometry, the
+trace replayed through the model after the run); the Amaranth simulator keeps the short tests it is
+the right tool for, and one scenario run on both must give the same run."""
 
 from dataclasses import replace
 
@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from gateware.dlpc410.trigger import PIN_TO_STROBE
-from sim.models import bitplane
-from sim.models.dlpc410 import RULES, RuleBreak
-from sim.seq_rig import run_rig
+from sim.models import bitplane_model as bitplane
+from sim.models.dlpc410_model import RULES, RuleBreak
+from sim.rigs.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import INIT_CYCLES, dlpc410_for, frame_lights, period_light, run_bench
 from spec import group_orders, prng, schedule

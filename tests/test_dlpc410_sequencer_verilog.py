@@ -1,17 +1,17 @@
 """The sequencer's generated Verilog on full XGA, on the full DLP9500 (1080p, four buses) at DCLK
 400 MHz with rows at the row cycle, and on the small four-bus geometries (one under the four-DMD
-paper's settle reading), on the sequencer rig (:mod:`sim.seq_rig`): one
-triggered frame of the ramp image (every grey level on
-every row), RST_ACTIVE and settle scaled down (run-time parameters). The rule-checking DLPC410
-model, on the replayed pin trace, must break no rule and agree with the responder; its command
-log must equal the schedule model's cycle for cycle, and the camera model must see every pixel
-integrate exactly its grey level."""
+paper's settle reading), on the sequencer rig (:mod:`sim.rigs.seq_rig`, testbench
+:mod:`sim.tb.seq_rig_tb`): one triggered frame of the ramp image (every grey level on every row),
+RST_ACTIVE and settle scaled down (run-time parameters). The rule-checking DLPC410 model, on the
+replayed pin trace, must break no rule and agree with the responder; its command log must equal the
+schedule model's cycle for cycle, and the camera model must see every pixel integrate exactly its
+grey level."""
 
 import numpy as np
 import pytest
 
 from gateware.dlpc410.trigger import PIN_TO_STROBE
-from sim.seq_rig import run_rig
+from sim.rigs.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import frame_lights
 from spec import schedule

@@ -151,7 +151,7 @@ def test_board_figures_give_the_share_of_its_device():
 
 
 def test_bench_json_is_flat_name_value_unit(tmp_path):
-    figures = bench.collect(["sim.bench.bitplane"], resources=False, log=lambda *_: None)
+    figures = bench.collect(["sim.bench.bitplane_figures"], resources=False, log=lambda *_: None)
     path = bench.write(figures, tmp_path / "bench.json")
     data = json.loads(path.read_text())
     assert "serialiser.pixels_per_cycle" in data

@@ -1,4 +1,5 @@
-"""The simulation's fast GMII stimulus: file writer (against scapy and zlib) and Verilog replay."""
+"""The simulation's fast GMII stimulus: file writer (against scapy and zlib) and Verilog replay
+(:mod:`sim.tb.gmii_replay_tb`)."""
 
 import zlib
 
@@ -9,7 +10,7 @@ from scapy.packet import Raw
 
 from sim.harness import cocotb_run
 from sim.harness.paths import ROOT, build_dir
-from sim.models import gmii
+from sim.models import gmii_stim as gmii
 
 
 def frames():
@@ -40,7 +41,7 @@ def test_replay_verilog():
     fs = frames()
     path = build_dir("cocotb", "gmii_replay-frames") / "frames.bin"
     gmii.replay_file(path, fs, errors={(2, 30): True})
-    cocotb_run.run(None, toplevel="gmii_replay", module="sim.tb.gmii_replay", key="frames",
+    cocotb_run.run(None, toplevel="gmii_replay", module="sim.tb.gmii_replay_tb", key="frames",
                    extra_sources=[ROOT / "sim" / "hdl" / "gmii_replay.v"],
                    plusargs=[f"+GMII_REPLAY={path}"],
                    params={"cycles": gmii.cycles(fs, errors={(2, 30): True})})

@@ -1,15 +1,15 @@
-"""Plans of groups in plane orders of their own (:mod:`spec.group_orders`): the solver's plans
-pass the independent check (:mod:`sim.bench.group_orders`), reach the one-timeline ceiling where
+"""Plans of groups in plane orders of their own (:mod:`spec.group_orders`): the solver's plans pass
+the independent check (:mod:`sim.bench.group_orders_figures`), reach the one-timeline ceiling where
 that is optimal, never pass the bound, and the check fails each rule it checks when that rule is
-broken; the plan finder's register set is one the projector takes, played by the model with no
-pulse late."""
+broken; the plan finder's register set is one the projector takes, played by the model with no pulse
+late."""
 
 import copy
 from dataclasses import replace
 
 import pytest
 
-from sim.bench import group_orders as go
+from sim.bench import group_orders_figures as go
 from spec import ceiling, records, schedule
 from spec import group_orders as solver
 from spec.facts import DMDS, TEST_DMD

@@ -1,5 +1,6 @@
-"""The harnesses themselves: layouts round-trip, a failing cocotb test fails pytest, and runs of
-one build at the same time (pytest-xdist workers) each report their own result."""
+"""The harnesses themselves: layouts round-trip, a failing cocotb test fails pytest
+(:mod:`sim.tb.selfcheck_tb`), and runs of one build at the same time (pytest-xdist workers) each
+report their own result."""
 
 import random
 import threading
@@ -52,7 +53,7 @@ class Counter(wiring.Component):
 @pytest.mark.verilog
 def test_failing_cocotb_test_fails_pytest():
     with pytest.raises(AssertionError, match="1 of 1 cocotb tests failed"):
-        cocotb_run.run(Counter(), toplevel="counter", module="sim.tb.selfcheck", key="selfcheck",
+        cocotb_run.run(Counter(), toplevel="counter", module="sim.tb.selfcheck_tb", key="selfcheck",
                        testcase="wrong_expectation")
 
 
@@ -66,7 +67,7 @@ def test_concurrent_runs_of_one_build_report_their_own_results(tmp_path):
     def run(name, fail):
         start.wait()
         try:
-            cocotb_run.run(Counter(), toplevel="counter", module="sim.tb.selfcheck", key="selfcheck",
+            cocotb_run.run(Counter(), toplevel="counter", module="sim.tb.selfcheck_tb", key="selfcheck",
                            testcase="fail_as_told", params={"cycles": 20_000, "fail": fail},
                            run_dir=tmp_path / name)
             outcome[name] = "passed"

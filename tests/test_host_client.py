@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 from host import Client, ClientError, MasterClient, cli, codec, levels
-from sim.models.net import Model
-from sim.models.slots import SlotPolicy
+from sim.models.net_model import Model
+from sim.models.slots_model import SlotPolicy
 from spec import records
 from spec.facts import DMDS, TEST_DMD
 from spec.registers import MAX_GROUPS, MIN_CHAINED, PlaneOrder, ResetMode, TriggerMode

@@ -8,7 +8,7 @@ import pytest
 
 from gateware.mac.cdc import RxCrossing
 from sim.harness.amaranth_sim import simulate
-from sim.models import mac
+from sim.models import mac_model as mac
 
 
 @pytest.mark.parametrize("sync_hz,stall", [(125e6, 0.0), (100e6, 0.5), (150e6, 0.8)])

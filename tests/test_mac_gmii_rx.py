@@ -1,10 +1,10 @@
-"""The GMII receive MAC in the Amaranth simulator, against :mod:`sim.models.mac`."""
+"""The GMII receive MAC in the Amaranth simulator, against :mod:`sim.models.mac_model`."""
 
 import pytest
 
 from gateware.mac.gmii_rx import Receiver
 from sim.harness.amaranth_sim import simulate
-from sim.models import mac
+from sim.models import mac_model as mac
 
 CLOCKS = {"gmii_rx": 125e6}
 
@@ -133,6 +133,6 @@ def test_latency_figures():
     """``eth.mac_rx_latency_cycles`` as the benchmark measures it: the pin register, the FCS
     register, and the output register after ``rx_dv`` falls; through the crossing, the FIFO's
     Gray pointer register and its two synchroniser stages add three more."""
-    from sim.bench.mac import rx_latency
+    from sim.bench.mac_figures import rx_latency
     assert rx_latency() == 3
     assert rx_latency(path=True) == 6

@@ -5,7 +5,7 @@ import random
 from gateware.mac.gmii_tx import Transmitter
 from gateware.mac.path import TransmitPath
 from sim.harness.amaranth_sim import simulate, stream_put
-from sim.models import mac
+from sim.models import mac_model as mac
 
 
 def beats(frame, *, abort=False):

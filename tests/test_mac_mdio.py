@@ -1,10 +1,11 @@
-"""PHY management: reset, then status polls over MDIO, against the clause-22 PHY model."""
+"""PHY management: reset, then status polls over MDIO, against the clause-22 PHY model; on the
+generated Verilog, :mod:`sim.tb.mdio_tb`."""
 
 import pytest
 
 from gateware.mac.mdio import StatusPoller
 from sim.harness.amaranth_sim import simulate
-from sim.models.mdio_phy import MdioError, MdioPhy
+from sim.models.mdio_phy_model import MdioError, MdioPhy
 
 LINK_1000 = (0b10 << 14) | (1 << 11) | (1 << 10)
 LINK_DOWN = 0
@@ -65,5 +66,5 @@ def test_model_rejects_short_preamble():
 def test_mdio_verilog():
     from sim.harness import cocotb_run
     cocotb_run.run(StatusPoller(125e6, phy_address=7, reset_cycles=40, settle_cycles=10),
-                   toplevel="mdio_status_poller", module="sim.tb.mdio", key="atlys",
+                   toplevel="mdio_status_poller", module="sim.tb.mdio_tb", key="atlys",
                    params={"phy_address": 7, "status_word": LINK_1000, "polls": 3})

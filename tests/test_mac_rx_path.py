@@ -5,7 +5,7 @@ import random
 
 from gateware.mac.path import ReceivePath
 from sim.harness.amaranth_sim import simulate
-from sim.models import mac
+from sim.models import mac_model as mac
 
 
 def run_path(symbols, name, *, stall=0.0, depth=16384, max_frame=9018, sync_hz=125e6):

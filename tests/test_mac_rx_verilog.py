@@ -1,4 +1,5 @@
-"""The receive MAC's generated Verilog (AXI-Stream wrapper) under cocotb and Verilator."""
+"""The receive MAC's generated Verilog (AXI-Stream wrapper) under cocotb and Verilator
+(:mod:`sim.tb.mac_rx_tb`)."""
 
 import pytest
 
@@ -8,5 +9,5 @@ from sim.harness import cocotb_run
 
 @pytest.mark.verilog
 def test_mac_rx_verilog():
-    cocotb_run.run(AxisReceiver(), toplevel="mac_axis_rx", module="sim.tb.mac_rx", key="default",
+    cocotb_run.run(AxisReceiver(), toplevel="mac_axis_rx", module="sim.tb.mac_rx_tb", key="default",
                    params={"max_frame": 9018})

@@ -19,7 +19,7 @@ from gateware.store.reader import Reader
 from gateware.store.store import Store
 from sim.harness.amaranth_sim import simulate, stream_collect
 from sim.models import store_stim
-from sim.models.mcb import McbModel, amaranth_process, widths
+from sim.models.mcb_model import McbModel, amaranth_process, widths
 from spec.facts import DMDS, TEST_DMD
 
 

@@ -3,7 +3,7 @@ client can break (each violation injected once)."""
 
 import pytest
 
-from sim.models.mcb import READ, REFRESH, WRITE, WRITE_PRECHARGE, McbError, McbModel, McbTiming
+from sim.models.mcb_model import READ, REFRESH, WRITE, WRITE_PRECHARGE, McbError, McbModel, McbTiming
 from sim.models.store_stim import PortDriver
 
 

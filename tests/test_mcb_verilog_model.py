@@ -1,6 +1,6 @@
 """The system run's Verilog memory model against the Python MCB model: same data, same rules,
 on a 64-bit and a 128-bit port (each case's first rule broken on port 0, the second on port 1),
-and through a calibration loss."""
+and through a calibration loss (:mod:`sim.tb.mcb_model_tb`)."""
 
 import pytest
 
@@ -12,7 +12,7 @@ SOURCE = ROOT / "sim" / "hdl" / "mcb_model.v"
 
 
 def run(testcase, plusargs=(), **params):
-    cocotb_run.run(None, toplevel="mcb_model", module="sim.tb.mcb_model", key="default", testcase=testcase,
+    cocotb_run.run(None, toplevel="mcb_model", module="sim.tb.mcb_model_tb", key="default", testcase=testcase,
                    extra_sources=[SOURCE], params=params, plusargs=plusargs)
 
 

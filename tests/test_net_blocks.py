@@ -14,7 +14,7 @@ from gateware.protocol.parser import Parser, config_init
 from host import codec
 from sim.harness.amaranth_sim import simulate, stream_collect, stream_put
 from sim.models.frames import Addresses
-from sim.models.net import Model
+from sim.models.net_model import Model
 from sim.tb.endpoint_sim import plain
 from spec import records
 from spec.facts import TEST_DMD

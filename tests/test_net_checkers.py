@@ -10,7 +10,7 @@ from scapy.layers.l2 import ARP, Ether
 from gateware.net import arp, ethernet, icmp, ipv4, udp
 from sim.harness.amaranth_sim import simulate
 from sim.models import frames
-from sim.models.net import ones_sum
+from sim.models.net_model import ones_sum
 
 A = frames.Addresses()
 RNG = random.Random(8)

@@ -1,8 +1,9 @@
-"""The endpoint's reference model (:mod:`sim.models.net`) is an oracle apart from the gateware:
-it imports no gateware and none of the checks the parser is built from, and its register-set
-rule, written from ``docs/protocol.md``, agrees with :func:`spec.records.register_faults` (the
-parser's) on random register sets near every boundary the page names. Two rules written apart
-that agree are what makes the fuzz tests' verdicts worth having."""
+"""The endpoint's reference model (:mod:`sim.models.net_model`) is an oracle apart from the
+gateware: it imports no gateware and none of the checks the parser is built from, and its
+register-set rule, written from ``docs/protocol.md``, agrees with
+:func:`spec.records.register_faults` (the parser's) on random register sets near every boundary the
+page names. Two rules written apart that agree are what makes the fuzz tests' verdicts worth
+having."""
 
 import ast
 import inspect
@@ -12,7 +13,7 @@ from pathlib import Path
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from sim.models import net
+from sim.models import net_model as net
 from sim.models.endpoint_traffic import BAD_REGISTERS, GOOD_WIRE
 from spec import records
 from spec.facts import DMDS, TEST_DMD

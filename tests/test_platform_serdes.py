@@ -9,7 +9,7 @@ from amaranth.lib import data
 from amaranth.sim import Simulator
 
 from gateware.platform.serdes import DCLK_BITS, lane_bits
-from sim.models.oserdes2 import Oserdes2Model
+from sim.models.oserdes2_model import Oserdes2Model
 
 DMD_NS = 5.0
 IO_NS = DMD_NS / 4

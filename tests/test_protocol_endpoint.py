@@ -1,9 +1,9 @@
 """The endpoint (network stack + protocol parser + status reply) in the Amaranth simulator.
 
 Frames are built by scapy and the host encoder (:mod:`sim.models.endpoint_traffic`); expectations
-come from the reference model in :mod:`sim.models.net`; replies are parsed back by scapy. The long
-runs (the randomized mix with its ledger, records back to back at line rate) run on the generated
-Verilog (:mod:`sim.tb.endpoint`, ``tests/test_protocol_endpoint_verilog.py``).
+come from the reference model in :mod:`sim.models.net_model`; replies are parsed back by scapy. The
+long runs (the randomized mix with its ledger, records back to back at line rate) run on the
+generated Verilog (:mod:`sim.tb.endpoint_tb`, ``tests/test_protocol_endpoint_verilog.py``).
 """
 
 import pytest
@@ -14,7 +14,7 @@ from host import codec
 from sim.models import frames
 from sim.models.endpoint_traffic import BAD_CASES, GOOD_WIRE, IMAGE, A, image_frame, sequencer_record
 from sim.models.frames import Addresses
-from sim.models.net import Model
+from sim.models.net_model import Model
 from sim.tb import endpoint_sim
 from spec import records
 from spec.facts import TEST_DMD

@@ -1,4 +1,4 @@
-"""The endpoint's generated Verilog under cocotb and Verilator."""
+"""The endpoint's generated Verilog under cocotb and Verilator (:mod:`sim.tb.endpoint_tb`)."""
 
 import pytest
 
@@ -13,4 +13,4 @@ def test_endpoint_verilog():
     dmd = "test"
     a = Addresses()
     cocotb_run.run(Endpoint(DMDS[dmd], mac=a.mac, ip=a.ip, port=a.port), toplevel="endpoint",
-                   module="sim.tb.endpoint", key=dmd, params={"dmd": dmd})
+                   module="sim.tb.endpoint_tb", key=dmd, params={"dmd": dmd})

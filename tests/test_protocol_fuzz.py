@@ -2,7 +2,7 @@
 random (a byte of the headers changed, the frame cut short or padded; or a byte of a record
 changed, the record cut or lengthened, in a well-formed datagram), go through the endpoint
 in the Amaranth simulator one by one. Each must land in exactly the counters the reference model
-(:mod:`sim.models.net`, written from the RFCs and the protocol page, not from the gateware)
+(:mod:`sim.models.net_model`, written from the RFCs and the protocol page, not from the gateware)
 names, and nothing of a dropped frame may leak: no pixel, no register set, no reply, no
 configuration change. Hypothesis draws a fresh seed each run and prints the failing example
 (with the blob that replays it)."""
@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from host import codec
 from sim.models import frames
 from sim.models.endpoint_traffic import COLUMNS, A, image_frame, sequencer_record
-from sim.models.net import Model
+from sim.models.net_model import Model
 from sim.tb import endpoint_sim
 from spec import records
 from spec.facts import TEST_DMD

@@ -1,5 +1,5 @@
 """The row assembler (:class:`gateware.protocol.rows.RowAssembler`) against the protocol's row
-rule as the reference model states it (:class:`sim.models.net.Rows`): records that split rows
+rule as the reference model states it (:class:`sim.models.net_model.Rows`): records that split rows
 anywhere, lost and reordered records, frames interleaved, a consumer that stalls."""
 
 import random
@@ -9,7 +9,7 @@ import numpy as np
 from gateware.protocol.layouts import position_bits
 from gateware.protocol.rows import RowAssembler
 from sim.harness.amaranth_sim import simulate
-from sim.models.net import Rows
+from sim.models.net_model import Rows
 from sim.tb.endpoint_sim import assemble_rows, pixel_sink, plain
 from spec import records
 from spec.facts import TEST_DMD

@@ -10,8 +10,9 @@ import pytest
 
 from gateware.store.slots import SlotCounters
 from sim.harness.amaranth_sim import simulate, stream_collect, stream_feed
-from sim.models import bitplane, store_stim
-from sim.models.mcb import McbModel, McbTiming, amaranth_process, widths
+from sim.models import bitplane_model as bitplane
+from sim.models import store_stim
+from sim.models.mcb_model import McbModel, McbTiming, amaranth_process, widths
 from sim.models.store_stim import SHORT_DMD
 from sim.tb.store_chain import StoreChain
 from spec.facts import TEST_DMD
@@ -514,15 +515,15 @@ def test_no_free_slot_and_bad_release(test_name):
 
 
 def test_read_rate_under_ingest_is_the_plans():
-    """The benchmark's plane read on the DLP7000 geometry, through the 128-bit port while the
-    writer takes rows at the GigE line rate: the reader gets from the MCB model the rate the
-    system run's plan counts on (``sim.fast_top.read_rate``, the model's bandwidth less the
-    ingest) within 1 %, so the look-ahead hides the latency and the plan's row period is the
-    shortest the memory keeps fed (the figures are printed by ``python -m sim.bench.store``)."""
-    from sim import xga
-    from sim.bench.store import read_rate, row_period
-    from sim.fast_top import INGEST_BYTES_PER_S
-    from sim.fast_top import read_rate as planned_rate
+    """The benchmark's plane read on the DLP7000 geometry, through the 128-bit port while the writer
+    takes rows at the GigE line rate: the reader gets from the MCB model the rate the system run's
+    plan counts on (``sim.rigs.fast_system_rig.read_rate``, the model's bandwidth less the ingest)
+    within 1 %, so the look-ahead hides the latency and the plan's row period is the shortest the
+    memory keeps fed (the figures are printed by ``python -m sim.bench.store_figures``)."""
+    from sim.bench.store_figures import read_rate, row_period
+    from sim.rigs import xga_run as xga
+    from sim.rigs.fast_system_rig import INGEST_BYTES_PER_S
+    from sim.rigs.fast_system_rig import read_rate as planned_rate
     figure = read_rate(timing=McbTiming(), ingest_bytes_per_s=INGEST_BYTES_PER_S)
     assert figure["ingest_bytes_per_s"] == pytest.approx(INGEST_BYTES_PER_S, rel=0.01), "the writer kept up"
     assert figure["words_per_cycle"] == pytest.approx(planned_rate(McbTiming(), xga.DMD_HZ), rel=0.01)
@@ -530,10 +531,10 @@ def test_read_rate_under_ingest_is_the_plans():
 
 
 def test_random_events_against_policy_model(seed, test_name):
-    """Random records (new frames, parts and rests of frames, stale and shown ids, rows beyond
-    the frame, overlaps), asks and releases, a fresh seed each run: after each event the
-    gateware's counters and the frames it gives equal the reference model's (sim.models.slots)."""
-    from sim.models.slots import SlotPolicy
+    """Random records (new frames, parts and rests of frames, stale and shown ids, rows beyond the
+    frame, overlaps), asks and releases, a fresh seed each run: after each event the gateware's
+    counters and the frames it gives equal the reference model's (sim.models.slots_model)."""
+    from sim.models.slots_model import SlotPolicy
 
     rng = random.Random(seed)
     bench = Bench(SHORT_DMD, slots=4)
@@ -689,8 +690,8 @@ def test_delta_frames(test_name):
     row, at its base's bit depth; the base is kept while a delta uses it and freed after; a delta
     of a base not held (gone, never sent, or itself a delta) is refused row by row, and one that
     claims more rows than the frame as outside. After each step the counters equal the reference
-    model's (sim.models.slots), and every frame shown reads back as numpy composes it."""
-    from sim.models.slots import SlotPolicy
+    model's (sim.models.slots_model), and every frame shown reads back as numpy composes it."""
+    from sim.models.slots_model import SlotPolicy
 
     dmd = SHORT_DMD
     rows = dmd.rows

@@ -8,7 +8,7 @@ import pytest
 
 from gateware.store.addresses import MEMORY_BYTES, PLANES, AddressMap
 from sim.models import store_stim
-from sim.models.mcb import McbModel, McbTiming
+from sim.models.mcb_model import McbModel, McbTiming
 from spec.facts import DMDS
 
 

@@ -1,5 +1,5 @@
 """The store's generated Verilog (serialiser, frame slots, writer, reader) under cocotb and
-Verilator, with the MCB model's cocotb adapter on both ports."""
+Verilator, with the MCB model's cocotb adapter on both ports (:mod:`sim.tb.store_tb`)."""
 
 import pytest
 
@@ -17,7 +17,7 @@ from spec.facts import DMDS
 def test_store_verilog(dmd, depths, extremes):
     slots = 4
     memory = AddressMap(DMDS[dmd], slots).end
-    cocotb_run.run(StoreChain(DMDS[dmd], slots=slots), toplevel="store_chain", module="sim.tb.store",
+    cocotb_run.run(StoreChain(DMDS[dmd], slots=slots), toplevel="store_chain", module="sim.tb.store_tb",
                    key=dmd, params={"dmd": dmd, "slots": slots, "depths": depths, "extremes": extremes,
                                     "memory_bytes": memory}, testcase="every_bit_depth_and_extreme_images")
 
@@ -28,7 +28,7 @@ def test_store_verilog_sequence_beyond_the_live_slots():
     live ones (their states in LUT RAM, their rows' sources not kept) on the generated Verilog."""
     slots, live = 12, 4
     memory = AddressMap(DMDS["test"], slots).end
-    cocotb_run.run(StoreChain(DMDS["test"], slots=slots, live=live), toplevel="store_chain", module="sim.tb.store",
+    cocotb_run.run(StoreChain(DMDS["test"], slots=slots, live=live), toplevel="store_chain", module="sim.tb.store_tb",
                    key="sequence", params={"dmd": "test", "slots": slots, "live": live, "depths": [],
                                            "extremes": False, "memory_bytes": memory},
                    testcase="sequence_beyond_the_live_slots")

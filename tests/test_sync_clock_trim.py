@@ -1,9 +1,9 @@
 """The board's clock loop (:class:`gateware.sync.clock_trim.ClockTrim`) against its model
-(:mod:`sim.models.clock_trim`, written from the description): pulses arrive before or after the
-falling edge of a cycle, near where they are expected, far from it (saturating each term), and
-beyond the capture range (a slip); after each the phase, the trim word, the lock and the counts
-must be the model's. The model's loop also locks a VCXO from 100 ppm off at every period the
-gains are chosen for."""
+(:mod:`sim.models.clock_trim_model`, written from the description): pulses arrive before or after
+the falling edge of a cycle, near where they are expected, far from it (saturating each term), and
+beyond the capture range (a slip); after each the phase, the trim word, the lock and the counts must
+be the model's. The model's loop also locks a VCXO from 100 ppm off at every period the gains are
+chosen for."""
 
 import random
 
@@ -13,7 +13,7 @@ from amaranth import ClockDomain, ClockSignal, Module, Signal
 from amaranth.sim import Simulator
 
 from gateware.sync.clock_trim import ClockTrim, gains
-from sim.models.clock_trim import ClockTrimModel, lock, loop_gains
+from sim.models.clock_trim_model import ClockTrimModel, lock, loop_gains
 
 PERIOD_NS = 10
 #: The time base when the pulse is seen, after the falling edge that sampled it: the

@@ -8,7 +8,7 @@ from amaranth.sim import Simulator
 
 from gateware.registers import TriggerMode
 from gateware.sync.master import SyncMaster
-from sim.models.sync_master import SyncMasterModel, scenario
+from sim.models.sync_master_model import SyncMasterModel, scenario
 
 BOARDS = 4
 SYNC_STAGES = 2      # the trigger pin's and the ready lines' synchronisers

@@ -1,6 +1,6 @@
 """The sync master behind its network port: its core's generated Verilog driven over GMII
-(:mod:`sim.tb.master_core`), and the parser's checks in Amaranth simulation against the protocol's
-reference model."""
+(:mod:`sim.tb.master_core_tb`), and the parser's checks in Amaranth simulation against the
+protocol's reference model."""
 
 import pytest
 
@@ -20,5 +20,5 @@ def test_sync_master_core_over_gmii(boards):
     config = master_config_init(mode=TriggerMode.EXTERNAL, armed=False, period=1000, min_period=400, width=3)
     core = SyncMasterCore(boards, config=config, mac=address_value(ADDRESSES["mac"]), ip=address_value(ADDRESSES["ip"]),
                           port=ADDRESSES["port"], mdio_cycles=(20, 20))
-    cocotb_run.run(core, toplevel="sync_master_core", module="sim.tb.master_core", key=str(boards),
+    cocotb_run.run(core, toplevel="sync_master_core", module="sim.tb.master_core_tb", key=str(boards),
                    params={"boards": boards, "clock_hz": int(SYNC_HZ), "config": config, **ADDRESSES})

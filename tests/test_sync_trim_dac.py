@@ -1,7 +1,7 @@
-"""The VCXO DAC writer (:class:`gateware.sync.trim_dac.TrimDac`) seen through the AD5662's
-interface (:mod:`sim.models.ad5662`, written from the data sheet): every write carries the trim
-word of the cycle it began on, whole, in offset binary, within the DAC's timing, at 200 MHz and
-at a slower clock; in the Amaranth simulation and on the generated Verilog."""
+"""The VCXO DAC writer (:class:`gateware.sync.trim_dac.TrimDac`) seen through the AD5662's interface
+(:mod:`sim.models.ad5662_model`, written from the data sheet): every write carries the trim word of
+the cycle it began on, whole, in offset binary, within the DAC's timing, at 200 MHz and at a slower
+clock; in the Amaranth simulation and on the generated Verilog (:mod:`sim.tb.trim_dac_tb`)."""
 
 import random
 
@@ -10,7 +10,7 @@ from amaranth.sim import Simulator
 
 from gateware.sync.trim_dac import TrimDac, gap_halves, half_period_cycles
 from sim.harness import cocotb_run
-from sim.models.ad5662 import Ad5662, TimingError, TrimWrites, trim_scenario
+from sim.models.ad5662_model import Ad5662, TimingError, TrimWrites, trim_scenario
 
 CYCLES = 12_000
 
@@ -60,5 +60,5 @@ def test_dac_model_catches_a_fast_clock_and_a_short_write():
 
 @pytest.mark.verilog
 def test_trim_dac_verilog(seed):
-    cocotb_run.run(TrimDac(200e6), toplevel="trim_dac", module="sim.tb.trim_dac", key="200mhz",
+    cocotb_run.run(TrimDac(200e6), toplevel="trim_dac", module="sim.tb.trim_dac_tb", key="200mhz",
                    params={"cycles": CYCLES, "seed": seed, "clk_hz": 200e6})

@@ -1,9 +1,10 @@
 """The projector's core end to end on its generated Verilog: configured, armed and fed over GMII,
-the DLPC410 model out, the status reply read back; faults interleaved (see ``sim/tb/system.py``)."""
+the DLPC410 model out, the status reply read back; faults interleaved (the testbench:
+:mod:`sim.tb.system_tb`)."""
 
 import pytest
 
-from sim import system
+from sim.rigs import system_run as system
 
 
 @pytest.mark.verilog
@@ -41,7 +42,7 @@ def test_system_small_geometry():
 def test_system_sequence_entries():
     """A sequence played by its entry table, end to end: configured over GMII, every pixel's
     light each entry's frame at its own exposure and planes, a trigger after the last entry
-    ignored and counted (``sim/tb/system.py``, ``sequence_entries_play_as_their_table_says``)."""
+    ignored and counted (``sim/tb/system_tb.py``, ``sequence_entries_play_as_their_table_says``)."""
     report = system.run("test", testcase="sequence_entries_play_as_their_table_says")
     assert report["latency_cycles"] <= 8
     assert report["status"]["triggers_after_end"] == 1
@@ -51,7 +52,7 @@ def test_system_sequence_entries():
 def test_system_tiled_board_clock_loop():
     """The clock loop inside the core, configured over GMII: it runs in SYNC mode with the
     master's period, a pulse left out is a slip in the status reply, and it is off in another
-    mode (``sim/tb/system.py``, ``a_tiled_board_trims_its_clock``)."""
+    mode (``sim/tb/system_tb.py``, ``a_tiled_board_trims_its_clock``)."""
     report = system.run("test", testcase="a_tiled_board_trims_its_clock")
     assert report["status"]["clock_loop_slips"] == 1
     assert len(report["trims"]) == 12 and all(report["trims"][1:])

@@ -4,11 +4,11 @@ stored as a sequence played by an entry table (the second frame, then the first 
 three triggers faster than frames can be shown: the first finds the sequencer ready, the others
 are held and played back to back at the frame starts of the schedule model; every DLPC410 rule
 checked on the recorded pins, the image the camera sees exact. Shares its Verilator build with
-``make sim``."""
+``make sim`` (:func:`sim.rigs.xga_run.run`; the testbench :mod:`sim.tb.fast_system_rig_tb`)."""
 
 import pytest
 
-from sim import xga
+from sim.rigs import xga_run as xga
 
 
 @pytest.mark.verilog
@@ -74,7 +74,7 @@ def test_window_holds_back_the_first_frames_last_datagram(tmp_path):
     import numpy as np
 
     from host import codec
-    from sim.scene import default_scene
+    from sim.rigs.scene import default_scene
 
     images = default_scene(3, 96, 128)
     sends, held, query, _ = xga._replay_files(tmp_path, images, hold_last=True)
@@ -93,3 +93,17 @@ def test_window_holds_back_the_first_frames_last_datagram(tmp_path):
     sends, held, _, _ = xga._replay_files(tmp_path, images)
     assert held is None and [s["kind"] for s in sends] == ["control", "whole", "delta", "delta"]
     assert np.any(images[1] != images[0])
+
+
+@pytest.mark.verilog
+def test_binary_patterns_from_the_store_while_gige_writes():
+    """1-bit patterns chained from the store on the full DLP7000 at DCLK 400 MHz, set over GMII
+    (a bit depth of 1, the binary plan's registers), while the next frame is written at line
+    rate: every pattern is one of the frames sent, exact, in order (``xga.binary_stream`` raises
+    otherwise), and every pattern period is the plan's: the memory model keeps the rows' pace
+    under the writes."""
+    r = xga.binary_stream("test-binary", frames=2, log=lambda _text: None)
+    assert r["frames_shown"][0] == 0 and r["frames_shown"][-1] == 1
+    assert len(r["periods_during_ingest"]) > 50
+    assert set(r["periods"]) == {r["period_cycles"]}, sorted(set(r["periods"]))
+    assert r["status"]["pulses_late"] == 0 and r["status"]["store_frames_complete"] == 2

@@ -1,6 +1,6 @@
 """The tiled display on the generated Verilog: a sync master and four boards, each on its own
 crystal (+-100 ppm, one drifting, two jittering), in one Verilator simulation
-(:mod:`sim.tiled_rig`).
+(:mod:`sim.rigs.tiled_rig`, testbench :mod:`sim.tb.tiled_rig_tb`).
 
 Every board must obey every pulse and play its tile exactly under the rule model, and the
 spread of the boards' clocking pulses must stay inside what the clocks explain: the board's
@@ -12,9 +12,9 @@ from the recorded times, so that the spread is measured on the clocks the test c
 import numpy as np
 import pytest
 
-from sim.models.camera import to_lsb
+from sim.models.camera_model import to_lsb
+from sim.rigs.tiled_rig import BOARD_PERIOD_FS, Oscillator, master_period, run_tiled, tiles
 from sim.tb.seq_sim import frame_lights
-from sim.tiled_rig import BOARD_PERIOD_FS, Oscillator, master_period, run_tiled, tiles
 from spec import schedule
 from spec.facts import TEST_DMD
 

@@ -1,8 +1,9 @@
-"""The virtual projector (:mod:`sim.virtual`): real host software, installed in a fresh virtual
-environment without Amaranth, talks through the operating system's network stack (a namespace
-of its own) to the core's generated Verilog on a TAP device, and the frame it sends is the frame
-the DMD shows. Skipped, with the reason, where the machine does not allow a network namespace and
-a TAP device."""
+"""The virtual projector (:mod:`sim.rigs.virtual_run`; testbenches
+:mod:`sim.tb.virtual_projector_tb` and :mod:`sim.tb.virtual_master_tb`): real host software,
+installed in a fresh virtual environment without Amaranth, talks through the operating system's
+network stack (a namespace of its own) to the core's generated Verilog on a TAP device, and the
+frame it sends is the frame the DMD shows. Skipped, with the reason, where the machine does not
+allow a network namespace and a TAP device."""
 
 import shutil
 import subprocess
@@ -11,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from sim import virtual
+from sim.rigs import virtual_run as virtual
 
 REASON = virtual.unavailable()
 ROOT = Path(__file__).resolve().parents[1]

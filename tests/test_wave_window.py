@@ -1,7 +1,8 @@
-"""The wave window of ``make sim WINDOW=1`` (``sim/hdl/wave_window.v``) on a small design built
-as the XGA run's window build is (tracing, the DPI close): the dump holds value changes only
-while the window is open, every signal inside the design included, and the save file made for it
-(:func:`sim.system.window_groups`) names only signals the dump declares."""
+"""The wave window of ``make sim WINDOW=1`` (``sim/hdl/wave_window.v``) on a small design built as
+the XGA run's window build is (tracing, the DPI close): the dump holds value changes only while the
+window is open, every signal inside the design included, and the save file made for it
+(:func:`sim.rigs.system_run.window_groups`) names only signals the dump declares. The testbench:
+:mod:`sim.tb.wave_window_tb`."""
 
 import re
 
@@ -10,11 +11,11 @@ from amaranth import ClockDomain, ClockSignal, Instance, Module, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from sim import system
-from sim.fast_top import PLUSARGS, WINDOW_SOURCES
 from sim.harness import cocotb_run
 from sim.harness.paths import build_dir
 from sim.harness.waves import declared
+from sim.rigs import system_run as system
+from sim.rigs.fast_system_rig import PLUSARGS, WINDOW_SOURCES
 
 OPEN_NS, CLOSE_NS = 200, 500
 
@@ -56,7 +57,7 @@ def test_window_dumps_only_while_open_and_save_file_names_exist():
     directory = build_dir("wave_window", "run")
     vcd = directory / "window.vcd"
     vcd.unlink(missing_ok=True)
-    cocotb_run.run(WindowRig(), toplevel="window_rig", module="sim.tb.wave_window", key="window",
+    cocotb_run.run(WindowRig(), toplevel="window_rig", module="sim.tb.wave_window_tb", key="window",
                    params={"open_ns": OPEN_NS, "close_ns": CLOSE_NS}, extra_sources=WINDOW_SOURCES,
                    plusargs=[f"+{PLUSARGS['window']}={vcd}"], traced=True, run_dir=directory)
     text = vcd.read_text()

@@ -6,8 +6,8 @@ steps in ``constraints/README.md``) as a Verilog module with two 64-bit bidirect
 (port configuration "Two 64-bit bi-directional ports": no configuration has a 128-bit port beside
 another one). This block instantiates it, and presents a port the store wants 128 bits wide (the
 plane reader's) through a :class:`~gateware.platform.read_widener.ReadWidener` on its 64-bit port.
-Simulations never see it (they connect :mod:`sim.models.mcb`, with ports of the store's widths,
-to the store's ports instead).
+Simulations never see it (they connect :mod:`sim.models.mcb_model`, with ports of the store's
+widths, to the store's ports instead).
 
 Which wrapper, on which pins, is the board's :class:`Memory` (``platform.memory``; the Atlys's
 :data:`ATLYS_DDR2` by default). Its resource names the pins as amaranth-boards' Atlys ``ddr2``

@@ -11,9 +11,9 @@ DCLK is a lane too, sending ``1 0 1 0`` each ``dmd`` cycle from a second BUFPLL 
 runs half a bit (625 ps, 90 degrees of DCLK) later than the data's, so that every DCLK edge falls
 in the middle of a data bit and DCLK's rising edge in the middle of edge 0's bit.
 
-:class:`Oserdes4` is the vendor primitive; ``sim/models/oserdes2.py`` is its behavioural model,
-against which ``tests/test_platform_serdes.py`` checks the bits on each lane, in order, at each
-DCLK edge.
+:class:`Oserdes4` is the vendor primitive; ``sim/models/oserdes2_model.py`` is its behavioural
+model, against which ``tests/test_platform_serdes.py`` checks the bits on each lane, in order, at
+each DCLK edge.
 """
 
 from amaranth import Elaboratable, Instance, Module

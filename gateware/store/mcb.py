@@ -14,7 +14,7 @@ bits up; ``wr_mask`` bit ``i`` set keeps byte ``i`` of the word's memory unchang
 registered in the port's own clock.
 
 The same signature serves the vendor controller (:mod:`gateware.platform.mcb_instance`) and the
-simulation model (:mod:`sim.models.mcb`).
+simulation model (:mod:`sim.models.mcb_model`).
 """
 
 from amaranth.lib import enum, wiring

@@ -4,7 +4,7 @@ Serialiser words in (``sync``), planes out to the sequencer (``dmd``), two MCB p
 memory controller (port 0 in ``sync`` for writing, 64 bits; port 1 in ``dmd`` for reading, 64 or
 128 bits). The system top connects ``mcb_write`` and ``mcb_read`` to
 :class:`gateware.platform.mcb_instance.McbInstance`; simulations connect them to
-:mod:`sim.models.mcb`.
+:mod:`sim.models.mcb_model`.
 
 A memory that loses its calibration loses every frame (:mod:`.recovery`); ``lost`` tells the
 sequencer's side, which plays what it holds dark and waits for a frame stored after it.

@@ -17,7 +17,7 @@ that samples it, so that every board takes the pulse on the same edge of its own
   decides on even cycles, so every board starts its frame on the same cycle after the pulse.
 * A proportional and an integral term, each a power of two chosen from the period (a longer
   period sees more drift per pulse: ``kp = 23 - bit_length(period)``, ``ki = kp - 4``, found by
-  the loop's model, :mod:`sim.models.clock_trim`), saturated to 15 bits each and summed into the
+  the loop's model, :mod:`sim.models.clock_trim_model`), saturated to 15 bits each and summed into the
   16-bit ``trim`` word a DAC turns into the VCXO's control voltage.
 * A pulse more than ``CAPTURE`` cycles from where it was expected (a pulse missed, the master
   restarted) is a slip: counted, and the next pulse sets the expected times again.

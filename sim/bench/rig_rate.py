@@ -1,13 +1,14 @@
-"""A plan's 8-bit frame rate measured on the sequencer's generated Verilog (:mod:`sim.seq_rig`):
-the ramp frame played back to back, the pins through the rule-checking DLPC410 model, the
-commands the schedule model's cycle for cycle, every level of a frame between two others exact.
-Used by the rate benchmarks (:mod:`sim.bench.rates`, :mod:`sim.bench.group_orders`).
+"""A plan's 8-bit frame rate measured on the sequencer's generated Verilog
+(:mod:`sim.rigs.seq_rig`): the ramp frame played back to back, the pins through the rule-checking
+DLPC410 model, the commands the schedule model's cycle for cycle, every level of a frame between two
+others exact. Used by the rate benchmarks (:mod:`sim.bench.rates_figures`,
+:mod:`sim.bench.group_orders_figures`).
 """
 
 import numpy as np
 
 from gateware.dlpc410.trigger import PIN_TO_STROBE
-from sim.seq_rig import run_rig
+from sim.rigs.seq_rig import run_rig
 from sim.tb.plane_source import ramp_image
 from sim.tb.seq_sim import frame_lights, period_light
 from spec import schedule
@@ -19,7 +20,7 @@ __all__ = ["FRAMES", "RIG_SOURCE", "measured_rate", "ready", "median_period", "s
 #: Frames played back to back (the period is the median of the last ones).
 FRAMES = 4
 #: Where a rate measured by :func:`measured_rate` comes from (:mod:`flow.bench`), run ``name``.
-RIG_SOURCE = ("gateware: sequencer Verilog (sim.seq_rig), rates rig: {what}, the ramp frame back to back, pins "
+RIG_SOURCE = ("gateware: sequencer Verilog (sim.rigs.seq_rig), rates rig: {what}, the ramp frame back to back, pins "
               "through the DLPC410 rule model, commands equal to the schedule model's, camera model on a frame "
               "between two others; run {name}")
 

@@ -28,7 +28,7 @@ sequencer is elaborated):
   reading (with the loose one, RST_ACTIVE may be another group's, and a group falls back on
   its planned time: the pin then says nothing of its own reset). The blocks a pulse covers and
   the block a load writes are read from the pins (BLKMD, BLKAD, RST2BLKZ; ROWMD, ROWAD);
-* DLPA008B 4.2, as the rule model (:mod:`sim.models.dlpc410`) checks it: a row cycle that clears
+* DLPA008B 4.2, as the rule model (:mod:`sim.models.dlpc410_model`) checks it: a row cycle that clears
   a block loads no row, and the ``clear_row_cycles - 1`` row cycles after it (1080p parts) load
   no row, clear no block and pulse not the block being cleared; idle gaps do not count, and a
   controller that initialises again forgets the clear. The sequencer also keeps those no-op

@@ -1,4 +1,4 @@
-// The DLPC410's outputs to the applications FPGA, as sim/models/dlpc410.py drives them.
+// The DLPC410's outputs to the applications FPGA, as sim/models/dlpc410_model.py drives them.
 //
 // Simulation only. The system run records the pins to a file (trace_recorder.v) and checks them
 // afterwards with the Python model, so the controller's outputs must come from Verilog: this

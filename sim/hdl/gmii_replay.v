@@ -3,7 +3,7 @@
 // Simulation only. The fast stimulus path of the system simulation: driving GMII byte by byte
 // from Python costs tens of microseconds a byte, reading a file from the simulator costs
 // nanoseconds. The file (plusarg +GMII_REPLAY=<path>) holds two bytes per GMII cycle:
-// flags (bit 0 = RX_DV, bit 1 = RX_ER) then RXD. Written by sim/models/gmii.py.
+// flags (bit 0 = RX_DV, bit 1 = RX_ER) then RXD. Written by sim/models/gmii_stim.py.
 //
 // A pulse on `start` opens the file and plays it to the end; `busy` is high meanwhile.
 module gmii_replay (

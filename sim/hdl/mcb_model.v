@@ -1,6 +1,6 @@
 // Spartan-6 MCB native user ports with one shared memory: the fast memory of the system run.
 //
-// Simulation only. The same port protocol and rules as the Python model sim/models/mcb.py (which
+// Simulation only. The same port protocol and rules as the Python model sim/models/mcb_model.py (which
 // stays the reference and the checker of the store's tests), at nanoseconds per cycle instead of
 // a Python call per cycle. PORTS ports, each in its own clock and of its own width (32, 64 or 128
 // bits), share one memory of WORDS 64-bit words (bytes in address order from the low bits up).

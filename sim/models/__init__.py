@@ -1,1 +1,2 @@
-"""Behavioural and reference models, plain Python and numpy, shared by unit and system tests."""
+"""Behavioural and reference models (``*_model``), plain Python and numpy, and the stimulus shared
+by unit and system tests."""

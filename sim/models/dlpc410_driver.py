@@ -1,6 +1,6 @@
 """A minimal driver of the DLPC410 interface, for tests: legal cycles built by hand.
 
-:class:`Driver` appends the per-cycle signal dicts of :meth:`sim.models.dlpc410.Dlpc410.step`
+:class:`Driver` appends the per-cycle signal dicts of :meth:`sim.models.dlpc410_model.Dlpc410.step`
 (and :class:`Idle` runs of DVALID-low cycles) to :attr:`Driver.items` and counts cycles, so a
 test knows the cycle of every command it issued without asking the model. It applies no timing
 rule itself: legal or not is the caller's choice, which is how rule breaks are injected.

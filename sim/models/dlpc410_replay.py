@@ -1,7 +1,7 @@
 """A tiny Amaranth component that replays driver-built DLPC410 cycles from a ROM, and the
 sequences the adapter tests replay.
 
-It proves the two adapters of :mod:`sim.models.dlpc410` (Amaranth simulator and cocotb on the
+It proves the two adapters of :mod:`sim.models.dlpc410_model` (Amaranth simulator and cocotb on the
 generated Verilog) see exactly what the pure-Python model sees when fed the same cycles: the
 replay is blind (it ignores the controller's outputs), so the same legal sequence gives the same
 command log and mirrors, and the illegal one the same named rule break, through either adapter.
@@ -78,7 +78,7 @@ class Replay(wiring.Component):
     ----------
     dmd : DmdType
     sequences : list of lists of dicts
-        Per-cycle signal dicts (:meth:`sim.models.dlpc410.Dlpc410.step`'s form).
+        Per-cycle signal dicts (:meth:`sim.models.dlpc410_model.Dlpc410.step`'s form).
 
     Ports
     -----

@@ -1,10 +1,11 @@
 """Test traffic for the endpoint (stack + protocol) on the test geometry.
 
-Every class of bad input with the counter that must count it (:data:`BAD_CASES`: the stack's
-bad frames, a bad MAC verdict, malformed records and register sets the sequencer could not obey),
-and :func:`randomized_mix`, hundreds of frames of every kind interleaved. Frames are built by
-scapy and the host encoder; what the endpoint must make of them comes from the reference model
-(:class:`sim.models.net.Model`). Shared by the Amaranth-simulator tests and the cocotb testbench.
+Every class of bad input with the counter that must count it (:data:`BAD_CASES`: the stack's bad
+frames, a bad MAC verdict, malformed records and register sets the sequencer could not obey), and
+:func:`randomized_mix`, hundreds of frames of every kind interleaved. Frames are built by scapy and
+the host encoder; what the endpoint must make of them comes from the reference model
+(:class:`sim.models.net_model.Model`). Shared by the Amaranth-simulator tests and the cocotb
+testbench.
 """
 
 import random

@@ -1,17 +1,17 @@
 """A well-behaved MCB port client and scripted rule breaks, to hold the Verilog memory model
-(``sim/hdl/mcb_model.v``) against the Python one (:mod:`sim.models.mcb`).
+(``sim/hdl/mcb_model.v``) against the Python one (:mod:`sim.models.mcb_model`).
 
-:class:`Client` is a cycle-by-cycle user of one port: ``step(outputs) -> inputs``, the same
-function on both models. It follows the port's rules (write data before its command, no push
-while full, read commands only when the read FIFO has room for every word in flight) and keeps
-the words it read. :data:`CASES` are scripts that each break one rule, named by the Python
-model's :class:`~sim.models.mcb.McbError` kind, for a port of a given width. :class:`LossClient`
-runs a port through a calibration loss (:data:`LOSS_CASES`).
+:class:`Client` is a cycle-by-cycle user of one port: ``step(outputs) -> inputs``, the same function
+on both models. It follows the port's rules (write data before its command, no push while full, read
+commands only when the read FIFO has room for every word in flight) and keeps the words it read.
+:data:`CASES` are scripts that each break one rule, named by the Python model's
+:class:`~sim.models.mcb_model.McbError` kind, for a port of a given width. :class:`LossClient` runs
+a port through a calibration loss (:data:`LOSS_CASES`).
 """
 
 import random
 
-from sim.models.mcb import FIFO_DEPTH, READ, WRITE, McbError, McbModel, McbTiming
+from sim.models.mcb_model import FIFO_DEPTH, READ, WRITE, McbError, McbModel, McbTiming
 
 __all__ = ["Client", "traffic", "writes", "reads", "python_reads", "python_fault", "CASES", "FAULTS",
            "PERIODS_S", "WIDTHS", "LossClient", "LOSS_CASES", "LOSS_AT_NS", "LOSS_NS", "loss_plusargs",

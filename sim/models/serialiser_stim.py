@@ -1,12 +1,12 @@
 """Stimulus and checking for the bit-plane serialiser, shared by the Amaranth and cocotb tests.
 
 The transfers a whole image makes on the serialiser's ports, as plain dicts, and the reassembly of
-what comes out into numpy arrays to compare with :mod:`sim.models.bitplane`.
+what comes out into numpy arrays to compare with :mod:`sim.models.bitplane_model`.
 """
 
 import numpy as np
 
-from . import bitplane
+from . import bitplane_model as bitplane
 
 
 def pixel_beats(image, lanes, frame=0, row_order=None, base=0, carried=0):

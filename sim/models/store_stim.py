@@ -11,7 +11,8 @@ import numpy as np
 from gateware.store.addresses import PLANES, AddressMap
 from spec.facts import TEST_DMD
 
-from . import bitplane, serialiser_stim
+from . import bitplane_model as bitplane
+from . import serialiser_stim
 
 #: The test geometry cut to 24 rows in 2 blocks, for the store's policy tests (which slot, which
 #: frame, which counter): a quarter of the cycles per frame. Its 5-bit row field leaves rows 24 to
@@ -71,7 +72,7 @@ def check_writes_inside(model, dmd, slots, allowed, since=0):
 
 
 class PortDriver:
-    """Drives one port of :class:`sim.models.mcb.McbModel` from plain Python, cycle by cycle,
+    """Drives one port of :class:`sim.models.mcb_model.McbModel` from plain Python, cycle by cycle,
     with the traffic the writer and reader make: the reference of the store's memory traffic."""
 
     def __init__(self, model, port=0, period=8e-9):

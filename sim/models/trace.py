@@ -5,15 +5,15 @@ bus changed or was marked (DVALID high; TX_EN high); on the cycles between two l
 held the earlier line's value.
 
 :func:`replay_dlpc410` feeds a DLPC410 pin trace to the rule-checking
-:class:`sim.models.dlpc410.Dlpc410` (``step`` on recorded cycles, ``idle`` over the gaps, which
-have DVALID low) and checks on every recorded cycle that the controller outputs the Verilog
+:class:`sim.models.dlpc410_model.Dlpc410` (``step`` on recorded cycles, ``idle`` over the gaps,
+which have DVALID low) and checks on every recorded cycle that the controller outputs the Verilog
 responder drove equal the model's; :func:`gmii_frames` cuts a GMII transmit trace into frames;
 :func:`write_vcd` turns a window of a trace into waves.
 """
 
 from gateware.mac import gmii as gmii_pins
 from sim.harness.layout import fields
-from sim.models.dlpc410 import INPUTS, OUTPUTS
+from sim.models.dlpc410_model import INPUTS, OUTPUTS
 
 __all__ = ["read", "Mismatch", "replay_dlpc410", "rising_edges", "gmii_frames", "write_vcd"]
 

@@ -21,7 +21,7 @@ from scapy.packet import Raw
 from gateware.mac.gmii import TxPins
 from host import codec
 from sim.harness.layout import fields
-from sim.models import gmii
+from sim.models import gmii_stim as gmii
 from spec import records
 
 __all__ = ["GmiiHost", "HOST_MAC", "HOST_IP", "HOST_PORT", "address_value", "start_clocks"]

@@ -6,7 +6,7 @@ and the frames to offer (:func:`contents` fills them from images and a frame lis
 are read ports (:class:`TableSignature`) outside :class:`SourcedSequencer`, so that the same
 sequencer and store stand-in run in the Amaranth simulator with the tables in memories
 (:class:`SequencerBench`) and under Verilator with the tables loaded from files at run time
-(:class:`sim.seq_rig.SequencerRig`).
+(:class:`sim.rigs.seq_rig.SequencerRig`).
 """
 
 from dataclasses import dataclass
@@ -20,7 +20,7 @@ from amaranth.utils import ceil_log2
 from gateware.compose import forward, members
 from gateware.dlpc410.sequencer import Sequencer
 from gateware.store.layouts import SLOT_BITS, FrameInfo, PlaneRequest, Showing
-from sim.models import bitplane
+from sim.models import bitplane_model as bitplane
 from spec.registers import TIME_BITS
 
 __all__ = ["TableSignature", "OfferedFrame", "Contents", "contents", "PlaneSource", "SourcedSequencer",

@@ -1,10 +1,10 @@
 """Run the sequencer bench in the Amaranth simulator under the rule-checking DLPC410 model.
 
-:class:`sim.models.dlpc410.Dlpc410` plays the controller (:func:`dlpc410_for`): it drives
-ECP2_FINISHED, INIT_ACTIVE (checking the training pattern meanwhile) and RST_ACTIVE, decodes
-every row cycle, keeps the DMD's memory and mirrors, and raises
-:class:`~sim.models.dlpc410.RuleBreak` on the first broken rule. Its RST_ACTIVE time and settle
-time are the plan's ``t_rst_s`` and ``t_settle_s`` (the facts, or the scaled-down values of a
+:class:`sim.models.dlpc410_model.Dlpc410` plays the controller (:func:`dlpc410_for`): it drives
+ECP2_FINISHED, INIT_ACTIVE (checking the training pattern meanwhile) and RST_ACTIVE, decodes every
+row cycle, keeps the DMD's memory and mirrors, and raises
+:class:`~sim.models.dlpc410_model.RuleBreak` on the first broken rule. Its RST_ACTIVE time and
+settle time are the plan's ``t_rst_s`` and ``t_settle_s`` (the facts, or the scaled-down values of a
 test), so the sequencer's parameters are checked against the times they were planned for.
 
 The model's command log, moved to the sequencer's time base (``status.now``; a command's cycle
@@ -20,8 +20,8 @@ from amaranth.lib import data
 from gateware.dlpc410.layouts import Status
 from gateware.registers import Registers
 from sim.harness.amaranth_sim import simulate
-from sim.models.camera import Camera
-from sim.models.dlpc410 import Dlpc410, amaranth_process
+from sim.models.camera_model import Camera
+from sim.models.dlpc410_model import Dlpc410, amaranth_process
 from sim.tb.plane_source import SequencerBench
 from spec.schedule import DECISION_TO_PINS, FABRIC_HZ, RST_MARGIN
 
@@ -50,7 +50,7 @@ class Run:
     ready: list = field(default_factory=list)        # (now, level) at each change (the rig's trace)
     releases: list = field(default_factory=list)     # (now, slot) handed back
     lights: list = field(default_factory=list)       # camera images of the frames (frame_lights)
-    report: dict = field(default_factory=dict)       # on the rig: the testbench's (sim.seq_rig)
+    report: dict = field(default_factory=dict)       # on the rig: the testbench's (sim.rigs.seq_rig)
 
     def frames(self):
         """``(first, last)`` model cycles of each shown frame: sync out rising and falling."""

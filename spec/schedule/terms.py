@@ -192,7 +192,7 @@ class Params:
 @dataclass
 class Frame:
     """A frame the store offers: its slot, bit depth and occupancy (blocks,) bytes, bit k =
-    stored plane k has a bit set in the block (:func:`sim.models.bitplane.occupancy`); and how
+    stored plane k has a bit set in the block (:func:`sim.models.bitplane_model.occupancy`); and how
     a sequence entry shows it (the defaults: as the registers say). It shows stored planes
     ``8 - depth - skip .. 7 - skip`` (``skip``: a sequence entry's planes left out above them)."""
     slot: int
