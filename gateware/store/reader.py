@@ -47,16 +47,86 @@ from amaranth.utils import exact_log2
 
 from . import mcb
 from .addresses import PLANES, AddressMap
-from .layouts import PlaneRequest
+from .layouts import SLOT_BITS, PlaneRequest
 from .read_fifo import ReadFifo
 from .runs import Runs
 from .slot_maps import RowLookupSignature
 
-__all__ = ["Reader"]
+__all__ = ["Reader", "RunStart"]
 
 
 def _trailing_zeros(n):
     return (n & -n).bit_length() - 1
+
+
+class RunStart(wiring.Component):
+    """A run's first port word, summed as the run's slot is chosen (``sync``).
+
+    A run starts at its slot's start (a table of the slots, read from a register: the table's
+    LUTs, no more) plus its plane's (a table of 8) plus its rows' offset. Every start is a multiple
+    of ``2**low`` port words, so each sum is one carry chain above the low bits, in a stage of its
+    own: the slot's and plane's starts are summed here, a cycle or more before the run is given;
+    the reader adds the rows' offset as it loads the run. (With the memory full of slots, up to
+    256, each chain is at most 16 bits for the DLP7000, the DLP9500 and the test geometries through
+    either port, 17 for the DLP650LNIR's past 65 slots.)
+
+    Parameters
+    ----------
+    address_map : :class:`~gateware.store.addresses.AddressMap`
+        Where the slots and planes lie.
+    word_bytes : int
+        Bytes in a port word.
+    plane_words : int
+        Port words in a plane.
+
+    Attributes
+    ----------
+    low : int
+        The low bits of a port word's address that every start has zero.
+    address_bits : int
+        Bits of a port word's address.
+
+    Members
+    -------
+    slot : In(SLOT_BITS)
+        The slot of the run being opened; no run is of a slot past the table (a request for one
+        is dropped, and the row map names the store's slots only).
+    plane : In(3)
+        The run's plane: the request's, the same from the cycle the run is opened on.
+    load : In(1)
+        The run is opened: its start is summed at the end of this cycle.
+    start : Out(address_bits - low)
+        The run's start above the low bits, from the cycle after ``load``.
+    """
+
+    def __init__(self, address_map, word_bytes, plane_words):
+        assert address_map.base % word_bytes == 0
+        self.low = _trailing_zeros(math.gcd(address_map.base // word_bytes, plane_words))
+        self.address_bits = (address_map.end // word_bytes - 1).bit_length()
+        self._slot_starts = [address_map.address(slot, 0) // word_bytes >> self.low
+                             for slot in range(address_map.slots)]
+        self._plane_starts = [plane * plane_words >> self.low for plane in range(PLANES)]
+        super().__init__({
+            "slot": In(SLOT_BITS),
+            "plane": In(3),
+            "load": In(1),
+            "start": Out(self.address_bits - self.low),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        width = self.address_bits - self.low
+        m.submodules.slot_starts = table = Memory(shape=width, depth=len(self._slot_starts), init=self._slot_starts)
+        slot_start = table.read_port(domain="comb")
+        plane_start = Signal(width)
+        with m.Switch(self.plane):
+            for plane, value in enumerate(self._plane_starts):
+                with m.Case(plane):
+                    m.d.comb += plane_start.eq(value)
+        m.d.comb += slot_start.addr.eq(self.slot)
+        with m.If(self.load):
+            m.d.sync += self.start.eq(slot_start.data + plane_start)
+        return m
 
 
 class Reader(wiring.Component):
@@ -118,20 +188,11 @@ class Reader(wiring.Component):
         plane_words = dmd.rows * row_words
         burst_bits = exact_log2(mcb.MAX_BURST)
 
-        # Addresses in port words. A run starts at its slot's start (a table of ``slots`` entries,
-        # read from a register: the table's LUTs, no more) plus its plane's (a table of 8) plus its
-        # rows' offset. Every start is a multiple of 2**low, so each sum is one carry chain above
-        # the low bits, in a stage of its own: the slot's and plane's starts are summed into
-        # ``start`` as the run's slot is chosen (``runs.loads``, a cycle or more before the run is
-        # given), the rows' offset is added as the run is loaded. A burst of 64 steps the bits
-        # above the burst's, in two halves (below). (With the memory full of slots, up to 256, each
-        # sum's chain is at most 16 bits for the DLP7000, the DLP9500 and the test geometries
-        # through either port, 17 for the DLP650LNIR's past 65 slots; a step's half at most 9.)
-        assert self._map.base % word_bytes == 0
-        low = _trailing_zeros(math.gcd(self._map.base // word_bytes, plane_words))
-        slot_starts = [self._map.address(s, 0) // word_bytes >> low for s in range(self._slots)]
-        plane_starts = [p * plane_words >> low for p in range(PLANES)]
-        address_bits = (self._map.end // word_bytes - 1).bit_length()
+        # Addresses in port words: a run's start above the low bits that every start has zero
+        # (:class:`RunStart`), plus its rows' offset as the run is loaded; a burst of 64 steps the
+        # bits above the burst's, in two halves (below; a half is at most 9 bits).
+        starts = RunStart(self._map, word_bytes, plane_words)
+        low, address_bits = starts.low, starts.address_bits
 
         # ---- the words: the memory's (or zeros) through a FIFO to the sequencer ----------------
         m.submodules.fifo = fifo = ReadFifo(self._width, depth)
@@ -212,28 +273,14 @@ class Reader(wiring.Component):
         wiring.connect(m, runs.sources, wiring.flipped(self.sources))
         m.d.comb += [runs.busy.eq(issuing), self.bad_requests.eq(runs.bad_requests)]
         run = runs.run
-        # the run's first port word above the low bits (``start``): its slot's start and its
-        # plane's, read and summed as its slot is chosen (its plane is the request's, the same from
-        # ``CHECK`` on; no run is of a slot past the table: a request for one is dropped, and the
-        # row map names the store's slots only)
-        m.submodules.slot_starts = slot_rom = Memory(shape=address_bits - low, depth=self._slots,
-                                                     init=slot_starts)
-        slot_start = slot_rom.read_port(domain="comb")
-        plane_start = Signal(address_bits - low)
-        with m.Switch(run.plane):
-            for p, value in enumerate(plane_starts):
-                with m.Case(p):
-                    m.d.comb += plane_start.eq(value)
-        start = Signal(address_bits - low)
-        m.d.comb += slot_start.addr.eq(runs.next_slot)
-        with m.If(runs.loads):
-            m.d.sync += start.eq(slot_start.data + plane_start)
+        m.submodules.run_start = starts
+        m.d.comb += [starts.slot.eq(runs.next_slot), starts.plane.eq(run.plane), starts.load.eq(runs.loads)]
         run_last = run.words - 1
         with m.If(runs.emit):
             m.d.sync += [
                 issuing.eq(1),
                 address[:low].eq(run.off[:low]),
-                address[low:].eq(start + run.off[low:]),
+                address[low:].eq(starts.start + run.off[low:]),
                 last_bl.eq(run_last[:burst_bits]),
                 before_last.eq(run_last[burst_bits:]),
                 is_last.eq(run.single),

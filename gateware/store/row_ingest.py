@@ -2,7 +2,7 @@
 dropped whole and counted (``sync`` domain).
 
 At a row's first word the ingest asks the slot table where the row goes
-(:class:`~gateware.store.slot_table.Placement`). A slot taken for a new frame first has its maps
+(:class:`~gateware.store.placement.Placement`). A slot taken for a new frame first has its maps
 set up (one row per cycle): no row arrived, each row shown from the slot itself, or for a delta
 frame from its base, whose occupancy map it starts from. Then the row's entry is read: a row that
 arrived before is refused. An accepted row's words of the stored planes go to the writer
@@ -22,8 +22,8 @@ from gateware.bitplane.serialiser import row_flags_layout, word_layout
 
 from .addresses import PLANES
 from .layouts import BLOCK_BITS, COUNTER_BITS, SLOT_BITS, OccupancySignature
+from .placement import Placement, PlacementSignature, opening_layout
 from .slot_maps import RowLookupSignature, map_write_layout
-from .slot_table import Placement, PlacementSignature, opening_layout
 from .writer import write_word_layout
 
 __all__ = ["RowIngest", "IngestCounters"]
@@ -113,7 +113,6 @@ class RowIngest(wiring.Component):
         missing_w, missing_r = missing_rows.write_port(), missing_rows.read_port(domain="comb")
         missing = missing_r.data
         head = self.words.payload
-        flags = self.rows.payload
         place = self.placement
         is_last = (head.plane == PLANES - 1) & (head.word == dmd.words_per_row - 1)
         cur_slot = Signal(SLOT_BITS)
@@ -123,10 +122,8 @@ class RowIngest(wiring.Component):
         base_depth = Signal(4)                  # at its bit depth
         needed = Signal(range(dmd.rows + 1))    # rows that complete it
         clear_index = Signal(ceil_log2(dmd.rows))
-        depth_in = Signal(4)
-        m.d.comb += depth_in.eq(self.bit_depth)
-        with m.If((self.bit_depth == 0) | (self.bit_depth > PLANES)):
-            m.d.comb += depth_in.eq(PLANES)
+        m.d.comb += [missing_r.addr.eq(cur_slot), missing_w.addr.eq(cur_slot)]
+        depth_in = self._depth_in(m)
         stored_mask = Signal(PLANES)            # planes a frame of depth cur_depth stores
         m.d.comb += [
             stored_mask.eq(Const(0xFF00, 2 * PLANES) >> cur_depth),
@@ -157,18 +154,7 @@ class RowIngest(wiring.Component):
             m.d.sync += counter.eq(counter + 1)
             m.next = "DROP"
 
-        # the store payload follows the head word
-        m.d.comb += [
-            self.store.payload.data.eq(head.data),
-            self.store.payload.slot.eq(cur_slot),
-            self.store.payload.plane.eq(head.plane),
-            self.store.payload.row.eq(head.row),
-            self.store.payload.word.eq(head.word),
-            self.store.payload.last.eq(is_last),
-            self.store.payload.completes.eq(missing == 1),
-            missing_r.addr.eq(cur_slot),
-            missing_w.addr.eq(cur_slot),
-        ]
+        self._store_word(m, slot=cur_slot, last=is_last, completes=missing == 1)
 
         with m.FSM(name="ingest") as ingest:
             m.d.comb += place.between_rows.eq(ingest.ongoing("ROW_START"))
@@ -189,20 +175,7 @@ class RowIngest(wiring.Component):
                     # WAIT: a slot frees when the frame being written becomes ready
 
             with m.State("CLEAR"):
-                # the base's occupancy of block i is read while block i - 1 is written
-                m.d.comb += [
-                    self.base_occupancy.slot.eq(base),
-                    self.base_occupancy.block.eq(clear_index[:BLOCK_BITS] + 1),
-                    self.map_writes.valid.eq(1),
-                    self.map_writes.payload.row.eq(clear_index),
-                    self.map_writes.payload.source.eq(Mux(delta, base, cur_slot)),
-                    self.map_writes.payload.block.eq(clear_index[:BLOCK_BITS]),
-                    self.map_writes.payload.occupancy_mask.eq(
-                        Cat((clear_index < 2**BLOCK_BITS) for _ in range(PLANES))),
-                    self.map_writes.payload.occupancy.eq(Mux(delta, self.base_occupancy.planes, 0)),
-                    self.map_writes.payload.opening.eq(clear_index == 0),
-                    self.map_writes.payload.delta.eq(delta),
-                ]
+                self._clear_row(m, clear_index, slot=cur_slot, delta=delta, base=base)
                 m.d.sync += clear_index.eq(clear_index + 1)
                 with m.If(clear_index == dmd.rows - 1):
                     m.d.comb += self.opened.valid.eq(1)
@@ -236,15 +209,7 @@ class RowIngest(wiring.Component):
                         self.rows.ready.eq(self.store.ready & self.words.valid),
                     ]
                     with m.If(both & self.store.ready):
-                        m.d.comb += [
-                            self.map_writes.valid.eq(1),
-                            self.map_writes.payload.row.eq(head.row),
-                            self.map_writes.payload.stored.eq(1),
-                            self.map_writes.payload.source.eq(cur_slot),
-                            self.map_writes.payload.block.eq(flags.block),
-                            self.map_writes.payload.occupancy_mask.eq(flags.planes & stored_mask),
-                            self.map_writes.payload.occupancy.eq(~0),
-                        ]
+                        self._row_arrived(m, slot=cur_slot, stored_mask=stored_mask)
                         m.d.comb += [missing_w.en.eq(1), missing_w.data.eq(missing - 1)]
                         with m.If(missing == 1):
                             m.d.comb += self.completed.valid.eq(1)
@@ -255,3 +220,58 @@ class RowIngest(wiring.Component):
                 with m.Else():
                     m.d.comb += self.words.ready.eq(1)  # a plane below the frame's bit depth
         return m
+
+    def _depth_in(self, m):
+        """The bit depth of frames that start now: ``bit_depth``, or 8 for a value outside 1..8."""
+        depth = Signal(4, name="depth_in")
+        m.d.comb += depth.eq(self.bit_depth)
+        with m.If((self.bit_depth == 0) | (self.bit_depth > PLANES)):
+            m.d.comb += depth.eq(PLANES)
+        return depth
+
+    def _store_word(self, m, *, slot, last, completes):
+        """The writer's word is the head word in the slot chosen here, whatever the row's header
+        said; ``last`` on the row's last word, ``completes`` when that row completes its frame."""
+        head, word = self.words.payload, self.store.payload
+        m.d.comb += [
+            word.data.eq(head.data),
+            word.slot.eq(slot),
+            word.plane.eq(head.plane),
+            word.row.eq(head.row),
+            word.word.eq(head.word),
+            word.last.eq(last),
+            word.completes.eq(completes),
+        ]
+
+    def _clear_row(self, m, index, *, slot, delta, base):
+        """Set row ``index`` of a slot taken for a new frame: no row arrived, the row shown from the
+        slot itself (a delta's from its base), and block ``index``'s occupancy cleared (a delta's
+        copied from its base)."""
+        writes = self.map_writes.payload
+        m.d.comb += [
+            # the base's occupancy of block i is read while block i - 1 is written
+            self.base_occupancy.slot.eq(base),
+            self.base_occupancy.block.eq(index[:BLOCK_BITS] + 1),
+            self.map_writes.valid.eq(1),
+            writes.row.eq(index),
+            writes.source.eq(Mux(delta, base, slot)),
+            writes.block.eq(index[:BLOCK_BITS]),
+            writes.occupancy_mask.eq(Cat((index < 2**BLOCK_BITS) for _ in range(PLANES))),
+            writes.occupancy.eq(Mux(delta, self.base_occupancy.planes, 0)),
+            writes.opening.eq(index == 0),
+            writes.delta.eq(delta),
+        ]
+
+    def _row_arrived(self, m, *, slot, stored_mask):
+        """Record an accepted row as it ends: its bit in the bitmap, its source its own slot, and
+        the planes of ``stored_mask`` its block has set in the occupancy map."""
+        flags, writes = self.rows.payload, self.map_writes.payload
+        m.d.comb += [
+            self.map_writes.valid.eq(1),
+            writes.row.eq(self.words.payload.row),
+            writes.stored.eq(1),
+            writes.source.eq(slot),
+            writes.block.eq(flags.block),
+            writes.occupancy_mask.eq(flags.planes & stored_mask),
+            writes.occupancy.eq(~0),
+        ]

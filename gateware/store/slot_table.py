@@ -40,6 +40,7 @@ from spec.records import ENTRIES
 
 from .entries import ENTRY_BITS, Entry
 from .layouts import COUNTER_BITS, LIVE_SLOTS, SLOT_BITS, FrameInfo
+from .placement import Placement, PlacementSignature, opening_layout
 from .slot_states import SlotStates
 
 __all__ = ["SlotTable", "SlotState", "Placement", "PlacementSignature", "opening_layout", "TableCounters"]
@@ -52,66 +53,6 @@ class SlotState(enum.Enum, shape=3):
     READY = 3
     SHOWN = 4
     KEPT = 5          # no longer showable; its words stay while a delta frame uses them
-
-
-class Placement(enum.Enum, shape=4):
-    """Where a row of a frame goes (a row number beyond the frame is the ingest's own refusal,
-    checked after ``HOLD`` and before the others)."""
-    HOLD = 0          # a change of mode is pending: nothing is decided before it
-    JOIN = 1          # the slot receiving this frame
-    TAKE = 2          # a free slot, for a new frame
-    ABANDON = 3       # the receiving slot, taken from an older frame that is not complete
-    WAIT = 4          # no slot now; one frees when the frame being written is ready
-    STALE = 5         # refused: older than the frame receiving, or not in the sequence
-    SHOWN = 6         # refused: the frame of a slot being shown
-    DUPLICATE = 7     # refused: the frame's slot is complete (sequence)
-    NO_SLOT = 8       # refused: the sequencer holds every other slot
-    NO_BASE = 9       # refused: a delta whose base is not a whole frame held
-
-
-class PlacementSignature(wiring.Signature):
-    """The ingest's question to the slot table, seen from the ingest (``sync``).
-
-    Members
-    -------
-    frame : Out(frame_bits)
-        Frame id of the row to place.
-    delta, base : Out(1), Out(frame_bits)
-        The frame is a delta of frame ``base``.
-    between_rows : Out(1)
-        The ingest waits for a row's first word: a change of mode may be applied.
-    verdict : In(Placement)
-        Where the row goes, at once.
-    slot : In(SLOT_BITS)
-        The slot for ``JOIN``, ``TAKE`` and ``ABANDON``.
-    depth : In(4)
-        The bit depth of the frame in that slot (for ``JOIN``).
-    base_slot, base_depth : In(SLOT_BITS), In(4)
-        A delta's base: its slot and bit depth (for ``TAKE`` and ``ABANDON``).
-    """
-
-    def __init__(self, frame_bits):
-        self._frame_bits = frame_bits
-        super().__init__({
-            "frame": Out(frame_bits),
-            "delta": Out(1),
-            "base": Out(frame_bits),
-            "between_rows": Out(1),
-            "verdict": In(Placement),
-            "slot": In(SLOT_BITS),
-            "depth": In(4),
-            "base_slot": In(SLOT_BITS),
-            "base_depth": In(4),
-        })
-
-    def __eq__(self, other):
-        return isinstance(other, PlacementSignature) and other._frame_bits == self._frame_bits
-
-
-def opening_layout(frame_bits):
-    """A slot taken for a new frame: from now on it receives frame ``frame`` at ``depth`` bits,
-    a delta of the frame in slot ``base`` with ``delta``."""
-    return data.StructLayout({"slot": SLOT_BITS, "frame": frame_bits, "depth": 4, "delta": 1, "base": SLOT_BITS})
 
 
 class TableCounters(data.Struct):
@@ -203,7 +144,7 @@ class SlotTable(wiring.Component):
         count = self.counters
         t = _Registers(live, self._frame_bits)
         slots = _Slots(m, t, n_slots, live)
-        state, frame_id, in_sequence, stale = t.state, t.frame_id, t.in_sequence, t.stale
+        state, in_sequence, stale = t.state, t.in_sequence, t.stale
 
         # -- mode
         seq_len = Signal(range(n_slots + 1))          # the mode in force
@@ -219,23 +160,7 @@ class SlotTable(wiring.Component):
 
         self._place(m, slots, seq_len, mode_pending | walking, sequence)
 
-        # -- the ingest's events
-        opening = self.opened.payload
-        with m.If(self.opened.valid):
-            slots.ingest(opening.slot, SlotState.RECEIVING, in_sequence=sequence, depth=opening.depth)
-            with m.If(opening.slot < live):
-                m.d.sync += [
-                    frame_id[opening.slot].eq(opening.frame),
-                    t.delta[opening.slot].eq(opening.delta),
-                    t.base[opening.slot].eq(opening.base),
-                ]
-            with m.If(~sequence):
-                m.d.sync += [t.recv_active.eq(1), t.recv_slot.eq(opening.slot), t.recv_frame.eq(opening.frame),
-                             t.last_valid.eq(1), t.last_frame.eq(opening.frame)]
-        with m.If(self.completed.valid):
-            slots.ingest(self.completed.payload, SlotState.WRITING)
-            with m.If(~sequence):
-                m.d.sync += t.recv_active.eq(0)
+        self._ingest_events(m, slots, sequence)
 
         # -- the answer to an ask
         answer = self._answer(m, slots, seq_len, sequence, high_ready)
@@ -244,13 +169,7 @@ class SlotTable(wiring.Component):
 
         # -- a base no delta uses any more is freed (housekeeping below never changes a KEPT slot
         # but to FREE)
-        used = [Signal(name=f"used{s}") for s in range(live)]
-        for s in range(live):
-            m.d.comb += used[s].eq(Cat((state[d] != SlotState.FREE) & t.delta[d] & (t.base[d] == s) & ~stale[d]
-                                       for d in range(live) if d != s).any())
-            with m.If((state[s] == SlotState.KEPT) & ~used[s]):
-                m.d.sync += state[s].eq(SlotState.FREE)
-        used = Array(used)
+        used = self._free_unused_bases(m, t)
 
         def retired(s):
             """What slot ``s`` becomes once neither shown nor showable: kept while a delta uses it
@@ -270,22 +189,7 @@ class SlotTable(wiring.Component):
         with m.If(~self.lose):
             m.d.sync += self.forgotten.eq(0)
         with m.If(walking):
-            # one sequence slot a cycle: a loss forgets it (stale if shown), a change of mode frees
-            # it unless shown and takes it out of the sequence
-            with m.If(walk_loss):
-                with m.If(hk.state != SlotState.FREE):
-                    m.d.sync += count.frames_lost.eq(count.frames_lost + 1)
-                with m.If(hk.state == SlotState.SHOWN):
-                    slots.keep(stale=1)
-                with m.Else():
-                    slots.keep(state=SlotState.FREE)
-            with m.Else():
-                slots.keep(state=Mux(hk.state == SlotState.SHOWN, SlotState.SHOWN, SlotState.FREE), in_sequence=0)
-            m.d.sync += walk_slot.eq(walk_slot + 1)
-            with m.If(walk_slot == n_slots - 1):
-                m.d.sync += walking.eq(0)
-                with m.If(walk_loss):
-                    m.d.sync += self.forgotten.eq(self.lose)
+            self._walk_step(m, slots, hk, walking, walk_loss, walk_slot)
         with m.Elif(self.lose & ~self.forgotten & self.placement.between_rows & ~offered):
             m.d.sync += [t.recv_active.eq(0), t.last_valid.eq(0), high_ready.eq(0),
                          count.calibration_losses.eq(count.calibration_losses + 1),
@@ -345,6 +249,60 @@ class SlotTable(wiring.Component):
             m.d.comb += play.next.eq(0)
             m.d.sync += finished.eq(0)
         return m
+
+    def _ingest_events(self, m, slots, sequence):
+        """The ingest's news: a slot opened for a frame (it receives it from now on) and a slot
+        whose rows have all arrived (it is being written)."""
+        registers, opening = slots.t, self.opened.payload
+        with m.If(self.opened.valid):
+            slots.ingest(opening.slot, SlotState.RECEIVING, in_sequence=sequence, depth=opening.depth)
+            with m.If(opening.slot < self._live):
+                m.d.sync += [
+                    registers.frame_id[opening.slot].eq(opening.frame),
+                    registers.delta[opening.slot].eq(opening.delta),
+                    registers.base[opening.slot].eq(opening.base),
+                ]
+            with m.If(~sequence):
+                m.d.sync += [registers.recv_active.eq(1), registers.recv_slot.eq(opening.slot),
+                             registers.recv_frame.eq(opening.frame), registers.last_valid.eq(1),
+                             registers.last_frame.eq(opening.frame)]
+        with m.If(self.completed.valid):
+            slots.ingest(self.completed.payload, SlotState.WRITING)
+            with m.If(~sequence):
+                m.d.sync += registers.recv_active.eq(0)
+
+    def _free_unused_bases(self, m, registers):
+        """Free each KEPT slot that no delta uses as its base any more. Returns, per live slot,
+        whether a delta held uses it (an :class:`Array`)."""
+        live, state = self._live, registers.state
+        used = [Signal(name=f"used{slot}") for slot in range(live)]
+        for slot in range(live):
+            m.d.comb += used[slot].eq(Cat((state[other] != SlotState.FREE) & registers.delta[other]
+                                          & (registers.base[other] == slot) & ~registers.stale[other]
+                                          for other in range(live) if other != slot).any())
+            with m.If((state[slot] == SlotState.KEPT) & ~used[slot]):
+                m.d.sync += state[slot].eq(SlotState.FREE)
+        return Array(used)
+
+    def _walk_step(self, m, slots, looked_at, walking, walk_loss, walk_slot):
+        """One sequence slot a cycle (``looked_at``, housekeeping's view of ``walk_slot``): a loss
+        forgets it (stale if shown), a change of mode frees it unless shown and takes it out of
+        the sequence."""
+        count = self.counters
+        with m.If(walk_loss):
+            with m.If(looked_at.state != SlotState.FREE):
+                m.d.sync += count.frames_lost.eq(count.frames_lost + 1)
+            with m.If(looked_at.state == SlotState.SHOWN):
+                slots.keep(stale=1)
+            with m.Else():
+                slots.keep(state=SlotState.FREE)
+        with m.Else():
+            slots.keep(state=Mux(looked_at.state == SlotState.SHOWN, SlotState.SHOWN, SlotState.FREE), in_sequence=0)
+        m.d.sync += walk_slot.eq(walk_slot + 1)
+        with m.If(walk_slot == self._slots - 1):
+            m.d.sync += walking.eq(0)
+            with m.If(walk_loss):
+                m.d.sync += self.forgotten.eq(self.lose)
 
     def _walk(self, m, walking, walk_loss, walk_slot, *, loss):
         """Start the walk over the sequence slots (if there are any beyond the live ones);
