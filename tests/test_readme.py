@@ -6,6 +6,8 @@ import importlib
 import re
 from pathlib import Path
 
+import pytest
+
 from flow import figures as figures_doc
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -23,7 +25,12 @@ def test_readme_headlines_are_the_figures_page():
     """The README's headline figures are the ones ``docs/figures.md`` holds: none copied by
     hand, none stale (``make figures`` writes both from one ``build/bench.json``)."""
     block = README.split(figures_doc.README_BEGIN, 1)[1].split(figures_doc.README_END, 1)[0].strip()
-    page = figures_doc.parse((ROOT / "docs" / "figures.md").read_text())
+    page_path = ROOT / "docs" / "figures.md"
+    if not page_path.exists():
+        # no make bench has been written out yet: then the README must quote no figure either
+        assert block == "(run `make bench`, then `make figures`)", block
+        pytest.skip("docs/figures.md not written yet (make bench, then make figures)")
+    page = figures_doc.parse(page_path.read_text())
     assert all(name in page for _what, name in figures_doc.HEADLINES)
     assert block == figures_doc.headlines(page)
 
