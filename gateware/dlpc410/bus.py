@@ -23,12 +23,12 @@ cycle after, it is applied: the command registers (the pins show it :data:`DECIS
 cycles after the decision), the pulse event, the load's progress. (The operation is registered
 as chosen without the pulses, and a pulse decided with it takes its place as it is applied.) A
 load's last operation ends the group's load on the cycle before the next decision may be made.
+Where the load at the head, and the dark's clears, have got to is kept by :class:`LoadCursor`.
 """
 
 from amaranth import Array, Cat, Const, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
-from amaranth.utils import ceil_log2
 
 from spec.schedule import DECISION_TO_PINS, row_cycles
 
@@ -37,9 +37,20 @@ from ..counter import Counter
 from ..registers import Registers, ResetMode
 from .due import lowest_due
 from .interface import BlockMode, RowMode
-from .layouts import COUNTER_BITS, Command, PulseSignature, dark_load, group_bits, ready_load
+from .layouts import COUNTER_BITS, Command, PulseSignature, block_bits, dark_load, group_bits, ready_load
 
-__all__ = ["Bus", "DECISION_TO_PINS"]
+__all__ = ["Bus", "LoadCursor", "DECISION_TO_PINS"]
+
+
+def _decision(dmd):
+    """The bus's decision, registered: whether it pulses (and which group), loads a row or clears
+    a block (a dark's clear, the load's last operation), for which group, block and row; and, for
+    the load's operation after it, where that one will stand."""
+    group_index_bits, block_index_bits = group_bits(dmd), block_bits(dmd)
+    return data.StructLayout({
+        "pulse": 1, "pulse_group": group_index_bits, "row": 1, "clear": 1, "dark": 1, "last": 1,
+        "load_group": dmd.blocks, "block": block_index_bits, "row_at": 11, "fresh": 1, "starved": 1,
+        "block_last": 1, "following": block_index_bits, "following_last": 1, "following_filled": 1})
 
 
 class Bus(wiring.Component):
@@ -114,10 +125,8 @@ class Bus(wiring.Component):
         m = Module()
         dmd, regs = self._dmd, self.regs
         cycles_per_row = row_cycles(dmd, self._beats)
-        rows_per_block = dmd.rows_per_block
         blocks = dmd.blocks
-        group_index_bits = group_bits(dmd)
-        block_index_bits = ceil_log2(blocks) or 1
+        block_index_bits = block_bits(dmd)
         clear_cycles = dmd.clear_row_cycles * cycles_per_row
 
         # after an operation is applied: cycles until the next decision may be made (the next
@@ -139,27 +148,17 @@ class Bus(wiring.Component):
         m.d.comb += [self.planner.choice.eq(pulse_choice), self.planner.pulsing.eq(do_pulse)]
 
         # ---- loads: the operation at the head ----
-        # (the head's first operation, or the next of a load under way: whether it loads a row
-        # and whether it is the load's last, worked out as the operation before was applied)
-        head = self.loads.payload
-        fresh = Signal(init=1)                 # the head's first operation is next
-        load_block = Signal(block_index_bits)
-        load_row = Signal(range(rows_per_block))
-        load_occupied, load_last = Signal(), Signal()
-        row_at = Signal(11)                    # the next row's address, once not fresh
-        cur_block = Mux(fresh, head.first, load_block)
-        occupied = Mux(fresh, head.first_occupied, load_occupied)
-        last_op = Mux(fresh, head.single, load_last)
+        # (the head's first operation, or the next of a load under way, and the dark's next clear)
+        head, dark = self.loads.payload, self.darks.payload
+        m.submodules.cursor = cursor = LoadCursor(dmd)
+        m.d.comb += [cursor.head.eq(head), cursor.dark.eq(dark), cursor.restart.eq(self.restart)]
+        operation, clear_block = cursor.operation, cursor.clear_block
         m.submodules.pace = pace = Countdown(8, lag=1, flags="settled")
         # (one AND of the flags each: the head's group may change, ...; chosen as if no pulse
         # were due, the pulse's priority applied from the registered decision, so that the due
         # flags' priority is not in series with the operation's conditions)
         may_op = free & ~self.flushing & ~self.hold
         # ---- a dark pulse's clears first, once its group's memory may change ----
-        dark = self.darks.payload
-        dark_fresh = Signal(init=1)               # the dark's first block is next
-        dark_block = Signal(block_index_bits)
-        cur_dark = Mux(dark_fresh, dark.first, dark_block)
         dark_ready = self.darks.valid & self.planner.writable.bit_select(dark.group, 1)
         do_dark = may_op & dark_ready & ~self.planner.imminent_clear
         # a load operation waits while the dark's clears go first, or would wait for it (the
@@ -167,25 +166,22 @@ class Bus(wiring.Component):
         can_load = may_op & self.loads.valid & self.planner.writable.bit_select(head.group, 1)
         dark_soon = self.darks.valid & self.planner.frees_soon.bit_select(dark.group, 1)
         dark_soon_clear = self.darks.valid & self.planner.frees_soon_clear.bit_select(dark.group, 1)
-        wants_row = can_load & ~self.planner.imminent & ~dark_soon & occupied & pace.done
+        wants_row = can_load & ~self.planner.imminent & ~dark_soon & operation.occupied & pace.done
         do_row = wants_row & self.row_ready
-        do_clear = (can_load & ~self.planner.imminent_clear & ~dark_soon_clear & ~occupied) | do_dark
+        do_clear = (can_load & ~self.planner.imminent_clear & ~dark_soon_clear & ~operation.occupied) | do_dark
 
         # ---- the decision, registered ----
-        decision = Signal(data.StructLayout({
-            "pulse": 1, "pulse_group": group_index_bits, "row": 1, "clear": 1, "dark": 1, "last": 1,
-            "load_group": blocks, "block": block_index_bits, "row_at": 11, "fresh": 1, "starved": 1, "block_last": 1,
-            "following": block_index_bits, "following_last": 1, "following_filled": 1}))
-        following = (cur_block + 1)[:block_index_bits]
+        decision = Signal(_decision(dmd))
+        following = (operation.block + 1)[:block_index_bits]
         m.d.sync += [decision.pulse.eq(do_pulse), decision.pulse_group.eq(_lowest(due, fours)),
                      decision.row.eq(do_row), decision.clear.eq(do_clear), decision.dark.eq(dark_ready),
-                     decision.last.eq(Mux(dark_ready, cur_dark == dark.last, last_op)),
+                     decision.last.eq(Mux(dark_ready, clear_block == dark.last, operation.last)),
                      decision.load_group.eq(1 << Mux(dark_ready, dark.group, head.group)),
-                     decision.block.eq(Mux(dark_ready, cur_dark, cur_block)),
-                     decision.row_at.eq(Mux(fresh, head.first_row, row_at)), decision.fresh.eq(fresh),
+                     decision.block.eq(Mux(dark_ready, clear_block, operation.block)),
+                     decision.row_at.eq(operation.row_at), decision.fresh.eq(operation.fresh),
                      decision.starved.eq(wants_row & ~self.row_ready),
                      # (for the operation after it)
-                     decision.block_last.eq(cur_block == head.last), decision.following.eq(following),
+                     decision.block_last.eq(operation.block == head.last), decision.following.eq(following),
                      decision.following_last.eq(following == head.last),
                      decision.following_filled.eq(head.mask.bit_select(following, 1))]
 
@@ -195,37 +191,11 @@ class Bus(wiring.Component):
         m.d.comb += [row.eq(decision.row & ~decision.pulse), clear.eq(decision.clear & ~decision.pulse),
                      starved.eq(decision.starved & ~decision.pulse)]
         op = row | clear
-        m.d.comb += [pace.load.eq(row), pace.value.eq(regs.row_period)]
-        with m.If(clear & decision.dark):
-            with m.If(decision.last):
-                m.d.comb += self.darks.ready.eq(1)
-                m.d.sync += dark_fresh.eq(1)
-            with m.Else():
-                m.d.sync += [dark_fresh.eq(0), dark_block.eq(decision.block + 1)]
-        with m.Elif(op):
-            with m.If(decision.last):
-                m.d.comb += self.loads.ready.eq(1)
-                m.d.sync += fresh.eq(1)
-            with m.Else():
-                m.d.sync += fresh.eq(0)
-                at_row = Mux(decision.fresh, 0, load_row)
-                with m.If(row & (at_row != rows_per_block - 1)):
-                    # the block's next row
-                    m.d.sync += [load_block.eq(decision.block), load_row.eq(at_row + 1), load_occupied.eq(1),
-                                 load_last.eq(decision.block_last & (at_row == rows_per_block - 2))]
-                with m.Else():
-                    # the next block: its rows, or a clear
-                    m.d.sync += [load_block.eq(decision.following), load_row.eq(0),
-                                 load_occupied.eq(decision.following_filled),
-                                 load_last.eq(decision.following_last
-                                              & (~decision.following_filled | (rows_per_block == 1)))]
-            # rows are numbered block after block: the next row follows this one, or the next
-            # block's first row follows a cleared block's
-            m.d.sync += row_at.eq(decision.row_at + Mux(row, 1, rows_per_block))
+        m.d.comb += [pace.load.eq(row), pace.value.eq(regs.row_period),
+                     cursor.decision.eq(decision), cursor.row.eq(row), cursor.clear.eq(clear),
+                     self.loads.ready.eq(cursor.load_taken), self.darks.ready.eq(cursor.dark_taken)]
         with m.If(self.flushing):
             m.d.comb += [self.loads.ready.eq(1), self.darks.ready.eq(1)]
-        with m.If(self.restart):
-            m.d.sync += [fresh.eq(1), dark_fresh.eq(1)]
 
         # a row counts once however many cycles it waits for its data
         waiting = Signal()
@@ -307,6 +277,104 @@ class Bus(wiring.Component):
         with m.Else():
             m.d.sync += [self.dvalid.eq(0), op_row.eq(0), cmd.rowmd.eq(RowMode.NOOP),
                          cmd.blkmd.eq(BlockMode.NOOP), cmd.rst2blkz.eq(1)]
+
+
+class LoadCursor(wiring.Component):
+    """Where the ready load at the head of its queue, and the dark pulse's clears at the head of
+    theirs, have got to: the next operation of each, worked out as the operation before it is
+    applied, so that the bus decides from registers.
+
+    Parameters
+    ----------
+    dmd : :class:`spec.facts.DmdType`
+
+    Members
+    -------
+    head : In(ready_load)
+        The ready load at the head of its queue.
+    dark : In(dark_load)
+        The dark pulse's clears at the head of their queue.
+    decision : In(StructLayout)
+        The bus's decision of the cycle before (:func:`_decision`), applied now.
+    row, clear : In(1)
+        The operation applied now loads a row, clears a block (a pulse took the place of neither).
+    restart : In(1)
+        The next operations are the loads' first (the frame control takes a frame while waiting).
+    operation : Out(StructLayout(fresh, block, occupied, last, row_at))
+        The head load's next operation: whether it is the load's first, its block, whether it
+        loads a row of that block (else it clears the block), whether it is the load's last, and
+        its row's address (rows are numbered block after block).
+    clear_block : Out(block_bits)
+        The block the dark's next clear clears.
+    load_taken, dark_taken : Out(1)
+        The head load's, the dark's last operation is applied now: its queue may let it go.
+    """
+
+    def __init__(self, dmd):
+        self._dmd = dmd
+        block_index_bits = block_bits(dmd)
+        super().__init__({
+            "head": In(ready_load(dmd)),
+            "dark": In(dark_load(dmd)),
+            "decision": In(_decision(dmd)),
+            "row": In(1),
+            "clear": In(1),
+            "restart": In(1),
+            "operation": Out(data.StructLayout({"fresh": 1, "block": block_index_bits, "occupied": 1, "last": 1,
+                                                "row_at": 11})),
+            "clear_block": Out(block_index_bits),
+            "load_taken": Out(1),
+            "dark_taken": Out(1),
+        })
+
+    def elaborate(self, platform):
+        m = Module()
+        rows_per_block = self._dmd.rows_per_block
+        block_index_bits = block_bits(self._dmd)
+        head, dark, decision, row, operation = self.head, self.dark, self.decision, self.row, self.operation
+        # the head's next operation once the load is under way (while ``fresh``, the head's first)
+        fresh = Signal(init=1)
+        load_block = Signal(block_index_bits)
+        load_row = Signal(range(rows_per_block))
+        load_occupied = Signal()
+        load_last = Signal()
+        row_at = Signal(11)
+        dark_fresh = Signal(init=1)               # the dark's first block is next
+        dark_block = Signal(block_index_bits)
+        m.d.comb += [operation.fresh.eq(fresh), operation.block.eq(Mux(fresh, head.first, load_block)),
+                     operation.occupied.eq(Mux(fresh, head.first_occupied, load_occupied)),
+                     operation.last.eq(Mux(fresh, head.single, load_last)),
+                     operation.row_at.eq(Mux(fresh, head.first_row, row_at)),
+                     self.clear_block.eq(Mux(dark_fresh, dark.first, dark_block))]
+        with m.If(self.clear & decision.dark):
+            with m.If(decision.last):
+                m.d.comb += self.dark_taken.eq(1)
+                m.d.sync += dark_fresh.eq(1)
+            with m.Else():
+                m.d.sync += [dark_fresh.eq(0), dark_block.eq(decision.block + 1)]
+        with m.Elif(row | self.clear):
+            with m.If(decision.last):
+                m.d.comb += self.load_taken.eq(1)
+                m.d.sync += fresh.eq(1)
+            with m.Else():
+                m.d.sync += fresh.eq(0)
+                at_row = Mux(decision.fresh, 0, load_row)
+                with m.If(row & (at_row != rows_per_block - 1)):
+                    # the block's next row
+                    m.d.sync += [load_block.eq(decision.block), load_row.eq(at_row + 1), load_occupied.eq(1),
+                                 load_last.eq(decision.block_last & (at_row == rows_per_block - 2))]
+                with m.Else():
+                    # the next block: its rows, or a clear
+                    m.d.sync += [load_block.eq(decision.following), load_row.eq(0),
+                                 load_occupied.eq(decision.following_filled),
+                                 load_last.eq(decision.following_last
+                                              & (~decision.following_filled | (rows_per_block == 1)))]
+            # rows are numbered block after block: the next row follows this one, or the next
+            # block's first row follows a cleared block's
+            m.d.sync += row_at.eq(decision.row_at + Mux(row, 1, rows_per_block))
+        with m.If(self.restart):
+            m.d.sync += [fresh.eq(1), dark_fresh.eq(1)]
+        return m
 
 
 def _lowest(bits, fours):

@@ -147,7 +147,6 @@ class FrameControl(wiring.Component):
             "start": 1, "take": 1, "newer": 1, "flush": 1, "restart": 1,
             "obey": 1, "hold": 1, "release": 1, "overrun": 1, "early": 1, "after_end": 1}))
         begun = Signal(START)                  # the frame a start begins
-        restarting = Signal()                  # RESTART: the controller is ready again
 
         # ---- the state the decisions so far leave ----
         retakes = Signal()                     # a frame taken or a restart (registered apart)
@@ -159,55 +158,9 @@ class FrameControl(wiring.Component):
         holding = Signal()
         holding_now = (holding | did.hold) & ~did.release
 
+        # ---- the states, their flags registered with them ----
         flush_over = self._lead(m, did)
-        last_group = Signal.like(self.n_groups)          # (the registers hold still)
-        m.d.sync += last_group.eq(self.n_groups - 1)
-        # the state's flags, registered with it (set on each change of state)
-        run = Signal()
-        queueing = Signal()                    # QUEUE or RELOAD: a first plane queued each cycle
-        waiting = Signal(init=1)               # WAIT
-
-        def goto(state):
-            m.next = state
-            m.d.sync += [self.running.eq(state in ("RUN", "FLUSH", "RELOAD")), run.eq(state == "RUN"),
-                         self.flushing.eq(state in ("FLUSH", "RESTART")),
-                         queueing.eq(state in ("QUEUE", "RELOAD")), waiting.eq(state == "WAIT")]
-
-        def restart_on_init():
-            with m.If(~self.initialised):
-                goto("RESTART")
-
-        with m.FSM(name="start"):
-            with m.State("WAIT"):
-                with m.If(did.start):
-                    goto("QUEUE")
-            with m.State("QUEUE"):
-                self._queue_first_planes(m, start_group, goto, last_group)
-                restart_on_init()
-            with m.State("RUN"):
-                with m.If(did.take):
-                    goto("RELOAD")
-                    with m.If(did.flush):
-                        goto("FLUSH")
-                restart_on_init()
-            with m.State("FLUSH"):
-                # queued loads are dropped by the requester, looked-up ones by the bus, the words
-                # asked for are discarded; then the first planes are queued, exactly
-                # ``flush_rows * row_period`` cycles after the frame was taken
-                with m.If(self.drained & flush_over):
-                    goto("RELOAD")
-                restart_on_init()
-            with m.State("RELOAD"):
-                self._queue_first_planes(m, start_group, goto, last_group)
-                restart_on_init()
-            with m.State("RESTART"):
-                # no pulse, no load; what was under way is dropped as in FLUSH
-                m.d.comb += restarting.eq(self.initialised & self.drained & ~did.restart)
-                with m.If(did.restart):
-                    goto("RELOAD")
-
-        # (from the state's flag, not its decode)
-        m.d.comb += [self.queue_first.valid.eq(queueing), self.queue_first.payload.eq(start_group)]
+        run, waiting, restarting = self._states(m, did, start_group, flush_over)
 
         # ---- decisions ----
         # a newer streamed frame offered while no group plays replaces the preloaded first planes
@@ -276,6 +229,61 @@ class FrameControl(wiring.Component):
                      self.ready.eq(ready & ~holding_now & ~ended)]
         m.d.comb += self.at_rest.eq(rest & ~settles)
         return m
+
+    def _states(self, m, did, start_group, flush_over):
+        """The states (see the module's notes), from the decisions applied now (``did``), with
+        ``start_group`` the group whose first plane is queued next and ``flush_over`` the flush's
+        end: returns the flags ``run`` (RUN) and ``waiting`` (WAIT), registered with the state,
+        and ``restarting`` (RESTART, and the controller is ready again)."""
+        restarting = Signal()                  # RESTART: the controller is ready again
+        last_group = Signal.like(self.n_groups)          # (the registers hold still)
+        m.d.sync += last_group.eq(self.n_groups - 1)
+        # the state's flags, registered with it (set on each change of state)
+        run = Signal()
+        queueing = Signal()                    # QUEUE or RELOAD: a first plane queued each cycle
+        waiting = Signal(init=1)               # WAIT
+
+        def goto(state):
+            m.next = state
+            m.d.sync += [self.running.eq(state in ("RUN", "FLUSH", "RELOAD")), run.eq(state == "RUN"),
+                         self.flushing.eq(state in ("FLUSH", "RESTART")),
+                         queueing.eq(state in ("QUEUE", "RELOAD")), waiting.eq(state == "WAIT")]
+
+        def restart_on_init():
+            with m.If(~self.initialised):
+                goto("RESTART")
+
+        with m.FSM(name="start"):
+            with m.State("WAIT"):
+                with m.If(did.start):
+                    goto("QUEUE")
+            with m.State("QUEUE"):
+                self._queue_first_planes(m, start_group, goto, last_group)
+                restart_on_init()
+            with m.State("RUN"):
+                with m.If(did.take):
+                    goto("RELOAD")
+                    with m.If(did.flush):
+                        goto("FLUSH")
+                restart_on_init()
+            with m.State("FLUSH"):
+                # queued loads are dropped by the requester, looked-up ones by the bus, the words
+                # asked for are discarded; then the first planes are queued, exactly
+                # ``flush_rows * row_period`` cycles after the frame was taken
+                with m.If(self.drained & flush_over):
+                    goto("RELOAD")
+                restart_on_init()
+            with m.State("RELOAD"):
+                self._queue_first_planes(m, start_group, goto, last_group)
+                restart_on_init()
+            with m.State("RESTART"):
+                # no pulse, no load; what was under way is dropped as in FLUSH
+                m.d.comb += restarting.eq(self.initialised & self.drained & ~did.restart)
+                with m.If(did.restart):
+                    goto("RELOAD")
+        # (from the state's flag, not its decode)
+        m.d.comb += [self.queue_first.valid.eq(queueing), self.queue_first.payload.eq(start_group)]
+        return run, waiting, restarting
 
     def _queue_first_planes(self, m, start_group, goto, last_group):
         m.d.sync += start_group.eq(start_group + 1)

@@ -197,21 +197,11 @@ class Planner(wiring.Component):
                      self.lsb.eq(first.showing.lsb_or(regs.lsb))]
 
         # ---- the frame offered: taken by a group (last cycle), or by a start or retake now ----
-        m.submodules.offers = offers = FrameOffer(blocks)
-        wiring.connect(m, wiring.flipped(self.frames), offers.frames)
-        m.d.comb += [offers.regs.eq(regs), offers.active.eq(active), offers.reload.eq(self.reload)]
-        taking = Signal()                      # a group took the offered frame last cycle
-        m.d.comb += [offers.answered.eq(taking | (self.start.valid & self.start.payload.take)
-                                        | (self.retake.valid & self.retake.payload.newer)),
-                     self.offer.eq(offers.offer), self.offer.valid.eq(offers.held & ~taking),
-                     self.bad_frames.eq(offers.bad_frames),
-                     frames.offered.slot.eq(offers.offer.slot), frames.offered.depth.eq(offers.offer.depth),
-                     frames.offered.low_plane.eq(offers.offer.low_plane),
-                     frames.offered.showing.eq(offers.offer.showing)]
+        offer, taking = self._offered(m, frames)
 
         # ---- the decision: what the pulse the bus chooses does (registered) ----
         pulse = self.bus.choice
-        usable = offers.offer.valid & ~use_prng
+        usable = offer.valid & ~use_prng
         # (the first group to move on to a new frame takes the one offered: ``frames.first``)
         hidden, final, takes = self._outcomes(
             m, info, frames, dark, usable, frames.first)
@@ -256,47 +246,26 @@ class Planner(wiring.Component):
                     m.d.comb += frames.advance[g].eq(info.last[g])
                 with m.Else():
                     m.d.sync += dark[g].eq(1)
-        m.submodules.started = started = Counter(COUNTER_BITS)
-        m.submodules.late_count = late_count = Counter(COUNTER_BITS)
-        was_late = Signal()                    # (counted a cycle later)
-        m.d.sync += was_late.eq((decided & late_now).any())
-        m.d.comb += [started.inc.eq(starts), self.frames_started.eq(started.count),
-                     late_count.inc.eq(was_late), self.late.eq(late_count.count)]
-        ended = Signal()
-        with m.If(starts):
-            m.d.sync += self.sync_out.eq(1)
-        # (the last group to end its play: in GROUPS, whichever it is; ``playing`` is worked out
-        # from the groups that played the cycle before)
-        with m.If(ends_any & ~self.playing):
-            m.d.sync += self.sync_out.eq(0)
-        with m.If(ends_seq):
-            m.d.sync += ended.eq(1)
+        # ---- the frame's marks and the counters ----
+        abandon = self.retake.valid & self.retake.payload.abandon
+        ended = self._frame_marks(m, starts, ends_any, ends_seq, abandon, late=(decided & late_now).any())
 
         # ---- the load job, from the group's new state (and a first plane queued) ----
-        m.submodules.load_jobs = jobs = LoadJobs(dmd)
-        wiring.connect(m, wiring.flipped(self.queue_first), jobs.queue_first)
-        wiring.connect(m, jobs.jobs, wiring.flipped(self.jobs))
-        m.d.comb += [jobs.regs.eq(regs), jobs.pulse.eq(decided), jobs.pulse_any.eq(decided_any),
-                     jobs.dark.eq(dark), jobs.next.eq(frames.next)]
-        for g in range(blocks):
-            m.d.comb += [jobs.pos[g].eq(pos[g]), jobs.frame[g].eq(frames.frame[g])]
+        jobs = self._load_jobs(m, frames, pos, dark, decided, decided_any)
 
         # ---- the frame control's events ----
         with m.If(self.start.valid):
             begin = self.start.payload
             m.d.comb += [every.valid.eq(1), every.payload.slot.eq(begin.slot), every.payload.depth.eq(begin.depth),
                          every.payload.low_plane.eq(begin.low_plane), every.payload.showing.eq(begin.showing)]
-            m.d.sync += [ended.eq(0), dark.eq(0)] + [pos[g].eq(0) for g in range(blocks)]
-        abandon = self.retake.valid & self.retake.payload.abandon
+            m.d.sync += [dark.eq(0)] + [pos[g].eq(0) for g in range(blocks)]
         with m.If(self.retake.valid):
             newer = self.retake.payload.newer
-            with m.If(newer):
-                m.d.sync += ended.eq(0)
             m.d.comb += [every.valid.eq(1),
                          every.payload.eq(Mux(newer, frames.offered.as_value(), frames.next.as_value()))]
             m.d.sync += loaded.eq(0)
             with m.If(abandon):
-                m.d.sync += [dark.eq(0), self.sync_out.eq(0)] + [pos[g].eq(0) for g in range(blocks)]
+                m.d.sync += [dark.eq(0)] + [pos[g].eq(0) for g in range(blocks)]
         m.d.comb += [times.obey.eq(self.trigger), times.abandon.eq(abandon)]
         # (a trigger sets the groups of the mode playing; the registers change only while none
         # plays, so no group outside the mode ever plays)
@@ -315,6 +284,68 @@ class Planner(wiring.Component):
         # ---- what the bus may do next cycle (registered) ----
         self._bus_flags(m, times, info, watch, decided)
         return m
+
+    def _offered(self, m, frames):
+        """The store's offer, registered (:class:`~.frame_offer.FrameOffer`), for the frame control
+        and the groups' ``frames``: answered when a group took it the cycle before, or a start or
+        a retake of a newer frame takes it now. Returns the offer and ``taking``, which the caller
+        drives (a group took the offered frame the cycle before)."""
+        m.submodules.offers = offers = FrameOffer(self._dmd.blocks)
+        wiring.connect(m, wiring.flipped(self.frames), offers.frames)
+        m.d.comb += [offers.regs.eq(self.regs), offers.active.eq(self.active), offers.reload.eq(self.reload)]
+        taking = Signal()                      # a group took the offered frame last cycle
+        m.d.comb += [offers.answered.eq(taking | (self.start.valid & self.start.payload.take)
+                                        | (self.retake.valid & self.retake.payload.newer)),
+                     self.offer.eq(offers.offer), self.offer.valid.eq(offers.held & ~taking),
+                     self.bad_frames.eq(offers.bad_frames),
+                     frames.offered.slot.eq(offers.offer.slot), frames.offered.depth.eq(offers.offer.depth),
+                     frames.offered.low_plane.eq(offers.offer.low_plane),
+                     frames.offered.showing.eq(offers.offer.showing)]
+        return offers.offer, taking
+
+    def _load_jobs(self, m, frames, pos, dark, decided, decided_any):
+        """The load jobs (:class:`~.load_jobs.LoadJobs`), from each group's ``frames``, display
+        position ``pos`` and ``dark`` flag as the pulse applied now (``decided``, ``decided_any``)
+        leaves them, and the first planes queued. Returns the part, whose ``due`` the frame
+        control reads."""
+        m.submodules.load_jobs = jobs = LoadJobs(self._dmd)
+        wiring.connect(m, wiring.flipped(self.queue_first), jobs.queue_first)
+        wiring.connect(m, jobs.jobs, wiring.flipped(self.jobs))
+        m.d.comb += [jobs.regs.eq(self.regs), jobs.pulse.eq(decided), jobs.pulse_any.eq(decided_any),
+                     jobs.dark.eq(dark), jobs.next.eq(frames.next)]
+        for g in range(self._dmd.blocks):
+            m.d.comb += [jobs.pos[g].eq(pos[g]), jobs.frame[g].eq(frames.frame[g])]
+        return jobs
+
+    def _frame_marks(self, m, starts, ends_any, ends_seq, abandon, *, late):
+        """``sync_out`` (high from a frame's first pulse, ``starts``, until the last group's play
+        ends, ``ends_any``, or the groups abandon their frames), the frames started and the late
+        pulses counted (``late``: the pulse applied now is late, counted a cycle later), and
+        ``ended`` (returned, registered: a sequence played once reached its last frame,
+        ``ends_seq``; a frame taken anew clears it)."""
+        m.submodules.started = started = Counter(COUNTER_BITS)
+        m.submodules.late_count = late_count = Counter(COUNTER_BITS)
+        was_late = Signal()                    # (counted a cycle later)
+        m.d.sync += was_late.eq(late)
+        m.d.comb += [started.inc.eq(starts), self.frames_started.eq(started.count),
+                     late_count.inc.eq(was_late), self.late.eq(late_count.count)]
+        ended = Signal()
+        with m.If(starts):
+            m.d.sync += self.sync_out.eq(1)
+        # (the last group to end its play: in GROUPS, whichever it is; ``playing`` is worked out
+        # from the groups that played the cycle before)
+        with m.If(ends_any & ~self.playing):
+            m.d.sync += self.sync_out.eq(0)
+        with m.If(ends_seq):
+            m.d.sync += ended.eq(1)
+        with m.If(self.start.valid):
+            m.d.sync += ended.eq(0)
+        with m.If(self.retake.valid):
+            with m.If(self.retake.payload.newer):
+                m.d.sync += ended.eq(0)
+            with m.If(abandon):
+                m.d.sync += self.sync_out.eq(0)
+        return ended
 
     def _ready_flags(self, m, times, decided):
         """``all_ready`` and ``trigger_ready``, registered from this cycle's changes: a trigger or

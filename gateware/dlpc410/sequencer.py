@@ -248,6 +248,13 @@ class Sequencer(wiring.Component):
         wiring.connect(m, planner.bus, bus.planner)
 
         # ---- outputs and counters ----
+        self._outputs(m, init, planner, control, bus, camera, period_watch)
+        self._drive_pins(m, init, bus)
+        return m
+
+    def _outputs(self, m, init, planner, control, bus, camera, period_watch):
+        """The camera, sync and status outputs: the frame's marks to the camera trigger and the
+        period watch, and every part's counters to ``status``."""
         m.d.comb += [
             camera.frame_start.eq(planner.camera_start),
             period_watch.frame_start.eq(planner.frame_start), period_watch.depth.eq(planner.depth),
@@ -269,9 +276,6 @@ class Sequencer(wiring.Component):
             self.status.after_end.eq(control.after_end),
             self.status.underruns.eq(bus.underruns),
         ]
-
-        self._drive_pins(m, init, bus)
-        return m
 
     def _split_jobs(self, m, jobs, planes, darks, size_log2):
         """The planner's ``jobs`` to the plane jobs' queue (``planes``, the requester's) and a dark

@@ -220,7 +220,7 @@ WINDOW_GROUPS = {
     "store: reader": ["store.reader", "store.reader.run_start"],
     "sequencer: control (broker, trigger, control)": ["broker", "sequencer.trigger", "sequencer.control"],
     "sequencer: planner": ["sequencer.planner"],
-    "sequencer: bus": ["sequencer.bus"],
+    "sequencer: bus": ["sequencer.bus", "sequencer.bus.cursor"],
 }
 #: The core's pins the last group shows: DLPC410, trigger, sync and camera.
 WINDOW_PINS = [name.split("[")[0] for group in ("sequencer: trigger and sync", "sequencer: DLPC410 pins")
