@@ -140,10 +140,36 @@ def print_table(figures):
         print(f"{key:<{width}}  {text:>14}  {unit:<{units}}  {figures[key].get('source') or '(no source)'}")
 
 
-def main(modules=None, resources=True, path="build/bench.json"):
+def commit():
+    """The commit the figures are measured on (short hash, ``-dirty`` when the tree has changes),
+    or None outside a git work tree."""
+    import subprocess
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], capture_output=True, text=True,
+                              check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], capture_output=True,
+                               text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return head + ("-dirty" if dirty else "")
+
+
+def main(modules=None, resources=True, path="build/bench.json", merge=False):
     """Collect, write and print the figures; 1 if a figure has no source or a model's figure
-    lacks ``_model`` in its name (:data:`CHECKS`), else 0."""
+    lacks ``_model`` in its name (:data:`CHECKS`), else 0. Each figure records the
+    :func:`commit` it was measured on. ``merge``: the figures of the modules run (and the synthesis
+    figures, with ``resources``) replace theirs in the ``path`` written before, the others kept as
+    they were (each with its own commit); the checks are counted again over the whole."""
     figures = collect(modules, resources=resources)
+    measured_on = commit()
+    for key in figures:
+        figures[key]["commit"] = measured_on
+    if merge and Path(path).exists():
+        figures = {**{k: v for k, v in json.loads(Path(path).read_text()).items() if k not in CHECKS}, **figures}
+        missing, from_model = _check({k: v for k, v in figures.items() if k not in CHECKS})
+        counted = "arithmetic: counted by flow.bench.collect over this run's figures' names and sources"
+        figures[CHECKS[0]] = {"value": len(missing), "unit": "figures", "source": counted, "commit": measured_on}
+        figures[CHECKS[1]] = {"value": len(from_model), "unit": "figures", "source": counted, "commit": measured_on}
     path = write(figures, path)
     print_table(figures)
     print(f"wrote {path}")

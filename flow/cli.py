@@ -34,6 +34,8 @@ def main(argv=None):
     bench = sub.add_parser("bench", help="run the benchmarks and write build/bench.json")
     bench.add_argument("--only", action="append", help="run only this benchmark module (repeatable)")
     bench.add_argument("--no-resources", action="store_true", help="skip the synthesis figures")
+    bench.add_argument("--merge", action="store_true",
+                       help="replace only the figures measured now in build/bench.json, keep the others")
     sub.add_parser("figures", help="write docs/figures.md from build/bench.json (make bench's figures)")
     sim = sub.add_parser("sim", help="the system simulation on the default scene")
     sim.add_argument("--frames", type=int, default=None, help="number of frames to store and show")
@@ -71,7 +73,7 @@ def main(argv=None):
         return run(quick=args.quick, only=args.only, jobs=args.jobs)
     if args.command == "bench":
         from flow.bench import main as run
-        return run(args.only, resources=not args.no_resources)
+        return run(args.only, resources=not args.no_resources, merge=args.merge)
     if args.command == "figures":
         from flow.figures import main as run
         try:

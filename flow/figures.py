@@ -68,12 +68,22 @@ def _value(value):
     return f"{value:.6g}"
 
 
+def _commits(figures):
+    """The commits the figures were measured on (``make bench`` records each figure's; a
+    ``--merge`` run leaves the figures it did not measure with theirs), and how many each."""
+    counts = {}
+    for entry in figures.values():
+        counts[entry.get("commit") or "not recorded"] = counts.get(entry.get("commit") or "not recorded", 0) + 1
+    return "Measured on commit " + ", ".join(f"`{commit}` ({n} figures)" for commit, n in
+                                             sorted(counts.items(), key=lambda item: -item[1])) + "."
+
+
 def render(figures):
     """The Markdown of ``figures`` (``{name: {"value", "unit", "source"}}``)."""
     groups = {}
     for name in sorted(figures):
         groups.setdefault(name.split(".", 1)[0], []).append(name)
-    lines = ["# Figures", "", HEADER, ""]
+    lines = ["# Figures", "", HEADER, "", _commits(figures), ""]
     for prefix in sorted(groups):
         lines += [f"## {prefix}", "", "| figure | value | unit | source |", "|---|---|---|---|"]
         for name in groups[prefix]:

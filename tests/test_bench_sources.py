@@ -164,6 +164,22 @@ def test_bench_exits_1_unless_every_figure_has_a_source_and_model_figures_say_so
             assert name in out.splitlines()[-1]
 
 
+def test_a_merged_run_replaces_only_what_it_measured(fake_modules, monkeypatch, tmp_path, capsys):
+    """``--merge`` keeps the figures of the run before (with their commit), replaces those it
+    measures now, records the commit of each, and counts the checks over the whole."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(bench, "commit", lambda: "first")
+    assert bench.main(["fake_bench_clean", "fake_bench_shared"], resources=False) == 0
+    monkeypatch.setattr(bench, "commit", lambda: "second")
+    assert bench.main(["fake_bench_mixed"], resources=False, merge=True) == 1
+    data = json.loads((tmp_path / "build" / "bench.json").read_text())
+    assert data["clean.rate"]["commit"] == "first" and data["shared.a"]["commit"] == "first"
+    assert all(data[name]["commit"] == "second" for name in MIXED)
+    assert data["bench.figures_without_source"]["value"] == len(WITHOUT_SOURCE)
+    assert "`first`" in figures_doc.render(data) and "`second`" in figures_doc.render(data)
+    capsys.readouterr()
+
+
 def test_figures_doc_has_a_table_per_prefix_with_every_figure_and_its_source(tmp_path):
     data = {
         "eth.payload_fraction_of_line_rate": {"value": 0.9916, "unit": "fraction", "source": "gateware: port | pins"},
