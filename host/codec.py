@@ -4,7 +4,6 @@ import numpy as np
 
 from spec import records, wire
 from spec.records import Action, RecordType
-from spec.schedule import row_cycles
 
 __all__ = ["ProtocolError", "header", "image_record", "image_records", "changed_rows", "sequence_records",
            "pixels_per_record", "control_record", "sequencer_record", "entry_record", "status_query",
@@ -146,7 +145,7 @@ def sequencer_record(registers, sequence=0, *, dmd=None, beats=1):
     fields = registers if all(isinstance(registers.get(n), int) for n in names) \
         else records.register_wire(registers)
     if dmd is not None:
-        faults = records.register_faults(fields, row_cycles(dmd, beats), dmd.clear_row_cycles)
+        faults = records.register_faults(fields, dmd, beats)
         failed = [check for check, bad in faults.items() if bad]
         if failed:
             raise ValueError(f"the sequencer cannot obey this register set: {', '.join(failed)}")

@@ -23,7 +23,7 @@ __all__ = [
     "MASTER_CONFIG", "MASTER_CONTROL", "MASTER_RECORD_COUNTERS", "MASTER_STATUS", "MASTER_STATUS_REPLY",
     "master_config_faults",
     "MAX_RECORD", "UDP_IP_OVERHEAD", "record_limit", "frame_newer",
-    "register_wire", "registers_bits", "register_faults",
+    "register_wire", "registers_bits", "register_faults", "group_reload",
 ]
 
 import enum as _enum
@@ -312,16 +312,39 @@ def _any(terms):
     return _functools.reduce(_operator.or_, terms)
 
 
-def register_faults(wire, row_cycles, clear_row_cycles):
+def register_faults(wire, dmd, beats=1, *, reload_terms=None):
     """Why the sequencer could not obey a register set: ``{check: condition}``, each condition
     true when the set fails the check. ``wire`` maps the :data:`SEQUENCER` field names to ints
     (the host, the reference model) or to Amaranth values (the parser); the conditions are built
-    with operators only, so both get the same checks. ``row_cycles``: cycles of a row cycle, the
-    shortest row period; ``clear_row_cycles``: row cycles a block clear takes on the DMD.
+    with operators only, so both get the same checks. ``dmd``: the :class:`spec.facts.DmdType`
+    played; ``beats``: its DCLK beats per cycle of the sequencer (a row cycle, the shortest row
+    period, is the DMD's DCLK cycles per row over the beats). ``reload_terms``: the
+    :func:`group_reload` of ``wire`` worked out before (the parser registers it a cycle ahead of
+    the checks, so that no path holds both the product and the comparisons), else worked out here.
 
-    ``lsb_keepable``: between two clocking pulses of a block come its reset (``t_rst``), its
-    settle time (``t_settle``) and at least a block clear, the shortest way to end a plane
-    (``docs/bounds.md``); a shorter least significant plane cannot be shown at its length.
+    What a group of the reset mode needs between two of its pulses (:func:`group_reload`): its
+    reset and settle time (``t_rst + t_settle``), then its blocks cleared (to end a plane with a
+    dark pulse) or its rows loaded at the row period (to show the next plane). Each check below
+    refuses a set in which some group would need more than it is given:
+
+    ``lsb_keepable``: the least significant plane holds the group's clears (a dark pulse ends it,
+    the shortest way to end a plane: ``docs/bounds.md``);
+
+    ``hide_keepable``: a plane at least ``hide`` long has the next plane loaded behind it, so
+    hiding must start no shorter than the reload; a ``hide`` below the reload is kept only when
+    no plane is as long as ``hide`` or the least significant plane already holds the reload;
+
+    ``dark_gap_keepable``: after a dark pulse the next plane is loaded, so the gap holds the
+    reload, whenever a dark pulse can come (not chained, or a plane shorter than ``hide``).
+
+    These are what one group needs on its own to show full frames. In the global mode (one
+    group) they are all it needs: a set that passes plays on time (``tests/test_register_rule.py``
+    holds that against the schedule model). In a phased mode the groups' loads share the bus,
+    and a set that passes can still make a pulse late (counted in ``pulses_late``); the plan
+    finder's plans are checked against that by the schedule model. The one check stricter than
+    need be is ``hide_keepable``: a ``hide`` below the reload that no plane's length falls
+    between is refused, though every plane it makes hide could (``sim.bench.registers_figures``
+    counts such refusals).
 
     ``period_keepable``: a periodic trigger's period is at least the least significant plane, the
     shortest a frame (one plane) can last; frames of more planes that outlast it are counted
@@ -348,6 +371,7 @@ def register_faults(wire, row_cycles, clear_row_cycles):
     not), names each weight exponent 0..7 once: a table that repeats a plane would show wrong
     levels. A frame of fewer planes plays only if the first entries of each table in force name
     its planes (the sequencer drops any other, and counts it)."""
+    row_cycles, clear_row_cycles = _row_cycles(dmd, beats), dmd.clear_row_cycles
     faults = {}
     for f, (_, wire_width) in zip(_registers.FIELDS, SEQUENCER, strict=True):
         if wire_width > f.bits:
@@ -358,7 +382,13 @@ def register_faults(wire, row_cycles, clear_row_cycles):
     faults["dark_gap_even"] = (wire["dark_gap"] & 1) != 0
     faults["stagger_even"] = (wire["stagger"] & 1) != 0
     faults["row_period"] = wire["row_period"] < row_cycles
-    faults["lsb_keepable"] = wire["lsb"] < wire["t_rst"] + wire["t_settle"] + clear_row_cycles * row_cycles
+    settle = wire["t_rst"] + wire["t_settle"]
+    clears, reload = reload_terms if reload_terms is not None else group_reload(wire, dmd, beats)
+    faults["lsb_keepable"] = wire["lsb"] < settle + clears
+    faults["hide_keepable"] = ((wire["hide"] < reload) & (wire["hide"] <= (wire["lsb"] << 7))
+                               & (wire["lsb"] < reload))
+    faults["dark_gap_keepable"] = (((wire["chain"] == 0) | (wire["lsb"] < wire["hide"]))
+                                   & (wire["dark_gap"] < reload))
     faults["period_keepable"] = ((wire["trigger"] == _registers.TriggerMode.PERIODIC.value)
                                  & (wire["period"] < wire["lsb"]))
     faults["settle_keepable"] = wire["t_settle"] < _registers.MIN_SETTLE
@@ -380,6 +410,25 @@ def register_faults(wire, row_cycles, clear_row_cycles):
                                           & (_all([_permutation(wire["group_tables"], g)
                                                     for g in range(_registers.MAX_GROUPS)]) == 0))
     return faults
+
+
+def group_reload(wire, dmd, beats=1):
+    """(clears, reload) of the largest group of ``wire``'s reset mode: the cycles its blocks'
+    clears take on the bus, and from a pulse to the earliest next pulse when the group is loaded
+    in between (``t_rst + t_settle``, then its rows at ``row_period``, the last a row cycle
+    long). Operators only, as :func:`register_faults`; an unknown mode gives 0 (it is refused)."""
+    mode, row_cycles = wire["reset_mode"], _row_cycles(dmd, beats)
+    clear = _registers.clear_cycles(row_cycles, dmd.clear_row_cycles)
+    sizes = {m: _registers.group_blocks(m, dmd.blocks) for m in _registers.ResetMode}
+    clears = sum((mode == m.value) * (size * clear) for m, size in sizes.items())
+    rows_after_first = sum((mode == m.value) * (size * dmd.rows_per_block - 1) for m, size in sizes.items())
+    return clears, wire["t_rst"] + wire["t_settle"] + rows_after_first * wire["row_period"] + row_cycles
+
+
+def _row_cycles(dmd, beats):
+    """A row cycle in the sequencer's cycles: the DMD's DCLK cycles per row over the beats."""
+    assert dmd.dclk_per_row % beats == 0
+    return dmd.dclk_per_row // beats
 
 
 def _permutation(tables, t):

@@ -14,7 +14,7 @@ import enum
 
 __all__ = ["ResetMode", "PlaneOrder", "TriggerMode", "Source", "FIELDS", "Field",
            "TIME_BITS", "LSB_BITS", "DURATION_BITS", "MIN_SETTLE", "MIN_CHAINED", "TIMED_NOTICE", "MAX_GROUPS",
-           "lead_cycles", "group_size", "layout_bits", "pack", "unpack"]
+           "lead_cycles", "clear_cycles", "group_blocks", "group_size", "layout_bits", "pack", "unpack"]
 
 #: Width of the free-running time base. Comparisons are made on differences, so the base may
 #: wrap (every 8 days at 400 MHz) without harm; every wait is shorter than 2**(TIME_BITS-1).
@@ -45,6 +45,18 @@ def lead_cycles(row_cycles, clear_row_cycles):
     keeps its time (:data:`MIN_CHAINED`); even."""
     lead = max(max(1, clear_row_cycles) * row_cycles + TIMED_NOTICE, MIN_CHAINED)
     return lead + (lead & 1)
+
+
+def clear_cycles(row_cycles, clear_row_cycles):
+    """Cycles one block clear takes on the bus: its row cycles, rounded up to even (the bus
+    decides on even cycles only, so a clear of an odd length holds the bus a cycle more)."""
+    cycles = clear_row_cycles * row_cycles
+    return cycles + (cycles & 1)
+
+
+def group_blocks(mode, blocks):
+    """Blocks in the largest group of a reset mode on a DMD of ``blocks`` blocks."""
+    return min(group_size(mode, blocks), blocks)
 
 
 class ResetMode(enum.IntEnum):

@@ -118,7 +118,7 @@ def test_the_finder_gives_a_register_set_the_projector_takes():
     assert schedule.simulate(TEST_DMD, p, [frame], [schedule.ready_cycle(TEST_DMD, p, frame)]).late == 0
     assert plan.frame_cycles == schedule.frame_period(TEST_DMD, p, frame)
     wire = records.register_wire(p.registers(TEST_DMD))
-    faults = records.register_faults(wire, schedule.row_cycles(TEST_DMD, 1), TEST_DMD.clear_row_cycles)
+    faults = records.register_faults(wire, TEST_DMD)
     assert [k for k, bad in faults.items() if bad] == []
 
 

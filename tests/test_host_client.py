@@ -22,6 +22,8 @@ from spec import records
 from spec.facts import DMDS, TEST_DMD
 from spec.registers import MAX_GROUPS, MIN_CHAINED, PlaneOrder, ResetMode, TriggerMode
 
+DLP7000 = DMDS["dlp7000"]
+
 #: The store's refusals, summed into the status reply's ``store_rows_refused``.
 REFUSALS = ("rows_outside", "rows_stale", "rows_shown", "rows_duplicate", "rows_no_slot", "rows_no_base")
 SHAPE = (TEST_DMD.rows, TEST_DMD.columns)
@@ -414,24 +416,25 @@ def test_sequencer_record_refuses_what_the_projector_would_drop():
     groups = {**wire, "order": PlaneOrder.GROUPS.value}
     with pytest.raises(ValueError, match="group_offsets_keepable"):
         codec.sequencer_record({**groups, "group_offsets": 14 << 24}, dmd=DMDS["dlp7000"])
-    assert not records.register_faults({**groups, "group_offsets": 16 << 24}, 16, 1)["group_offsets_keepable"]
+    assert not records.register_faults({**groups, "group_offsets": 16 << 24}, DLP7000)["group_offsets_keepable"]
     # group 0 starts the frame: no group's offset below its own; its own, if not 0, a clear's
     # row cycles at least too
-    assert records.register_faults({**groups, "group_offsets": 16}, 16, 1)["group_offsets_keepable"]
+    assert records.register_faults({**groups, "group_offsets": 16}, DLP7000)["group_offsets_keepable"]
     assert not records.register_faults({**groups, "group_offsets": sum(18 << 24 * g for g in range(MAX_GROUPS))},
-                                       16, 1)["group_offsets_keepable"]
+                                       DLP7000)["group_offsets_keepable"]
     # (group 0's, not 0, a row under way and the bus's notice of the pulse at least: 16 + 2)
     assert records.register_faults({**groups, "group_offsets": sum(16 << 24 * g for g in range(MAX_GROUPS))},
-                                   16, 1)["group_offsets_keepable"]
+                                   DLP7000)["group_offsets_keepable"]
     assert records.register_faults({**groups, "group_offsets": sum(14 << 24 * g for g in range(MAX_GROUPS))},
-                                   16, 1)["group_offsets_keepable"]
+                                   DLP7000)["group_offsets_keepable"]
     # where a clear is shorter than MIN_CHAINED (2 cycles), an offset or a stagger of 2 is refused:
     # the sequencer's timed first pulse needs that much notice
-    assert records.register_faults({**groups, "group_offsets": 2 << 24}, 2, 1)["group_offsets_keepable"]
-    assert not records.register_faults({**groups, "group_offsets": MIN_CHAINED << 24}, 2, 1)["group_offsets_keepable"]
+    assert records.register_faults({**groups, "group_offsets": 2 << 24}, TEST_DMD)["group_offsets_keepable"]
+    assert not records.register_faults({**groups, "group_offsets": MIN_CHAINED << 24},
+                                       TEST_DMD)["group_offsets_keepable"]
     phased = {**wire, "reset_mode": ResetMode.DUAL.value}
-    assert records.register_faults({**phased, "stagger": 2}, 2, 1)["stagger_keepable"]
-    assert not records.register_faults({**phased, "stagger": MIN_CHAINED}, 2, 1)["stagger_keepable"]
+    assert records.register_faults({**phased, "stagger": 2}, TEST_DMD)["stagger_keepable"]
+    assert not records.register_faults({**phased, "stagger": MIN_CHAINED}, TEST_DMD)["stagger_keepable"]
     with pytest.raises(ValueError, match="group_offsets_even"):
         codec.sequencer_record({**groups, "group_offsets": 4001 << 24}, dmd=TEST_DMD)
     codec.sequencer_record({**groups, "group_offsets": 4000 << 24}, dmd=TEST_DMD)
@@ -456,13 +459,13 @@ def test_order_tables_must_name_every_plane_once():
         table = rng.permutation(8) if rng.random() < 0.5 else rng.integers(0, 8, 8)
         bad = sorted(table) != list(range(8))
         faults = records.register_faults({**wire, "order": PlaneOrder.TABLE.value,
-                                          "order_table": packed([table])}, 16, 1)
+                                          "order_table": packed([table])}, DLP7000)
         assert faults["order_table_permutation"] == bad
         g = int(rng.integers(0, 16))
         tables = [range(8)] * 16
         tables[g] = table
         faults = records.register_faults({**wire, "order": PlaneOrder.GROUPS.value,
-                                          "group_tables": packed(tables)}, 16, 1)
+                                          "group_tables": packed(tables)}, DLP7000)
         assert faults["group_tables_permutation"] == bad
     # not checked in an order that does not read the table
     repeats = packed([(7, 6, 5, 4, 3, 2, 1, 1)])

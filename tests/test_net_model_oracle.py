@@ -55,7 +55,7 @@ def test_model_shares_no_rule_with_the_parser():
 
 
 def parser_refuses(registers, dmd, beats):
-    return any(records.register_faults(registers, row_cycles(dmd, beats), dmd.clear_row_cycles).values())
+    return any(records.register_faults(registers, dmd, beats).values())
 
 
 def even(value):
@@ -64,6 +64,14 @@ def even(value):
 
 def packed(entries, width):
     return sum(entry << width * i for i, entry in enumerate(entries))
+
+
+def group_terms(registers, dmd, beats):
+    """(blocks of a group of the set's reset mode, its reload: ``t_rst + t_settle``, then its rows
+    at ``row_period``, the last a row cycle)."""
+    group = min(dmd.blocks, (dmd.blocks, 4, 2, 1)[registers["reset_mode"]] if registers["reset_mode"] < 4 else 0)
+    rows = max(0, group * dmd.rows_per_block - 1)
+    return group, registers["t_rst"] + registers["t_settle"] + rows * registers["row_period"] + row_cycles(dmd, beats)
 
 
 @st.composite
@@ -85,10 +93,13 @@ def taken_sets(draw, geometry):
     for name in ("chain", "strict_rst", "source", "ns_flip", "park", "trigger_hold"):
         out[name] = draw(st.integers(0, 1))
     out["t_rst"], out["t_settle"] = draw(small), draw(st.integers(3, 1000))
-    out["lsb"] = even(out["t_rst"] + out["t_settle"] + clear + draw(small))
-    out["dark_gap"] = even(draw(st.integers(0, (1 << WIDTHS["dark_gap"]) - 2)))
-    out["stagger"] = draw(st.one_of(st.just(0), st.integers(shortest, 10_000).map(even)))
     out["row_period"] = draw(st.integers(row_cycle, 255))
+    group, reload = group_terms(out, dmd, beats)
+    out["lsb"] = even(out["t_rst"] + out["t_settle"] + group * even(clear) + draw(small))
+    out["hide"] = draw(st.one_of(st.integers(reload, (1 << WIDTHS["hide"]) - 1),
+                                 st.integers(out["lsb"] * 128 + 1, (1 << WIDTHS["hide"]) - 1)))
+    out["dark_gap"] = even(draw(st.integers(reload, (1 << WIDTHS["dark_gap"]) - 2)))
+    out["stagger"] = draw(st.one_of(st.just(0), st.integers(shortest, 10_000).map(even)))
     out["period"] = out["lsb"] + draw(small)
     out["order_table"] = packed(draw(st.permutations(range(PLANES))), 3)
     out["group_tables"] = packed([e for _ in range(GROUPS) for e in rng.sample(range(PLANES), PLANES)], 3)
@@ -108,8 +119,11 @@ def near_boundaries(draw):
     registers = draw(taken_sets(geometry))
     row_cycle = row_cycles(dmd, beats)
     clear = dmd.clear_row_cycles * row_cycle
+    group, reload = group_terms(registers, dmd, beats)
     bounds = [row_cycle, clear, 4, max(clear, 4), lead_cycles(row_cycle, dmd.clear_row_cycles),
-              registers["t_rst"] + registers["t_settle"] + clear, registers["lsb"]]
+              registers["t_rst"] + registers["t_settle"] + clear,
+              registers["t_rst"] + registers["t_settle"] + group * even(clear), registers["lsb"], reload,
+              registers["lsb"] * 128, registers["hide"]]
     near = st.tuples(st.sampled_from(bounds), st.integers(-3, 3)).map(lambda b: max(0, sum(b)))
     for _ in range(draw(st.integers(1, 3))):
         name = draw(st.sampled_from(sorted(WIDTHS)))

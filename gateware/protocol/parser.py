@@ -19,7 +19,6 @@ from amaranth.lib.wiring import In, Out
 
 from spec import records, wire
 from spec.records import RecordType
-from spec.schedule import row_cycles
 
 from ..net.layouts import OFFSET_BITS, Datagram, Peer
 from ..registers import Registers, wire_registers
@@ -133,9 +132,10 @@ class Parser(wiring.Component):
     #: Why a record is dropped, in the order the checks are made (``drop_app_<cause>``).
     _CAUSES = ["magic", "version", "type", "empty", "length", "rows", "value"]
 
-    def _cause(self, m, header, pixels, delta, control, sequencer, entry, length, needed):
+    def _cause(self, m, header, pixels, delta, control, sequencer, entry, length, needed, reload_terms):
         """The first check the record in ``captured`` fails: 1 + its index in :attr:`_CAUSES`,
-        or 0 when it passes every one. ``pixels``: where an image or delta record's pixels go."""
+        or 0 when it passes every one. ``pixels``: where an image or delta record's pixels go;
+        ``reload_terms``: the sequencer record's :func:`spec.records.group_reload`, registered."""
         dmd = self._dmd
         is_image = (header.type == RecordType.IMAGE) | (header.type == RecordType.DELTA)
         cause = Signal(range(8))
@@ -170,8 +170,8 @@ class Parser(wiring.Component):
                     & Cat(records.entry_faults(entry, self.settings.sequence_length).values()).any()):
             m.d.comb += cause.eq(1 + causes.index("value"))
         with m.Elif((header.type == RecordType.SEQUENCER)
-                    & Cat(records.register_faults(sequencer, row_cycles(dmd, self._beats),
-                                                    dmd.clear_row_cycles).values()).any()):
+                    & Cat(records.register_faults(sequencer, dmd, self._beats,
+                                                    reload_terms=reload_terms).values()).any()):
             m.d.comb += cause.eq(1 + causes.index("value"))
         return cause
 
@@ -238,7 +238,13 @@ class Parser(wiring.Component):
 
         needed = self._needed(m, header)
         pixels = self._pixels(m, header, image, delta, length, needed)
-        cause = self._cause(m, header, pixels, delta, control, sequencer, entry, length, needed)
+        # a sequencer record's group reload (a product of two of its fields) registered while
+        # the record waits a cycle (WEIGH), so that the checks start from registers
+        terms = records.group_reload(sequencer, self._dmd, self._beats)
+        reload_terms = [Signal(term.shape(), name=name) for term, name in
+                        zip(terms, ("group_clears", "group_reload"), strict=True)]
+        m.d.sync += [registered.eq(term) for registered, term in zip(reload_terms, terms, strict=True)]
+        cause = self._cause(m, header, pixels, delta, control, sequencer, entry, length, needed, reload_terms)
         causes = self._CAUSES
 
         position = Signal.like(self.pieces.payload.position)
@@ -254,7 +260,10 @@ class Parser(wiring.Component):
                 with m.If(taken):
                     m.d.sync += ended.eq(beat.last)
                     with m.If(beat.last | ((index >= _HEADER - 1) & (index + 1 == needed))):
-                        m.next = "CHECK"
+                        m.next = "WEIGH"
+            with m.State("WEIGH"):
+                # the record whole in ``captured``: its group reload registered (reload_terms)
+                m.next = "CHECK"
             with m.State("CHECK"):
                 with m.If(cause != 0):
                     for i, name in enumerate(causes):

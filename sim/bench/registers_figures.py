@@ -13,6 +13,11 @@ counts both ways the check can be wrong:
 * ``registers.playable_refused_fraction_model``: of the sets the model plays on time, the
   fraction the check refuses (how conservative it is).
 
+Each is also counted for the global mode alone (``..._global_model``), where the check is meant
+to be sound (its accepted-late fraction 0), and for the phased modes (``..._phased_model``),
+where the groups' loads share the bus and the check only holds each group to what it needs on
+its own.
+
 ``python -m sim.bench.registers_figures`` prints them.
 """
 
@@ -42,25 +47,33 @@ def draw(rng, dmd, dclk_hz=200e6):
     return dataclasses.replace(p, lsb=lsb, hide=hide)
 
 
-def run(draws=DRAWS, seed=SEED, dmd=TEST_DMD):
-    rng = random.Random(seed)
-    counts = {(accepted, late): 0 for accepted in (True, False) for late in (True, False)}
-    for _ in range(draws):
-        p = draw(rng, dmd)
-        faults = records.register_faults(records.register_wire(p.registers(dmd)),
-                                         schedule.row_cycles(dmd, p.beats), dmd.clear_row_cycles)
-        accepted = not any(bool(bad) for bad in faults.values())
-        late = not schedule.on_time(dmd, p, schedule.Frame(0, 8))
-        counts[accepted, late] += 1
-    source = SOURCE.format(draws=draws, seed=seed)
+def _fractions(counts, suffix, source):
+    """The figures of one share of the draws: ``counts[accepted, late]``."""
     accepted = counts[True, True] + counts[True, False]
     playable = counts[True, False] + counts[False, False]
     return {
-        "registers.drawn_model": (draws, "sets", source),
-        "registers.accepted_late_fraction_model": (counts[True, True] / accepted if accepted else 0.0, "", source),
-        "registers.playable_refused_fraction_model": (counts[False, False] / playable if playable else 0.0, "",
-                                                      source),
+        f"registers.drawn{suffix}_model": (sum(counts.values()), "sets", source),
+        f"registers.accepted_late_fraction{suffix}_model": (counts[True, True] / accepted if accepted else 0.0, "",
+                                                            source),
+        f"registers.playable_refused_fraction{suffix}_model": (counts[False, False] / playable if playable else 0.0,
+                                                               "", source),
     }
+
+
+def run(draws=DRAWS, seed=SEED, dmd=TEST_DMD):
+    rng = random.Random(seed)
+    shares = {share: {(accepted, late): 0 for accepted in (True, False) for late in (True, False)}
+              for share in ("", "_global", "_phased")}
+    for _ in range(draws):
+        p = draw(rng, dmd)
+        faults = records.register_faults(records.register_wire(p.registers(dmd)), dmd, p.beats)
+        accepted = not any(bool(bad) for bad in faults.values())
+        late = not schedule.on_time(dmd, p, schedule.Frame(0, 8))
+        for share in ("", "_global" if p.reset_mode == ResetMode.GLOBAL else "_phased"):
+            shares[share][accepted, late] += 1
+    source = SOURCE.format(draws=draws, seed=seed)
+    return {name: figure for share, counts in shares.items() for name, figure in _fractions(counts, share,
+                                                                                            source).items()}
 
 
 if __name__ == "__main__":

@@ -46,6 +46,11 @@ def sequencer_refusals(registers, dmd, beats=1):
     r = registers
     row_cycle = dmd.dclk_per_row // beats       # the DMD's DCLK cycles per row over the beats
     clear = dmd.clear_row_cycles * row_cycle    # a block clear
+    # a group of the reset mode: every block, 4, 2 or 1 (an unknown mode is refused anyway)
+    group = min(dmd.blocks, {GLOBAL: dmd.blocks, 1: 4, 2: 2, 3: 1}.get(r["reset_mode"], 0))
+    group_clears = group * (clear + clear % 2)  # each clear rounded up to even
+    reload = r["t_rst"] + r["t_settle"] + max(0, group * dmd.rows_per_block - 1) * r["row_period"] + row_cycle
+    dark_pulses = not r["chain"] or r["lsb"] < r["hide"]
     shortest = max(clear, 4)                    # a stagger or offset that is not 0
     lead = max(clear, row_cycle) + 2            # group 0's offset that is not 0, rounded up to even
     lead += lead % 2
@@ -63,7 +68,10 @@ def sequencer_refusals(registers, dmd, beats=1):
         ("a group's offset odd", any(offset % 2 for offset in offsets)),
         ("row_period under a row cycle", r["row_period"] < row_cycle),
         ("period shorter than lsb in periodic mode", r["trigger"] == PERIODIC and r["period"] < r["lsb"]),
-        ("lsb shorter than t_rst + t_settle and a block clear", r["lsb"] < r["t_rst"] + r["t_settle"] + clear),
+        ("lsb shorter than t_rst + t_settle and the group's clears",
+         r["lsb"] < r["t_rst"] + r["t_settle"] + group_clears),
+        ("hide below the group's reload", r["hide"] < reload and r["hide"] <= r["lsb"] * 128 and r["lsb"] < reload),
+        ("dark_gap below the group's reload where a dark pulse can come", dark_pulses and r["dark_gap"] < reload),
         ("t_settle under 3 cycles", r["t_settle"] < 3),
         ("a phased stagger not 0 but too short", r["reset_mode"] != GLOBAL and 0 < r["stagger"] < shortest),
         ("a group offset not 0 but too short", r["order"] == BY_GROUP

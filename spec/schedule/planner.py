@@ -14,6 +14,7 @@ from ..registers import (
     PlaneOrder,
     ResetMode,
     Source,
+    clear_cycles,
 )
 from .measures import (
     frame_period,
@@ -123,7 +124,7 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
     G = len(grp)
     rows_g = max(len(b) for b in grp) * dmd.rows_per_block
     load_g = (rows_g - 1) * row_period + R
-    clear_g = max(len(b) for b in grp) * dmd.clear_row_cycles * R
+    clear_g = max(len(b) for b in grp) * clear_cycles(R, dmd.clear_row_cycles)
     stagger = 0 if G == 1 else even(max(load_g, t_rst if strict_rst else R))
     if depth == 1 and chain and G > 1:
         # patterns back to back keep the bus busy: each group's rows at the row period, and its
