@@ -1,8 +1,5 @@
 """The PCS's 8b/10b encoder and decoder in the Amaranth simulator, against
-:mod:`sim.models.pcs_model`'s tables, written apart; and the model kept apart from the gateware."""
-
-import ast
-from pathlib import Path
+:mod:`sim.models.pcs_model`'s tables, written apart (``test_pcs_model_oracle`` keeps them apart)."""
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -106,15 +103,3 @@ def test_random_streams_through_encoder_and_decoder(stream):
     assert [model.to_bits(code) for code, _ in got[:-1]] == model_codes(sent)
     assert [group for _, group in got[1:]] == [(b, k, 0, 0) for b, k in sent]
 
-
-def test_model_imports_nothing_from_the_gateware():
-    """The model is an oracle only while it is written apart: it imports no gateware at all."""
-    tree = ast.parse(Path(model.__file__).read_text())
-    modules = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            modules |= {alias.name for alias in node.names}
-        elif isinstance(node, ast.ImportFrom):
-            modules.add(node.module or "")
-    assert not {name for name in modules if name.split(".")[0] in ("gateware", "amaranth")}
-    assert not {name for name in modules if name.startswith("sim")}
