@@ -116,7 +116,7 @@ def test_a_slip_between_frames_is_recovered(test_name):
 
 def test_tx_er_is_received_as_rx_er(test_name):
     """A byte sent with ``tx_er`` goes as /V/ and comes out with ``rx_er`` in its frame."""
-    frame = [rng_byte for rng_byte in range(60)]
+    frame = list(range(60))
     frame[20] = None
     out = run_link(gmii_of([frame], [20]), test_name)
     [got] = frames_of(out["rx"])
