@@ -12,6 +12,7 @@ ROOT = Path(__file__).resolve().parents[1]
 LAYERS = [
     ("spec",),
     ("gateware.wire", "gateware.registers", "gateware.cdc", "gateware.compose", "gateware"),
+    ("gateware.pcs",),
     ("gateware.mac",),
     ("gateware.net",),
     ("gateware.protocol",),
