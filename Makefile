@@ -69,7 +69,8 @@ formal: $(STAMP)
 bench: $(STAMP)
 	$(PY) -m flow bench
 
-# docs/figures.md from build/bench.json (make bench first): a table per figure prefix, with sources.
+# docs/figures.md from build/bench.json (make bench first): a table per figure prefix, with sources;
+# and every figure the README and docs/*.md quote between <!-- figure ... --> markers.
 figures: $(STAMP)
 	$(PY) -m flow figures
 

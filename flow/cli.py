@@ -36,7 +36,8 @@ def main(argv=None):
     bench.add_argument("--no-resources", action="store_true", help="skip the synthesis figures")
     bench.add_argument("--merge", action="store_true",
                        help="replace only the figures measured now in build/bench.json, keep the others")
-    sub.add_parser("figures", help="write docs/figures.md from build/bench.json (make bench's figures)")
+    sub.add_parser("figures", help="write docs/figures.md, the README's headline figures and the figures "
+                                   "the README and docs/*.md quote, from build/bench.json")
     sim = sub.add_parser("sim", help="the system simulation on the default scene")
     sim.add_argument("--frames", type=int, default=None, help="number of frames to store and show")
     sim.add_argument("--dclk", type=float, default=400, choices=(200, 400), help="DCLK in MHz (default 400)")

@@ -6,13 +6,25 @@ value, unit and source. The prefix is a figure name's part before its first dot 
 ``seq``, ``sys``, ``store``, ...); each table lists its figures in name order with their value,
 unit and source. The README quotes a few of them (:data:`HEADLINES`) between its markers, so that
 no figure in it is copied by hand; a test holds the README's block to ``docs/figures.md``.
+
+Any page under ``docs/`` (and the README) may quote a figure in its text between two markers::
+
+    <!-- figure seq.gray8_rate_hz_dlp7000:.1f Hz -->302.1 Hz<!-- /figure -->
+
+The opening marker names the figure, then optionally ``:`` and a Python format spec (``.1f``,
+``,.0f``, ``.1%`` for a fraction as a percentage, written ``97.2 %``), then optionally the unit
+to write after the value. ``make figures`` rewrites the text between the markers in every page
+(:func:`quote`); a figure the last run did not give is written as :data:`PLACEHOLDER`. The value
+formatted is the one ``docs/figures.md`` shows (six significant digits), so a page's figure can be
+checked against that page alone.
 """
 
 import json
 import re
 from pathlib import Path
 
-__all__ = ["render", "write", "main", "HEADER", "HEADLINES", "headlines", "parse", "README_BEGIN", "README_END"]
+__all__ = ["render", "write", "main", "HEADER", "HEADLINES", "headlines", "parse", "README_BEGIN", "README_END",
+           "MARKER", "PLACEHOLDER", "markers", "quote", "quoted"]
 
 HEADER = ("Written by `python -m flow figures` from `build/bench.json` (the output of `make bench`); "
           "do not edit by hand.")
@@ -30,6 +42,12 @@ HEADLINES = (
     ("8-bit frames back to back on the DLP9500 (one memory bank), on the pins", "sys.dlp9500_rate_hz_measured"),
 )
 README_BEGIN, README_END = "<!-- headline figures: written by make figures -->", "<!-- end of headline figures -->"
+
+#: A figure quoted in a page: ``<!-- figure NAME[:SPEC][ UNIT] -->text<!-- /figure -->``.
+MARKER = re.compile(r"<!-- figure (?P<name>[A-Za-z_][\w.]*)(?::(?P<spec>[^\s>]+))?(?: (?P<unit>[^<>]*?))? -->"
+                    r"(?P<text>.*?)<!-- /figure -->")
+#: What a marker holds when the last ``make bench`` did not give its figure.
+PLACEHOLDER = "(run make bench)"
 
 
 def headlines(figures):
@@ -68,6 +86,49 @@ def _value(value):
     return f"{value:.6g}"
 
 
+def _shown(value):
+    """``value`` as ``docs/figures.md`` shows it (:func:`_value`), read back as a number."""
+    text = _value(value)
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def quoted(entry, spec=None, unit=None):
+    """The text a marker holds for the figure ``entry`` (``{"value", ...}`` as :func:`render` or
+    :func:`parse` give it, or None: :data:`PLACEHOLDER`), formatted by ``spec``, then ``unit``."""
+    if entry is None:
+        return PLACEHOLDER
+    value = _shown(entry.get("value"))
+    if not spec:
+        text = _value(value)
+    elif spec.endswith("%"):
+        text = f"{value * 100:{spec[:-1]}f} %"
+    else:
+        text = format(value, spec)
+    return f"{text} {unit}" if unit else text
+
+
+def markers(text):
+    """Every figure ``text`` quotes: ``[(name, spec, unit, text between the markers)]``."""
+    return [(m["name"], m["spec"], m["unit"], m["text"]) for m in MARKER.finditer(text)]
+
+
+def quote(text, figures):
+    """``text`` with every marker's figure written from ``figures`` (as :func:`render` takes
+    them); ValueError naming the marker if its spec does not fit its figure."""
+    def one(match):
+        try:
+            value = quoted(figures.get(match["name"]), match["spec"], match["unit"])
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"{match[0]}: {error}") from error
+        return match[0][:match.start("text") - match.start()] + value + "<!-- /figure -->"
+    return MARKER.sub(one, text)
+
+
 def _commits(figures):
     """The commits the figures were measured on (``make bench`` records each figure's; a
     ``--merge`` run leaves the figures it did not measure with theirs), and how many each."""
@@ -94,10 +155,12 @@ def render(figures):
     return "\n".join(lines)
 
 
-def write(bench="build/bench.json", out="docs/figures.md", readme=None):
-    """Read ``bench`` and write ``out``, and the headline block of ``readme`` if given (between
-    its markers); returns the path of ``out``. FileNotFoundError if ``bench`` is missing (``make
-    bench`` writes it)."""
+def write(bench="build/bench.json", out="docs/figures.md", readme=None, pages=None):
+    """Read ``bench`` and write ``out``, the headline block of ``readme`` if given (between its
+    markers), and the figures quoted in ``readme`` and in every ``*.md`` page of the folder
+    ``pages`` if given (:func:`quote`; ``out`` itself left as written); returns the path of
+    ``out``. FileNotFoundError if ``bench`` is missing (``make bench`` writes it): then no page is
+    touched."""
     bench, out = Path(bench), Path(out)
     if not bench.is_file():
         raise FileNotFoundError(f"{bench} not found: run `make bench` (python -m flow bench) first, it writes "
@@ -114,10 +177,18 @@ def write(bench="build/bench.json", out="docs/figures.md", readme=None):
             head, rest = text.split(README_BEGIN, 1)
             _, tail = rest.split(README_END, 1)
             readme.write_text(f"{head}{README_BEGIN}\n{headlines(figures)}\n{README_END}{tail}")
+    quoting = [Path(readme)] if readme is not None and Path(readme).is_file() else []
+    if pages is not None:
+        quoting += [page for page in sorted(Path(pages).glob("*.md")) if page.resolve() != out.resolve()]
+    for page in quoting:
+        text = page.read_text()
+        new = quote(text, figures)
+        if new != text:
+            page.write_text(new)
     return out
 
 
-def main(bench="build/bench.json", out="docs/figures.md", readme="README.md"):
-    path = write(bench, out, readme)
-    print(f"wrote {path} and the headline figures of {readme}")
+def main(bench="build/bench.json", out="docs/figures.md", readme="README.md", pages="docs"):
+    path = write(bench, out, readme, pages)
+    print(f"wrote {path}, the headline figures of {readme} and the figures quoted in {readme} and {pages}/*.md")
     return 0
