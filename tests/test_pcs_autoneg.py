@@ -32,14 +32,19 @@ class Pair(Elaboratable):
 
 
 def traffic(seed, cycles):
-    """GMII for ``cycles`` cycles: distinct random frames with gaps; and the frames."""
+    """GMII for ``cycles`` cycles: distinct random frames with gaps; and the frames, those that fit."""
     rng = random.Random(seed)
-    frames = random_frames(rng, cycles // 60)
-    gmii = gmii_of(frames, [rng.randrange(12, 30) for _ in frames], lead=0)
-    return gmii[:cycles] + [(0, 0, 0)] * (cycles - len(gmii)), frames
+    frames, gmii = [], []
+    while True:
+        frame, gap = random_frames(rng, 1)[0], rng.randrange(12, 30)
+        more = gmii_of([frame], [gap], lead=0)
+        if len(gmii) + len(more) > cycles:
+            return gmii + [(0, 0, 0)] * (cycles - len(gmii)), frames
+        frames.append(frame)
+        gmii += more
 
 
-def run_pair(cycles, name, *, pause=(1, 2), events=None, gmii=None, slips=(3, 7)):
+def run_pair(cycles, name, *, pause=(1, 2), events=None, gmii=None, slips=(3, 7), enable=True):
     """Run the pair for ``cycles``; ``events(n, ctx, pair, lines)`` before each cycle. Gives, for
     each side, its auto-negotiation state after each cycle, the model's, GMII received, and the
     end's negotiated abilities and restarts."""
@@ -53,7 +58,8 @@ def run_pair(cycles, name, *, pause=(1, 2), events=None, gmii=None, slips=(3, 7)
         models = {}
         for side, ability in zip(SIDES, pause, strict=True):
             ctx.set(getattr(pair, side).pause, ability)
-            models[side] = model.AutoNeg(FULL_DUPLEX | ability << 7, LINK_TIMER)
+            ctx.set(getattr(pair, side).mr_an_enable, enable)
+            models[side] = model.AutoNeg(FULL_DUPLEX | ability << 7, LINK_TIMER, enable=enable)
         for n in range(cycles):
             if events:
                 events(n, ctx, pair, lines)
@@ -179,3 +185,19 @@ def test_loss_of_sync_restarts_negotiation(test_name):
     assert near["restarts"] == 1 and far["restarts"] == 1
     assert near["states"][-1] == far["states"][-1] == "LINK_OK"
     assert near["lp"] == far["ours"] | ACK and far["lp"] == near["ours"] | ACK
+
+
+def test_without_an_enable_data_passes_at_once(test_name):
+    """``mr_an_enable`` low on both sides: AN_ENABLE until in sync (idles sent, no configuration
+    words), then AN_DISABLE_LINK_OK, and frames pass both ways."""
+    cycles = 1200
+    gmii, sent = {}, {}
+    for seed, side in enumerate(SIDES):
+        gmii[side], sent[side] = traffic(seed + 20, cycles)
+    out = run_pair(cycles, test_name, gmii=gmii, enable=False)
+    assert_agrees_with_model(out)
+    for side, other in (("near", "far"), ("far", "near")):
+        assert visits(out[side]["states"]) == ["AN_ENABLE", "AN_DISABLE_LINK_OK"]
+        received = frames_of(out[side]["rx"])
+        assert_whole(received, sent[other])
+        assert len(received) >= len(sent[other]) - 1
