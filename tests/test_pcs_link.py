@@ -9,25 +9,13 @@ import pytest
 from gateware.pcs import Pcs
 from sim.harness.amaranth_sim import simulate
 from sim.models import pcs_model as model
-from sim.models.pcs_stim import Line
-
-IDLE = (0, 0, 0)
-PREAMBLE = [0x55] * 7 + [0xD5]
-
-
-def gmii_of(frames, gaps, lead=40):
-    """GMII ``(tx_en, tx_er, txd)`` per cycle: ``lead`` idles, then each frame's preamble, SFD
-    and bytes, each followed by its gap; a byte given as ``None`` is sent with ``tx_er``."""
-    cycles = [IDLE] * lead
-    for frame, gap in zip(frames, gaps, strict=True):
-        cycles += [(1, 1, 0) if b is None else (1, 0, b) for b in PREAMBLE + frame] + [IDLE] * gap
-    return cycles
+from sim.models.pcs_stim import PREAMBLE, Line, frames_of, gmii_of, random_frames
 
 
 def run_link(gmii, name, *, slip=0, slips_at=(), configuring=()):
     """Run the PCS in loopback; the code-groups sent, the GMII received, configuration words
     received, and the end's counters."""
-    dut = Pcs()
+    dut = Pcs(autoneg=False)
     out = {"codes": [], "rx": [], "configs": []}
 
     async def bench(ctx):
@@ -52,28 +40,12 @@ def run_link(gmii, name, *, slip=0, slips_at=(), configuring=()):
     return out
 
 
-def frames_of(pins):
-    """Runs of ``rx_dv``: each as its bytes (``None`` for a byte with ``rx_er``)."""
-    frames, current = [], None
-    for dv, er, d in pins:
-        if dv:
-            current = (current or []) + [None if er else d]
-        elif current is not None:
-            frames.append(current)
-            current = None
-    return frames
-
-
 def model_receive(codes):
     rd, groups = "-", []
     for code in codes:
         byte, control, code_error, disparity_error, rd = model.decode(code, rd)
         groups.append((byte, control, code_error or disparity_error))
     return model.receive(groups)
-
-
-def random_frames(rng, count):
-    return [[rng.randrange(256) for _ in range(rng.randrange(46, 120))] for _ in range(count)]
 
 
 @pytest.mark.parametrize("slip", [0, 3, 9])

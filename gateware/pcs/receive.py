@@ -6,7 +6,9 @@ position in a frame ends it with ``rx_er`` (the standard's EARLY_END: an ordered
 any other code-group in a frame, /V/ or invalid, is a byte with ``rx_er``. Losing sync inside
 a frame ends it with ``rx_er``. Between frames K28.5 followed by D21.5 or D2.2 is a
 configuration ordered set (/C1/, /C2/), whose 16-bit word, low byte first, is given on
-``configs``; K28.5 with another data code-group is an idle.
+``configs``; K28.5 with another data code-group is an idle, given on ``idle``; an invalid
+code-group between frames is given on ``invalid``. These three are clause 36's RUDI(/C/),
+RUDI(/I/) and RUDI(INVALID), for auto-negotiation.
 
 Not done: the look-ahead past /T/ for /R/ (``check_end``), carrier extension, and false carrier
 (``rx_er`` with 0x0E outside a frame).
@@ -48,7 +50,11 @@ class Receiver(wiring.Component):
         when ``rx_dv`` is low.
     configs : Out(stream.Signature(16, always_ready=True))
         Each configuration word received, the cycle after its last byte; the link partner's
-        auto-negotiation base page or next page (clause 37.2.1), for a process not here.
+        auto-negotiation base page or next page (clause 37.2.1).
+    idle : Out(1)
+        An /I/ was received, the cycle after its second code-group.
+    invalid : Out(1)
+        An invalid code-group was received in sync between frames, the cycle after it.
     """
 
     group: In(CodeGroup)
@@ -56,6 +62,8 @@ class Receiver(wiring.Component):
     sync_status: In(1)
     gmii: Out(RxPins)
     configs: Out(stream.Signature(16, always_ready=True))
+    idle: Out(1)
+    invalid: Out(1)
 
     def elaborate(self, platform):
         m = Module()
@@ -72,8 +80,8 @@ class Receiver(wiring.Component):
         def give(byte, error=0):
             m.d.sync += [self.gmii.d.eq(byte), self.gmii.dv.eq(1), self.gmii.er.eq(error)]
 
-        m.d.sync += [self.gmii.eq(0), self.configs.valid.eq(0)]
-        with m.FSM():
+        m.d.sync += [self.gmii.eq(0), self.configs.valid.eq(0), self.idle.eq(0), self.invalid.eq(0)]
+        with m.FSM() as fsm:
             with m.State("IDLE"):
                 with m.If(self.sync_status & k28_5):
                     m.next = "K"
@@ -84,6 +92,7 @@ class Receiver(wiring.Component):
                 with m.If(self.sync_status & configuring):
                     m.next = "CONFIG_LOW"
                 with m.Else():
+                    m.d.sync += self.idle.eq(self.sync_status & data_cg)
                     m.next = "IDLE"
             with m.State("CONFIG_LOW"):
                 m.d.sync += self.configs.payload[:8].eq(cg.data)
@@ -105,4 +114,6 @@ class Receiver(wiring.Component):
                     give(cg.data)
                 with m.Else():
                     give(cg.data, error=1)
+        with m.If(~fsm.ongoing("FRAME")):
+            m.d.sync += self.invalid.eq(self.sync_status & ~valid)
         return m

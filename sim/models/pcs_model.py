@@ -7,11 +7,13 @@ strings ``abcdeifghj``. It imports nothing from ``gateware``.
 
 Here: 8b/10b with running disparity (:func:`encode`, :func:`decode`), the ordered sets a
 transmitter sends for GMII bytes (:func:`transmit`), the GMII bytes a receiver gives for
-code-groups (:func:`receive`), and the synchronisation state machine of figure 36-9
-(:class:`Sync`).
+code-groups (:func:`receive`), the synchronisation state machine of figure 36-9
+(:class:`Sync`), and clause 37's auto-negotiation state machine of figure 37-6
+(:class:`AutoNeg`).
 """
 
-__all__ = ["encode", "decode", "to_int", "to_bits", "CONTROLS", "Sync", "transmit", "receive", "bit_stream"]
+__all__ = ["encode", "decode", "to_int", "to_bits", "CONTROLS", "Sync", "AutoNeg", "transmit", "receive",
+           "bit_stream"]
 
 #: Table 36-1a: EDCBA -> abcdei, (RD-, RD+).
 SIX = {
@@ -251,3 +253,86 @@ def bit_stream(codes, slip):
     bits = "0" * slip + "".join(codes)
     bits += "0" * (-len(bits) % 10)
     return [to_int(bits[i:i + 10]) for i in range(0, len(bits), 10)]
+
+
+class AutoNeg:
+    """Figure 37-6 (clause 37.3.1), base page only, one cycle at a time: :meth:`step` with what
+    the receive process indicated in the cycle (a config word, an /I/, an invalid code-group),
+    ``sync_status`` and ``mr_restart_an``, gives the state after it.
+
+    The match functions (clause 37.3.1.4) are read from the words received since the last /I/:
+    ``ability_match`` when the last three agree but for ACK (bit 14), ``acknowledge_match`` when
+    they are equal and have ACK; ``consistency_match`` when the last agrees, ACK aside, with the
+    one ability_match held for on the way into ACKNOWLEDGE_DETECT; ``idle_match`` after three /I/
+    with no word between. A state's exits are tested with what was received before the cycle;
+    the link timer is done ``link_timer`` cycles after the cycle that entered a state starting it.
+    RUDI(INVALID) restarts only while ``xmit`` is not DATA. No next pages."""
+
+    ACK = 1 << 14
+
+    def __init__(self, ability, link_timer, enable=True):
+        self.ability, self.link_timer, self.enable = ability, link_timer, enable
+        self.state, self.xmit, self.tx_config = "AN_ENABLE", "CONFIGURATION" if enable else "IDLE", 0
+        self.words, self.idles, self.held, self.timer = [], 0, None, 0
+        self.lp_ability, self.complete, self.restarts = 0, False, 0
+
+    def _same(self, a, b):
+        return (a ^ b) & ~self.ACK == 0
+
+    def _matches(self):
+        last = self.words[-3:]
+        ability = len(last) == 3 and all(self._same(w, last[0]) for w in last)
+        acknowledge = len(last) == 3 and all(w == last[0] and w & self.ACK for w in last)
+        consistency = bool(last) and self.held is not None and self._same(last[-1], self.held)
+        zero = bool(last) and last[-1] == 0
+        return ability, acknowledge, consistency, self.idles >= 3, zero
+
+    def _next(self, sync_status, restart, invalid):
+        if restart or not sync_status or (invalid and self.xmit != "DATA"):
+            return "AN_ENABLE"
+        ability, acknowledge, consistency, idle, zero = self._matches()
+        done = self.timer == self.link_timer
+        state = self.state
+        if state == "AN_ENABLE":
+            return "AN_RESTART" if self.enable else "AN_DISABLE_LINK_OK"
+        if state == "AN_DISABLE_LINK_OK":
+            return "AN_ENABLE" if self.enable else state
+        if state == "AN_RESTART":
+            return "ABILITY_DETECT" if done else state
+        if state == "ABILITY_DETECT":
+            if ability and not zero:
+                self.held = self.words[-1]
+                return "ACKNOWLEDGE_DETECT"
+            return state
+        if state == "LINK_OK":
+            return "AN_ENABLE" if ability else state
+        if ability and zero or (state == "ACKNOWLEDGE_DETECT" and acknowledge and not consistency):
+            return "AN_ENABLE"
+        if state == "ACKNOWLEDGE_DETECT":
+            return "COMPLETE_ACKNOWLEDGE" if acknowledge else state
+        if state == "COMPLETE_ACKNOWLEDGE":
+            return "IDLE_DETECT" if done else state
+        return "LINK_OK" if idle and done else state  # IDLE_DETECT
+
+    def step(self, *, word=None, idle=False, invalid=False, sync_status=True, restart=False):
+        nxt = self._next(sync_status, restart, invalid)
+        if nxt != self.state:
+            if nxt in ("AN_RESTART", "COMPLETE_ACKNOWLEDGE", "IDLE_DETECT"):
+                self.timer = -1
+            self.restarts += nxt == "AN_ENABLE"
+            if nxt == "COMPLETE_ACKNOWLEDGE":
+                self.lp_ability = self.words[-1]
+        self.timer = min(self.timer + 1, self.link_timer)
+        self.state, self.complete = nxt, nxt == "LINK_OK"
+        self.xmit, self.tx_config = {
+            "AN_ENABLE": ("CONFIGURATION" if self.enable else "IDLE", 0), "AN_RESTART": ("CONFIGURATION", 0),
+            "ABILITY_DETECT": ("CONFIGURATION", self.ability),
+            "ACKNOWLEDGE_DETECT": ("CONFIGURATION", self.ability | self.ACK),
+            "COMPLETE_ACKNOWLEDGE": ("CONFIGURATION", self.ability | self.ACK),
+            "IDLE_DETECT": ("IDLE", self.tx_config), "LINK_OK": ("DATA", self.tx_config),
+            "AN_DISABLE_LINK_OK": ("DATA", self.tx_config)}[nxt]
+        if word is not None:
+            self.words, self.idles = self.words[-2:] + [word], 0
+        elif idle:
+            self.words, self.idles = [], self.idles + 1
+        return nxt

@@ -1,5 +1,6 @@
 """Stimulus shared by the PCS tests: the receive chain's parts joined with handles on each, a
-run of per-cycle inputs through a component, and the line between two PCS sides."""
+run of per-cycle inputs through a component, the line between two PCS sides, and GMII frames
+sent and received."""
 
 from amaranth import Module
 from amaranth.hdl import Elaboratable
@@ -9,7 +10,10 @@ from gateware.pcs.code_groups import Decoder, Encoder
 from gateware.pcs.sync import Synchroniser
 from sim.harness.amaranth_sim import simulate
 
-__all__ = ["Chain", "run_cycles", "Line", "group_of"]
+__all__ = ["Chain", "run_cycles", "Line", "group_of", "PREAMBLE", "gmii_of", "frames_of", "random_frames"]
+
+IDLE = (0, 0, 0)
+PREAMBLE = [0x55] * 7 + [0xD5]
 
 
 class Chain(Elaboratable):
@@ -73,3 +77,28 @@ class Line:
         self.bits += "".join(str(code >> i & 1) for i in range(10))
         word, self.bits = self.bits[:10], self.bits[10:]
         return sum(int(bit) << i for i, bit in enumerate(word))
+
+
+def gmii_of(frames, gaps, lead=40):
+    """GMII ``(tx_en, tx_er, txd)`` per cycle: ``lead`` idles, then each frame's preamble, SFD
+    and bytes, each followed by its gap; a byte given as ``None`` is sent with ``tx_er``."""
+    cycles = [IDLE] * lead
+    for frame, gap in zip(frames, gaps, strict=True):
+        cycles += [(1, 1, 0) if b is None else (1, 0, b) for b in PREAMBLE + frame] + [IDLE] * gap
+    return cycles
+
+
+def frames_of(pins):
+    """Runs of ``rx_dv``: each as its bytes (``None`` for a byte with ``rx_er``)."""
+    frames, current = [], None
+    for dv, er, d in pins:
+        if dv:
+            current = (current or []) + [None if er else d]
+        elif current is not None:
+            frames.append(current)
+            current = None
+    return frames
+
+
+def random_frames(rng, count):
+    return [[rng.randrange(256) for _ in range(rng.randrange(46, 120))] for _ in range(count)]
