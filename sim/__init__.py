@@ -2,8 +2,8 @@
 benchmarks, formal checks and the whole-system rigs.
 
 A module's file name is unique in the repository (``spec``, ``gateware``, ``host``, ``sim``,
-``flow``, ``tests``; ``formal/``'s modules are named for the gateware they check), and in four
-folders its last word says what it is (``tests/test_module_names.py`` holds them to it):
+``flow``, ``tests``), and in five folders its last word says what it is
+(``tests/test_module_names.py`` holds them to it):
 
 ``models/<subject>_model``
     A model of a chip or a block, the oracle its tests check against (``dlpc410_model``,
@@ -25,7 +25,12 @@ folders its last word says what it is (``tests/test_module_names.py`` holds them
     and the small core's run of ``tb/system_tb``; ``xga_run``: the full-XGA run on
     ``fast_system_rig``; ``virtual_run``: the virtual projector). ``rigs/scene``: the default scene.
 
-``harness/`` runs the Amaranth simulator and cocotb, ``formal/`` holds the formal properties,
+``formal/<subject>_properties``
+    The formal properties of a block, or of every stream (``stream_properties``), that
+    ``formal/suite`` lists and ``make formal`` checks; ``harness``, ``suite``, ``tools`` and
+    ``geometry`` run them.
+
+``harness/`` runs the Amaranth simulator and cocotb,
 ``hdl/`` the Verilog models and ``plans/`` the plan ``make sim`` ships
 (:data:`sim.rigs.xga_run.SHIPPED_PLANS`).
 """

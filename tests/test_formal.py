@@ -14,9 +14,11 @@ from amaranth.hdl import Assert, Cover
 from amaranth.lib import stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from sim.formal import blocks, sequencer, suite
+from sim.formal import block_properties as blocks
+from sim.formal import sequencer_properties as sequencer
+from sim.formal import suite
 from sim.formal.harness import Check, FormalFailure, FormalTop, run
-from sim.formal.streams import ready_paths, stream_rules
+from sim.formal.stream_properties import ready_paths, stream_rules
 from sim.harness.paths import build_dir
 
 

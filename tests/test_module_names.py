@@ -24,13 +24,18 @@ def _is_cocotb_test(node):
 
 
 def test_sim_file_names_are_unique_in_the_repository():
-    """Outside ``sim/formal`` (named for the gateware it checks), no file name under ``sim/`` is
-    used anywhere else in the repository."""
+    """No file name under ``sim/`` is used anywhere else in the repository."""
     counts = Counter(p.name for p in _files(*TOPS))
-    formal = ROOT / "sim" / "formal"
-    clashes = sorted(str(p.relative_to(ROOT)) for p in _files("sim")
-                     if formal not in p.parents and counts[p.name] > 1)
+    clashes = sorted(str(p.relative_to(ROOT)) for p in _files("sim") if counts[p.name] > 1)
     assert not clashes, clashes
+
+
+def test_formal_modules_end_in_properties():
+    """A module of ``sim/formal`` that states properties of gateware ends in ``_properties``; the
+    others are the machinery that runs them."""
+    machinery = {"harness.py", "suite.py", "tools.py", "geometry.py"}
+    wrong = [p.name for p in _files("sim/formal") if p.name not in machinery and not p.stem.endswith("_properties")]
+    assert not wrong, wrong
 
 
 def test_testbenches_end_in_tb_and_name_their_tests():

@@ -1,10 +1,10 @@
 """Every formal property of the design, run together: ``make formal``, its bench figures and the
 README's table.
 
-A row is one property of one block: a SymbiYosys check (:mod:`sim.formal.blocks`,
-:mod:`sim.formal.store`), proven by k-induction or checked by BMC to a depth, or the structural
+A row is one property of one block: a SymbiYosys check (:mod:`sim.formal.block_properties`,
+:mod:`sim.formal.store_properties`), proven by k-induction or checked by BMC to a depth, or the structural
 proof that no output stream's ``valid`` has a combinational path from a consumer's ``ready``
-(:func:`sim.formal.streams.ready_paths`, one per block with stream ports).
+(:func:`sim.formal.stream_properties.ready_paths`, one per block with stream ports).
 """
 
 import concurrent.futures
@@ -14,9 +14,11 @@ from dataclasses import dataclass, field
 
 from sim.harness.paths import build_dir, slug
 
-from . import blocks, sequencer, store
+from . import block_properties as blocks
+from . import sequencer_properties as sequencer
+from . import store_properties as store
 from .harness import run
-from .streams import ready_paths
+from .stream_properties import ready_paths
 
 __all__ = ["checks", "Row", "run_all", "figures", "RESULTS"]
 

@@ -45,7 +45,7 @@ from spec.facts import TEST_DMD
 from spec.schedule import DECISION_TO_PINS
 
 from .harness import Check, FormalTop
-from .streams import stream_rules
+from .stream_properties import stream_rules
 
 __all__ = ["sequencer_checks", "streams_top", "at_beats", "rst_top", "settle_top", "phased_settle_top",
            "clear_top", "DMD", "DMD4", "DMD_1080P_CLEAR"]

@@ -20,7 +20,7 @@ from amaranth.hdl import Assert, Assume, Cover, Fragment
 
 from .geometry import FORMAL_DMD
 from .harness import Check, FormalTop
-from .streams import stream_rules
+from .stream_properties import stream_rules
 
 __all__ = ["STREAM_BLOCKS", "stream_checks", "countdown_check", "register_crossing_check", "checks"]
 

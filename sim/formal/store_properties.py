@@ -4,12 +4,12 @@ The top is :class:`gateware.store.Store` (frame slots, writer, reader) on a DMD 
 one word (:data:`DMD`; DMD block numbers of 2 bits while it is built), three slots and 2-bit
 frame ids, with its ``dmd`` side renamed into ``sync`` (one clock: the properties are about
 order, not clock ratios; the crossing's own stream rules are checked with free clocks in
-:mod:`sim.formal.blocks`). Everything at its boundary is free (the serialiser's words and row
+:mod:`sim.formal.block_properties`). Everything at its boundary is free (the serialiser's words and row
 flags, the sequencer's asks and releases) but for the stream rules, a bit depth held from the
 start (any of 1 to 8), and the serialiser's framing: the words of a row share its frame and row,
 their planes rise, every stored plane is there and plane 7 ends the row (planes below the bit
 depth may be left out, which makes rows short and traces shallow; the pixel data are zero). The
-writer's MCB port is :class:`sim.formal.mcb.WritePortEnvelope`, whose ``executed`` bursts are
+writer's MCB port is :class:`sim.formal.mcb_properties.WritePortEnvelope`, whose ``executed`` bursts are
 what reaches the memory. The mode is held: streaming (``sequence_length`` 0) or sequence (1 to
 3, fixed).
 
@@ -39,8 +39,8 @@ from gateware.store.addresses import PLANES, AddressMap
 
 from .geometry import FORMAL_DMD
 from .harness import Check, FormalTop
-from .mcb import WritePortEnvelope
-from .streams import stream_rules
+from .mcb_properties import WritePortEnvelope
+from .stream_properties import stream_rules
 
 __all__ = ["store_checks", "SLOTS"]
 
