@@ -127,7 +127,7 @@ def primitive_stubs(verilog_text, libraries=None):
     """Black-box declarations (header, ports, parameters, no body) of every module ``verilog_text``
     instantiates without defining, taken from Yosys's Xilinx cell library; returns (stubs,
     names not found there)."""
-    defined = set(re.findall(r"^module\s+(\S+?)\s*\(", verilog_text, re.M))
+    defined = set(re.findall(r"^module\s+(\S+?)\s*(?:#\s*)?\(", verilog_text, re.M))
     # an instance opens on a line of its own: "  TYPE #(" or "  TYPE name ("
     used = set(re.findall(r"^\s+([A-Za-z_]\w*)\s+(?:#\(|\S+\s*\()\s*$", verilog_text, re.M)) - defined - _KEYWORDS
     libraries = _cell_libraries() if libraries is None else libraries
@@ -170,8 +170,9 @@ def lint_top(path, top, blackboxes=(), workdir=None):
 
 
 def blackboxes(board):
-    """The generated cores a board's projector top instantiates: its memory controller, and the
-    SFP's GMII PHY on a board whose Ethernet is an SFP cage."""
+    """The generated cores a board's projector top instantiates: its memory controller, and its
+    Ethernet PHY's if it has one (the SVEC's is our PCS on the GTP, whose primitive the cell
+    library declares)."""
     from gateware.platform import BOARDS
     from gateware.platform.mcb_instance import McbInstance
     platform = BOARDS[board]

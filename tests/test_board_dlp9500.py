@@ -122,7 +122,12 @@ def test_tree_places_the_whole_link(svec_tree):
     v = (out / f"{top}.v").read_text()
     # a serialiser per lane: 64 DIN, 4 DVALID, 4 DCLK
     assert len(re.findall(r"^\s+OSERDES2 #\(", v, re.M)) == 72
-    assert re.search(rf"^\s+{SVEC_DDR3.module} mcb \(", v, re.M) and re.search(r"^\s+sfp_gmii pcs \(", v, re.M)
+    assert re.search(rf"^\s+{SVEC_DDR3.module} mcb \(", v, re.M)
+    # the Ethernet PHY: our PCS on one GTP lane, its two user clocks through BUFIO2s and BUFGs
+    assert len(re.findall(r"^\s+GTPA1_DUAL #\(", v, re.M)) == 1
+    assert re.search(r"\.PLL_DIVSEL_FB_0\(32'd2\)", v), "1.25 Gb/s from 125 MHz"
+    assert len(re.findall(r"^\s+BUFIO2 #\(", v, re.M)) >= 2
+    assert re.search(r"^module \\projector_dlp9500\.gmii\.pcs ", v, re.M), "the PCS"
     # the clock loop's DAC: the VCXO behind the 125 MHz reference (the reference design's pins)
     assert {("vcxo_dac_0__sclk__io", "N27"), ("vcxo_dac_0__din__io", "P25"),
             ("vcxo_dac_0__sync_n__io", "P26")} <= set(locs)

@@ -3,13 +3,17 @@ receive chain: comma alignment, decoder, synchronisation, receive process; and c
 auto-negotiation, whose ``xmit`` says what the transmitter sends between frames and when frames
 pass each way.
 
-Both sides run in ``sync``, at 125 MHz for 1000BASE-X; rename the domain for the
-transceiver's clocks (the receive side then runs on the recovered clock, the transmit side on
-the reference clock, and the MAC on each).
+Both sides run in ``sync`` by default, at 125 MHz for 1000BASE-X. On a transceiver they run in
+two domains (``tx_domain``, ``rx_domain``): the transmit side on the transmit user clock, the
+receive chain and auto-negotiation on the recovered clock, with ``xmit`` and the configuration
+word to send carried into the transmit domain by synchronisers. Both change only every link
+timer or so: a word torn in the crossing is sent in one ordered set and, differing from its
+neighbours, never counted as three alike by the partner.
 """
 
-from amaranth import Module, Mux, Signal
+from amaranth import DomainRenamer, Module, Mux, Signal
 from amaranth.lib import stream, wiring
+from amaranth.lib.cdc import FFSynchronizer
 from amaranth.lib.wiring import In, Out
 
 from .align import Aligner
@@ -36,6 +40,9 @@ class Pcs(wiring.Component):
     link_timer : int
         Auto-negotiation's link timer in cycles (10 ms nominal).
     counter_width : int
+    tx_domain, rx_domain : str
+        The domains of the transmit side (``gmii_tx``, ``tx_code``) and of the rest (``rx_bits``,
+        ``gmii_rx``, the status and auto-negotiation ports); both ``sync`` by default.
 
     Members
     -------
@@ -65,8 +72,10 @@ class Pcs(wiring.Component):
         Times the code-group boundary moved.
     """
 
-    def __init__(self, *, autoneg=True, link_timer=1_250_000, counter_width=16):
+    def __init__(self, *, autoneg=True, link_timer=1_250_000, counter_width=16, tx_domain="sync",
+                 rx_domain="sync"):
         self._counter_width = counter_width
+        self._tx_domain, self._rx_domain = tx_domain, rx_domain
         #: The auto-negotiation machine, reachable for tests; ``None`` without ``autoneg``.
         self.autoneg = AutoNegotiation(link_timer=link_timer, counter_width=counter_width) if autoneg else None
         ports = {
@@ -93,11 +102,12 @@ class Pcs(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         width = self._counter_width
-        m.submodules.transmitter = tx = Transmitter()
-        m.submodules.aligner = aligner = Aligner(counter_width=width)
-        m.submodules.decoder = decoder = Decoder()
-        m.submodules.synchroniser = sync = Synchroniser(counter_width=width)
-        m.submodules.receiver = rx = Receiver()
+        txd, rxd = self._tx_domain, self._rx_domain
+        tx, aligner = Transmitter(), Aligner(counter_width=width)
+        decoder, sync, rx = Decoder(), Synchroniser(counter_width=width), Receiver()
+        m.submodules.transmitter = DomainRenamer(txd)(tx) if txd != "sync" else tx
+        for name, block in (("aligner", aligner), ("decoder", decoder), ("synchroniser", sync), ("receiver", rx)):
+            m.submodules[name] = DomainRenamer(rxd)(block) if rxd != "sync" else block
         m.d.comb += [
             self.tx_code.eq(tx.code),
             aligner.bits.eq(self.rx_bits),
@@ -114,7 +124,15 @@ class Pcs(wiring.Component):
             m.d.comb += [tx.gmii.eq(self.gmii_tx), tx.configuring.eq(self.configuring), tx.config.eq(self.config),
                          self.gmii_rx.eq(rx.gmii)]
             return m
-        m.submodules.autoneg = an = self.autoneg
+        an = self.autoneg
+        m.submodules.autoneg = DomainRenamer(rxd)(an) if rxd != "sync" else an
+        # what the transmitter takes from auto-negotiation, in the transmit domain
+        xmit, tx_config = Signal(Xmit), Signal(16)
+        if txd == rxd:
+            m.d.comb += [xmit.eq(an.xmit), tx_config.eq(an.tx_config)]
+        else:
+            m.submodules.xmit_sync = FFSynchronizer(an.xmit.as_value(), xmit.as_value(), o_domain=txd)
+            m.submodules.config_sync = FFSynchronizer(an.tx_config, tx_config, o_domain=txd)
         m.d.comb += [
             an.configs.valid.eq(rx.configs.valid), an.configs.payload.eq(rx.configs.payload),
             an.idle.eq(rx.idle), an.invalid.eq(rx.invalid), an.sync_status.eq(sync.sync_status),
@@ -122,14 +140,13 @@ class Pcs(wiring.Component):
             an.pause.eq(self.pause),
             self.mr_adv_ability.eq(an.mr_adv_ability), self.mr_lp_adv_ability.eq(an.mr_lp_adv_ability),
             self.mr_an_complete.eq(an.mr_an_complete), self.xmit.eq(an.xmit), self.restarts.eq(an.restarts),
-            tx.configuring.eq(an.xmit == Xmit.CONFIGURATION), tx.config.eq(an.tx_config),
+            tx.configuring.eq(xmit == Xmit.CONFIGURATION), tx.config.eq(tx_config),
         ]
         # The gates open and close only between frames: each changes only while its side is idle.
-        data = an.xmit == Xmit.DATA
         tx_open, rx_open = Signal(), Signal()
         with m.If(~self.gmii_tx.en):
-            m.d.sync += tx_open.eq(data)
+            m.d[txd] += tx_open.eq(xmit == Xmit.DATA)
         with m.If(~rx.gmii.dv):
-            m.d.sync += rx_open.eq(data)
+            m.d[rxd] += rx_open.eq(an.xmit == Xmit.DATA)
         m.d.comb += [tx.gmii.eq(Mux(tx_open, self.gmii_tx, 0)), self.gmii_rx.eq(Mux(rx_open, rx.gmii, 0))]
         return m

@@ -5,21 +5,16 @@ The core gives plain signals per clock cycle; here they become IOB registers, DD
 vendor primitives, and these adapters are checked by building the Spartan-6 tree.
 """
 
-from amaranth import ClockSignal, Const, Elaboratable, Instance, Module, ResetSignal, Signal
+from amaranth import ClockDomain, ClockSignal, Const, Elaboratable, Instance, Module, Mux, ResetSignal, Signal
 from amaranth.lib import io
 from amaranth.lib.cdc import FFSynchronizer, ResetSynchronizer
 
 from gateware.dlpc410.interface import Signature as Dlpc410Signature
 from gateware.mac.gmii import RxPins, TxPins
 
-from .blackbox import blackbox_verilog
 from .serdes import DCLK_BITS, Oserdes4, lane_bits
 
-__all__ = ["GmiiPins", "SfpGmiiPins", "SFP_MODULE", "Dlpc410Pins", "TriggerPins", "VcxoDacPins"]
-
-#: The wrapper around the vendor's 1000BASE-X PCS/PMA on the SFP's GTP (not part of this tree).
-SFP_MODULE = "sfp_gmii"
-
+__all__ = ["GmiiPins", "SfpGmiiPins", "GmiiTxElastic", "Dlpc410Pins", "TriggerPins", "VcxoDacPins"]
 
 class EthernetPins(Elaboratable):
     """What the core's MAC sees of the Ethernet PHY, whichever it is: GMII and management.
@@ -104,49 +99,76 @@ class GmiiPins(EthernetPins):
 class SfpGmiiPins(EthernetPins):
     """Gigabit Ethernet through an SFP cage (the SVEC): a GMII PHY inside the FPGA.
 
-    The PHY is :data:`SFP_MODULE`, a wrapper (not part of this tree, not written yet) around the
-    vendor's 1000BASE-X PCS/PMA core on the SFP's GTP, that keeps the 88E1111's GMII contract:
-    its receive clock and data out (``rx_clk``, ``rxd``, ``rx_dv``, ``rx_er``), transmit data in
-    on the clock given to it (``tx_clk``, ``txd``, ``tx_en``, ``tx_er``: ``gmii_tx``, which the
-    wrapper carries into the GTP's clock), and a reset. It is instantiated here as a black box.
-    The receive outputs are registered once on ``gmii_rx``, as the 88E1111's are in the IOBs.
+    The PHY is our 1000BASE-X PCS (:class:`gateware.pcs.Pcs`, 8b/10b and auto-negotiation in
+    fabric) on one lane of the SFP's GTP transceiver (:class:`.gtp.Gtp`, 10 bits a cycle at
+    1.25 Gb/s), keeping the 88E1111's GMII contract: the receive side runs on the GTP's recovered
+    clock, which drives ``ClockSignal("gmii_rx")``, and its outputs are registered once on
+    ``gmii_rx`` as the 88E1111's are in the IOBs; the transmit side runs on the GTP's transmit
+    user clock (``sfp_tx``, from the SFP's 125 MHz reference), into which :class:`GmiiTxElastic`
+    carries ``gmii_tx``, dropping or adding idle cycles between frames so that the two 125 MHz
+    clocks may differ by their tolerance.
 
     There is no MDIO PHY: MDIO reads all ones (the core's PHY poller reads the 88E1111's
     register 17, which a 1000BASE-X PCS does not have).
     """
 
-    #: The wrapper's ports: (name, direction, width).
-    PORTS = [
-        ("refclk_p", "i", 1), ("refclk_n", "i", 1), ("txp", "o", 1), ("txn", "o", 1), ("rxp", "i", 1),
-        ("rxn", "i", 1), ("reset", "i", 1),
-        ("rx_clk", "o", 1), ("rxd", "o", 8), ("rx_dv", "o", 1), ("rx_er", "o", 1),
-        ("tx_clk", "i", 1), ("txd", "i", 8), ("tx_en", "i", 1), ("tx_er", "i", 1),
-    ]
-
     def elaborate(self, platform):
+        from gateware.pcs import Pcs
+
+        from .gtp import Gtp
         m = Module()
         sfp = platform.request("sfp", 0, dir="-")
         refclk = platform.request("sfp_refclk", 0, dir="-")
-        rx_clk = Signal()
-        rx = Signal(RxPins)
-        ports = dict(
-            refclk_p=refclk.p, refclk_n=refclk.n, txp=sfp.tx.p, txn=sfp.tx.n, rxp=sfp.rx.p, rxn=sfp.rx.n,
-            reset=~self.phy_reset_n, rx_clk=rx_clk, rxd=rx.d, rx_dv=rx.dv, rx_er=rx.er,
-            tx_clk=ClockSignal("gmii_tx"), txd=self.tx.d, tx_en=self.tx.en, tx_er=self.tx.er,
-        )
-        m.submodules.pcs = Instance(SFP_MODULE, **{f"{kind}_{name}": ports[name] for name, kind, _ in self.PORTS})
-        m.submodules.rx_bufg = Instance("BUFG", i_I=rx_clk, o_O=ClockSignal("gmii_rx"))
-        platform.add_clock_constraint(rx_clk, 125e6)
-        m.submodules.rx_rst = ResetSynchronizer(~self._locked, domain="gmii_rx")
-        m.d.gmii_rx += self.rx.eq(rx)
+        m.domains += [ClockDomain("sfp_tx", local=True), ClockDomain("sfp_rx", local=True)]
+        m.submodules.gtp = gtp = Gtp(sfp, refclk, ~self.phy_reset_n, tx_domain="sfp_tx", rx_domain="sfp_rx")
+        m.submodules.pcs = pcs = Pcs(tx_domain="sfp_tx", rx_domain="sfp_rx")
+        m.d.comb += [pcs.rx_bits.eq(gtp.rx_bits), gtp.tx_code.eq(pcs.tx_code)]
+        m.submodules.tx_elastic = elastic = GmiiTxElastic("gmii_tx", "sfp_tx")
+        m.d.comb += [elastic.i.eq(self.tx), pcs.gmii_tx.eq(elastic.o)]
+
+        m.d.comb += ClockSignal("gmii_rx").eq(ClockSignal("sfp_rx"))
+        m.submodules.rx_rst = ResetSynchronizer(~(self._locked & gtp.ready), domain="gmii_rx")
+        m.d.gmii_rx += self.rx.eq(pcs.gmii_rx)
         m.submodules.tx_disable = tx_disable = io.Buffer("o", sfp.tx_disable)
         m.d.comb += [tx_disable.o.eq(0), self.mdio_i.eq(1)]
         return m
 
-    @classmethod
-    def blackbox_verilog(cls):
-        """A Verilog declaration of :data:`SFP_MODULE`'s ports (what the lint reads)."""
-        return blackbox_verilog(SFP_MODULE, {f"{kind}_{name}": Signal(width) for name, kind, width in cls.PORTS})
+
+class GmiiTxElastic(Elaboratable):
+    """GMII transmit words from ``i_domain`` to ``o_domain``, two clocks of the same nominal rate.
+
+    Every word passes through a small asynchronous FIFO; idle words (``en`` low) are dropped on
+    the way in while it is fuller than ``high``, and idle words are added on the way out, between
+    frames only, while it holds fewer than ``low``. A frame, once started, is read a word every
+    cycle.
+
+    Attributes
+    ----------
+    i : Signal(TxPins), in ``i_domain``
+    o : Signal(TxPins), in ``o_domain``, registered
+    """
+
+    def __init__(self, i_domain, o_domain, *, depth=16, low=6, high=11):
+        self._i_domain, self._o_domain, self._depth, self._low, self._high = i_domain, o_domain, depth, low, high
+        self.i = Signal(TxPins)
+        self.o = Signal(TxPins)
+
+    def elaborate(self, platform):
+        from amaranth.lib.fifo import AsyncFIFO
+        m = Module()
+        m.submodules.fifo = fifo = AsyncFIFO(width=len(self.i.as_value()), depth=self._depth,
+                                             r_domain=self._o_domain, w_domain=self._i_domain)
+        m.d.comb += [fifo.w_data.eq(self.i), fifo.w_en.eq(self.i.en | (fifo.w_level < self._high))]
+        primed, in_frame = Signal(), Signal()
+        head = Signal(TxPins)
+        m.d.comb += head.eq(fifo.r_data)
+        read = Signal()
+        m.d.comb += read.eq(fifo.r_rdy & primed & (in_frame | (fifo.r_level >= self._low)))
+        m.d.comb += fifo.r_en.eq(read)
+        with m.If(fifo.r_level >= self._low):
+            m.d[self._o_domain] += primed.eq(1)
+        m.d[self._o_domain] += [self.o.eq(Mux(read, fifo.r_data, 0)), in_frame.eq(read & head.en)]
+        return m
 
 
 class Dlpc410Pins(Elaboratable):
