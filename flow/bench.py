@@ -118,10 +118,16 @@ def collect(modules=None, *, resources=True, log=print):
     for what, names in (("no source", missing), ("a model's, without _model in its name", from_model)):
         for key in names:
             log(f"bench: {key}: source {what}")
-    counted = "arithmetic: counted by flow.bench.collect over this run's figures' names and sources"
-    figures[CHECKS[0]] = {"value": len(missing), "unit": "figures", "source": counted}
-    figures[CHECKS[1]] = {"value": len(from_model), "unit": "figures", "source": counted}
+    _count_checks(figures, missing, from_model)
     return figures
+
+
+def _count_checks(figures, missing, from_model, **extra):
+    """Write :data:`CHECKS` into ``figures``: how many have no source, and how many are a model's
+    without ``_model`` in their name (``extra``: more fields of each, such as its commit)."""
+    counted = "arithmetic: counted by flow.bench.collect over this run's figures' names and sources"
+    for key, names in zip(CHECKS, (missing, from_model), strict=True):
+        figures[key] = {"value": len(names), "unit": "figures", "source": counted, **extra}
 
 
 def write(figures, path="build/bench.json"):
@@ -166,10 +172,7 @@ def main(modules=None, resources=True, path="build/bench.json", merge=False):
         figures[key]["commit"] = measured_on
     if merge and Path(path).exists():
         figures = {**{k: v for k, v in json.loads(Path(path).read_text()).items() if k not in CHECKS}, **figures}
-        missing, from_model = _check({k: v for k, v in figures.items() if k not in CHECKS})
-        counted = "arithmetic: counted by flow.bench.collect over this run's figures' names and sources"
-        figures[CHECKS[0]] = {"value": len(missing), "unit": "figures", "source": counted, "commit": measured_on}
-        figures[CHECKS[1]] = {"value": len(from_model), "unit": "figures", "source": counted, "commit": measured_on}
+        _count_checks(figures, *_check({k: v for k, v in figures.items() if k not in CHECKS}), commit=measured_on)
     path = write(figures, path)
     print_table(figures)
     print(f"wrote {path}")

@@ -175,6 +175,16 @@ class Parser(wiring.Component):
             m.d.comb += cause.eq(1 + causes.index("value"))
         return cause
 
+    def _reload_terms(self, m, sequencer):
+        """A sequencer record's group reload (:func:`spec.records.group_reload`: a product of two
+        of its fields), registered while the record waits a cycle (WEIGH), so that the checks
+        start from registers."""
+        terms = records.group_reload(sequencer, self._dmd, self._beats)
+        registered = [Signal(term.shape(), name=name) for term, name in
+                      zip(terms, ("group_clears", "group_reload"), strict=True)]
+        m.d.sync += [r.eq(term) for r, term in zip(registered, terms, strict=True)]
+        return registered
+
     def _needed(self, m, header):
         """The bytes of header a record of ``header.type`` needs before it can be checked: the
         whole record, but for an image record's pixels."""
@@ -238,12 +248,7 @@ class Parser(wiring.Component):
 
         needed = self._needed(m, header)
         pixels = self._pixels(m, header, image, delta, length, needed)
-        # a sequencer record's group reload (a product of two of its fields) registered while
-        # the record waits a cycle (WEIGH), so that the checks start from registers
-        terms = records.group_reload(sequencer, self._dmd, self._beats)
-        reload_terms = [Signal(term.shape(), name=name) for term, name in
-                        zip(terms, ("group_clears", "group_reload"), strict=True)]
-        m.d.sync += [registered.eq(term) for registered, term in zip(reload_terms, terms, strict=True)]
+        reload_terms = self._reload_terms(m, sequencer)
         cause = self._cause(m, header, pixels, delta, control, sequencer, entry, length, needed, reload_terms)
         causes = self._CAUSES
 
