@@ -27,7 +27,7 @@ import re
 import time
 from pathlib import Path
 
-__all__ = ["collect", "write", "print_table", "main", "kind", "kinds", "KINDS", "SOURCES", "CHECKS"]
+__all__ = ["collect", "write", "print_table", "main", "earlier", "kind", "kinds", "KINDS", "SOURCES", "CHECKS"]
 
 #: The kinds of source, strongest first: arithmetic takes the weakest of its inputs'.
 KINDS = ("gateware", "synthesis", "formal", "host", "document", "model")
@@ -160,18 +160,31 @@ def commit():
     return head + ("-dirty" if dirty else "")
 
 
+def earlier(path="build/bench.json", page="docs/figures.md"):
+    """The figures a ``--merge`` run keeps: ``path`` as the last run wrote it, or, in a clone where
+    no run wrote it, the figures page committed beside the code (:func:`flow.figures.recorded`:
+    every figure with its value as the page shows it, its source and its commit); {} if neither."""
+    if Path(path).exists():
+        return json.loads(Path(path).read_text())
+    if Path(page).exists():
+        from flow import figures as figures_page
+        return figures_page.recorded(Path(page).read_text())
+    return {}
+
+
 def main(modules=None, resources=True, path="build/bench.json", merge=False):
     """Collect, write and print the figures; 1 if a figure has no source or a model's figure
     lacks ``_model`` in its name (:data:`CHECKS`), else 0. Each figure records the
     :func:`commit` it was measured on. ``merge``: the figures of the modules run (and the synthesis
     figures, with ``resources``) replace theirs in the ``path`` written before, the others kept as
-    they were (each with its own commit); the checks are counted again over the whole."""
+    they were (each with its own commit; :func:`earlier`); the checks are counted again over the whole."""
     figures = collect(modules, resources=resources)
     measured_on = commit()
     for key in figures:
         figures[key]["commit"] = measured_on
-    if merge and Path(path).exists():
-        figures = {**{k: v for k, v in json.loads(Path(path).read_text()).items() if k not in CHECKS}, **figures}
+    if merge:
+        before = earlier(path)
+        figures = {**{k: v for k, v in before.items() if k not in CHECKS}, **figures}
         _count_checks(figures, *_check({k: v for k, v in figures.items() if k not in CHECKS}), commit=measured_on)
     path = write(figures, path)
     print_table(figures)

@@ -24,7 +24,7 @@ import re
 from pathlib import Path
 
 __all__ = ["render", "write", "main", "HEADER", "HEADLINES", "headlines", "parse", "README_BEGIN", "README_END",
-           "MARKER", "PLACEHOLDER", "markers", "quote", "quoted"]
+           "MARKER", "PLACEHOLDER", "markers", "quote", "quoted", "recorded"]
 
 HEADER = ("Written by `python -m flow figures` from `build/bench.json` (the output of `make bench`); "
           "do not edit by hand.")
@@ -63,21 +63,40 @@ def headlines(figures):
 
 
 def parse(markdown):
-    """The figures of a page :func:`render` wrote: ``{name: {"value", "unit", "source"}}``, the
-    values as the page shows them (text)."""
+    """The figures of a page :func:`render` wrote: ``{name: {"value", "unit", "source",
+    "commit"}}``, the values as the page shows them (text)."""
     figures = {}
     for line in markdown.splitlines():
         if line.startswith("| `"):
-            cells = [cell.strip() for cell in re.split(r"(?<!\\)\|", line)[1:-1]]
-            if len(cells) == 4:
-                name, value, unit, source = cells
-                figures[name.strip("`")] = {"value": value, "unit": unit, "source": source}
+            cells = [_uncell(cell.strip()) for cell in re.split(r"(?<!\\)\|", line)[1:-1]]
+            if len(cells) == 5:
+                name, value, unit, source, commit = cells
+                figures[name.strip("`")] = {"value": value, "unit": unit, "source": source,
+                                            "commit": commit.strip("`")}
     return figures
+
+
+def recorded(markdown):
+    """The figures of a page :func:`render` wrote as ``build/bench.json`` holds them: each value a
+    number again (six significant digits, as the page shows it), with its unit, source and commit.
+    A ``--merge`` run of ``make bench`` in a clone without ``build/bench.json`` starts from these."""
+    out = {}
+    for name, entry in parse(markdown).items():
+        entry = dict(entry, value=_shown(entry["value"]))
+        if entry["commit"] in ("", "not recorded"):
+            del entry["commit"]
+        out[name] = entry
+    return out
 
 
 def _cell(text):
     """``text`` fit for a Markdown table cell."""
     return str(text).replace("\\", "\\\\").replace("|", "\\|").replace("\n", " ")
+
+
+def _uncell(text):
+    """A Markdown table cell's text as :func:`_cell` was given it."""
+    return re.sub(r"\\(.)", r"\1", text)
 
 
 def _value(value):
@@ -89,6 +108,8 @@ def _value(value):
 def _shown(value):
     """``value`` as ``docs/figures.md`` shows it (:func:`_value`), read back as a number."""
     text = _value(value)
+    if text in ("True", "False"):
+        return text == "True"
     for kind in (int, float):
         try:
             return kind(text)
@@ -146,11 +167,11 @@ def render(figures):
         groups.setdefault(name.split(".", 1)[0], []).append(name)
     lines = ["# Figures", "", HEADER, "", _commits(figures), ""]
     for prefix in sorted(groups):
-        lines += [f"## {prefix}", "", "| figure | value | unit | source |", "|---|---|---|---|"]
+        lines += [f"## {prefix}", "", "| figure | value | unit | source | commit |", "|---|---|---|---|---|"]
         for name in groups[prefix]:
             entry = figures[name]
             lines.append(f"| `{_cell(name)}` | {_cell(_value(entry.get('value')))} | {_cell(entry.get('unit', ''))} "
-                         f"| {_cell(entry.get('source') or '(no source)')} |")
+                         f"| {_cell(entry.get('source') or '(no source)')} | `{entry.get('commit') or 'not recorded'}` |")
         lines.append("")
     return "\n".join(lines)
 

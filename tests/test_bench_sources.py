@@ -15,6 +15,7 @@ import json
 import re
 import sys
 import types
+from pathlib import Path
 
 import pytest
 
@@ -203,7 +204,7 @@ def test_figures_doc_has_a_table_per_prefix_with_every_figure_and_its_source(tmp
     for line in lines:
         if line.startswith("| `"):
             cells = [c.strip() for c in re.split(r"(?<!\\)\|", line)[1:-1]]
-            assert len(cells) == 4, line
+            assert len(cells) == 5, line
             rows[cells[0].strip("`")] = cells
     assert set(rows) == set(data)
     for name, entry in data.items():
@@ -213,9 +214,37 @@ def test_figures_doc_has_a_table_per_prefix_with_every_figure_and_its_source(tmp
     assert rows["eth.drops_at_line_rate"][1] == "0"
     # each table under its prefix's heading, in name order
     eth = lines.index("## eth")
-    assert lines[eth + 2] == "| figure | value | unit | source |"
+    assert lines[eth + 2] == "| figure | value | unit | source | commit |"
+    assert rows["eth.drops_at_line_rate"][4] == "`not recorded`"
     assert lines[eth + 4].startswith("| `eth.drops_at_line_rate`")
     assert lines[eth + 5].startswith("| `eth.payload_fraction_of_line_rate`")
+
+
+def test_a_merged_run_in_a_fresh_clone_starts_from_the_figures_page(fake_modules, monkeypatch, tmp_path, capsys):
+    """With no ``build/bench.json``, ``--merge`` keeps what ``docs/figures.md`` records: each
+    figure's value as the page shows it, its source and its commit."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(bench, "commit", lambda: "first")
+    assert bench.main(["fake_bench_clean", "fake_bench_shared"], resources=False) == 0
+    figures_doc.write("build/bench.json", "docs/figures.md")
+    first = json.loads((tmp_path / "build" / "bench.json").read_text())
+    (tmp_path / "build" / "bench.json").unlink()
+    monkeypatch.setattr(bench, "commit", lambda: "second")
+    assert bench.main(["fake_bench_mixed"], resources=False, merge=True) == 1
+    data = json.loads((tmp_path / "build" / "bench.json").read_text())
+    for name, entry in first.items():
+        if name not in bench.CHECKS:
+            assert data[name]["commit"] == "first" and data[name]["source"] == entry["source"]
+            assert figures_doc.quoted(data[name]) == figures_doc.quoted(entry)
+    assert all(data[name]["commit"] == "second" for name in MIXED)
+    capsys.readouterr()
+
+
+def test_the_page_reads_back_as_it_was_written():
+    """``docs/figures.md`` as committed, read back (:func:`flow.figures.recorded`) and rendered
+    again, is the same page: a merge that starts from it loses nothing."""
+    page = (Path(__file__).parent.parent / "docs" / "figures.md").read_text()
+    assert figures_doc.render(figures_doc.recorded(page)) == page
 
 
 def test_figures_doc_needs_bench_json(tmp_path, monkeypatch, capsys):
@@ -332,5 +361,6 @@ def test_figures_write_the_readmes_headline_block_only(tmp_path):
     assert text.count("missing from the last make bench") == len(figures_doc.HEADLINES) - 1
     # the page's figures read back as they were written
     page = figures_doc.parse((tmp_path / "figures.md").read_text())
-    assert page == {"sys.xga_rate_hz_measured": {"value": "280.89", "unit": "Hz", "source": "gateware: run"}}
+    assert page == {"sys.xga_rate_hz_measured": {"value": "280.89", "unit": "Hz", "source": "gateware: run",
+                                                "commit": "not recorded"}}
 
