@@ -170,8 +170,9 @@ def render(figures):
         lines += [f"## {prefix}", "", "| figure | value | unit | source | commit |", "|---|---|---|---|---|"]
         for name in groups[prefix]:
             entry = figures[name]
+            commit = entry.get("commit") or "not recorded"
             lines.append(f"| `{_cell(name)}` | {_cell(_value(entry.get('value')))} | {_cell(entry.get('unit', ''))} "
-                         f"| {_cell(entry.get('source') or '(no source)')} | `{entry.get('commit') or 'not recorded'}` |")
+                         f"| {_cell(entry.get('source') or '(no source)')} | `{commit}` |")
         lines.append("")
     return "\n".join(lines)
 
