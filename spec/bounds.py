@@ -87,7 +87,9 @@ class Bound:
 
 def one(paces, depth):
     """Binary-weighted PWM on one DMD: ``2**depth - 1`` settle paths, or ``depth`` loads a frame
-    on the bus if those take longer (``binds``: ``lsb`` or ``loads``)."""
+    on the bus if those take longer (``binds``: ``lsb`` or ``loads``). The loads are every row of
+    every plane: a frame with light in every block of every plane (the sequencer clears a block
+    a plane leaves dark instead of loading its rows, so a sparser frame may load less)."""
     pwm = (2 ** depth - 1) * paces.settle_path
     loads = depth * paces.rows * paces.row_period
     return Bound("one", depth, max(pwm, loads), "lsb" if pwm >= loads else "loads")
