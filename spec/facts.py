@@ -23,6 +23,16 @@ DS162       Xilinx Spartan-6 FPGA data sheet: DC and switching characteristics (
             characteristics, -3 speed grade)
 assumption  a planning figure, no document behind it: said so in the entry
 AD5662      Analog Devices AD5662 16-bit nanoDAC data sheet (serial interface timing)
+E2E-594673  TI E2E forum, "DLP7000: how to achieve maxim pattern rate for DLP7000 8bit greyscale"
+            (thread 594673): 43.22 us a global-reset bit-plane, 8-bit with modulated light
+DLP7000-p1  DLP7000 datasheet, page 1: "> 1900 Hz (8-bit gray)"
+OE-32-10373 Optics Express 32(6):10373 (2024): two DMDs in weighted light, 8-bit
+PH-11-793   Photonics 11(9):793 (2024), doi:10.3390/photonics11090793: two DMDs (one modulates the
+            source), 12-bit
+OLE-108171  Optics and Lasers in Engineering 108171 (2024), doi:10.1016/j.optlaseng.2024.108171:
+            two parallel DMDs lit at different intensities, 16-bit
+SVEC        CERN SVEC carrier: DDR3 on bank 4 (svec_base_ddr4.ucf: 14 row address lines, 3 bank,
+            16 data bits; constraints/README.md)
 """
 
 import enum
@@ -31,7 +41,7 @@ from dataclasses import dataclass
 __all__ = ["Fact", "TIMING", "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "VCXO_DAC", "DmdType", "DMDS",
            "SPARTAN6_PATH", "RowMode", "BlockMode",
            "TEST_DMD", "TEST_DMD4",
-           "TEST_DMD_400", "TEST_DMD4_400"]
+           "TEST_DMD_400", "TEST_DMD4_400", "MEMORY", "LIGHT_SOURCE", "ANCHORS"]
 
 
 @dataclass(frozen=True)
@@ -182,6 +192,30 @@ class BlockMode(enum.IntEnum):
 MEMORY = {
     "bytes": Fact(128 * 2**20, "B", "Micron MT47H64M16 (64 Mi x 16 bit); Digilent Atlys reference manual", "high",
                   "the one DDR2 part on the board"),
+    "svec_bank4_bytes": Fact(256 * 2**20, "B", "SVEC (14 row address lines, 8 banks, x16: a 2 Gb x16 part)",
+                             "medium", "the DDR3 on bank 4; the store sizes its slots by ``bytes`` and uses half"),
+}
+
+
+#: A light source gated on and off inside each bit-plane (``docs/bounds.md``, "Beyond one DMD").
+LIGHT_SOURCE = {
+    "t_edge": Fact(50e-9, "s", "assumption (planning figure, no document)", "assumption",
+                   "rise or fall time of a current-switched laser or LED driver; the gate stops this long "
+                   "before the next pulse, and the shortest light pulse is its rise and fall"),
+}
+
+
+#: Frame rates others reached or TI states past one DMD's PWM, to set the bounds beside.
+ANCHORS = {
+    "gated_gray8_dlp7000_limit": Fact(2.89e3, "Hz", "E2E-594673", "high",
+                                      "global reset at its fastest, 8 x 43.22 us, the source gated in each plane"),
+    "gated_gray8_dlp7000": Fact(1.9e3, "Hz", "DLP7000-p1; E2E-594673", "high",
+                                "TI's 8-bit rate with a modulated source"),
+    "dual_gray8": Fact(1300, "Hz", "OE-32-10373", "medium", "two DMDs in weighted light, 8-bit (their DMD)"),
+    "dimmed_gray12": Fact(1611, "Hz", "PH-11-793", "medium",
+                          "a DMD modulating the source before an image DMD, 12-bit (their DMD)"),
+    "dual_gray16": Fact(220, "Hz", "OLE-108171", "medium",
+                        "two parallel DMDs lit at different intensities, quaternary PWM, 16-bit (their DMD)"),
 }
 
 

@@ -11,6 +11,7 @@ kind is ``model`` (or arithmetic on one) has ``_model`` in its name.
 
 MODULES = [
     "sim.bench.bitplane_figures",
+    "sim.bench.bounds_figures",
     "sim.bench.camera_figures",
     "sim.bench.dlpc410_model_figures",
     "sim.bench.formal_figures",
