@@ -23,13 +23,16 @@ DS162       Xilinx Spartan-6 FPGA data sheet: DC and switching characteristics (
             characteristics, -3 speed grade)
 assumption  a planning figure, no document behind it: said so in the entry
 AD5662      Analog Devices AD5662 16-bit nanoDAC data sheet (serial interface timing)
+OE2024      Optics Express 32(6):10373 (2024): two DMDs in weighted light, "quaternary PWM"
+Photonics   Photonics 11(9):793 (2024): one DMD as an intensity modulator
+OLEng       Optics and Lasers in Engineering, article 108171 (2024)
 """
 
 import enum
 from dataclasses import dataclass
 
 __all__ = ["Fact", "TIMING", "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "VCXO_DAC", "DmdType", "DMDS",
-           "SPARTAN6_PATH", "RowMode", "BlockMode",
+           "SPARTAN6_PATH", "RowMode", "BlockMode", "WEIGHTED",
            "TEST_DMD", "TEST_DMD4",
            "TEST_DMD_400", "TEST_DMD4_400"]
 
@@ -238,6 +241,20 @@ VCXO_DAC = {
                        "first, each taken on SCLK's falling edge; the output updates on the 24th; SYNC "
                        "high before it abandons the write"),
     "code_bits": Fact(16, "bits", "AD5662", "high", "straight binary: mid-scale 0x8000"),
+}
+
+
+#: Two DMDs in weighted light (``host.weighted``): the published rates they are compared with, and
+#: the attenuator's error the trim is shown against.
+WEIGHTED = {
+    "gray8_rate_oe2024": Fact(1300, "Hz", "OE2024 (abstract)", "medium",
+                              "8-bit frames from two DMDs whose light is added at weights 1 and 1/16"),
+    "gray12_rate_photonics2024": Fact(1611, "Hz", "Photonics (abstract)", "medium",
+                                      "12-bit frames, one DMD with a second modulator of the intensity"),
+    "gray16_rate_oleng2024": Fact(220, "frame/s", "OLEng (abstract)", "medium", "16-bit frames"),
+    "ratio_error": Fact(0.03, "", "assumption (a planning figure, no document)", "assumption",
+                        "board B's light off 2**-k of board A's by this fraction before the trim: an "
+                        "attenuator's tolerance of a few per cent"),
 }
 
 
