@@ -114,6 +114,15 @@ class DualPlan:
         (``sync_period``: the master's period in nominal cycles, for the clock loop; 0: off)."""
         return replace(self.plan.params, trigger=TriggerMode.SYNC, period=sync_period)
 
+    def board_params(self, board, trimmed=None, sync_period=0):
+        """Board ``board``'s (``"a"`` or ``"b"``) :meth:`params`, its ``lsb`` the trim's
+        (``trimmed``, a :class:`Trim`) when the board's frame is shown alone, not by a sequence's
+        entries."""
+        p = self.params(sync_period)
+        if trimmed is not None:
+            p = replace(p, lsb=trimmed.lsb_a if board == "a" else trimmed.lsb_b)
+        return p
+
     def registers(self, dmd, sync_period=0):
         """Each board's sequencer registers (the same for both): ``{"a": dict, "b": dict}``."""
         regs = self.params(sync_period).registers(dmd)

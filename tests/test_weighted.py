@@ -8,9 +8,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from host import weighted
+from host.cli import main
 from sim.models import weighted_light_model as light
 from sim.rigs.tiled_rig import Oscillator, master_period, run_tiled
 from spec.facts import TEST_DMD
+from spec.registers import TriggerMode
 
 SPLITS = [(n, k) for n in (8, 12, 16) for k in range(max(1, n - 8), min(8, n - 1) + 1)]
 
@@ -140,3 +142,30 @@ def test_two_boards_show_every_8_bit_level():
     errors = light.sync_errors_ns(run.pulses[0][0], run.pulses[1][0], run.syncs)
     assert len(errors) >= FRAMES - 1
     assert max(np.abs(e).max() for e in errors) <= 2 * 5 + 60e-6 * frame * 5 + 0.1
+
+
+def test_cli_dual_sends_each_board_its_part(tmp_path, capsys):
+    """``python -m host dual``: board A gets the high bits, B the low bits (the trim lengthening
+    the dim board's planes), both in SYNC mode at the dual depth."""
+    from test_host_client import FakeProjector
+    rng = np.random.default_rng(3)
+    image = rng.integers(0, 1 << 12, (TEST_DMD.rows, TEST_DMD.columns), dtype=np.uint16)
+    np.save(path := tmp_path / "scene.npy", image)
+    boards = [FakeProjector().start() for _ in range(2)]
+    try:
+        args = ["--timeout", "2", "dual", *[f"127.0.0.1:{b.port}" for b in boards], str(path), "--bits", "12",
+                "--dmd", "test", "--dclk", "200e6", "--ratio-error", "-0.03"]
+        assert main(args) == 0, capsys.readouterr().err
+        out = capsys.readouterr().out
+        assert "12-bit as 6 + 6 bits" in out and "board B at 127.0.0.1" in out
+        dual = weighted.plan(TEST_DMD, 200e6, 12)
+        (regs_a,), (regs_b,) = boards[0].model.registers, boards[1].model.registers
+        assert regs_a["trigger"] == regs_b["trigger"] == TriggerMode.SYNC
+        assert regs_a["lsb"] == dual.lsb < regs_b["lsb"] == weighted.trim(dual, -0.03).lsb_b
+        for board, want in zip(boards, weighted.split(image, 12), strict=True):
+            assert board.depths == [6]
+            frame = max(board.stored)[0]
+            assert np.array_equal(board.image(frame) >> 2, want)
+    finally:
+        for b in boards:
+            b.close()

@@ -13,6 +13,7 @@ MODULES = [
     "sim.bench.bitplane_figures",
     "sim.bench.camera_figures",
     "sim.bench.dlpc410_model_figures",
+    "sim.bench.dual_figures",
     "sim.bench.formal_figures",
     "sim.bench.host_figures",
     "sim.bench.mac_figures",
