@@ -186,13 +186,15 @@ def _dual_parser(sub):
                            "(host.weighted.measure): the dim board's planes are lengthened")
     dual.add_argument("--sync-period", type=float, default=0.0,
                       help="the sync master's period in seconds, for the boards' clock loops (default: off)")
+    dual.add_argument("--best", action="store_true",
+                      help="both boards under the plan finder's fastest plan (spec.plan_search) at their depth")
     dual.add_argument("--dry-run", action="store_true", help="plan and say the rate; send nothing")
 
 
 def _dual(args):
     """``dual``: plan both boards, trim, and send each its registers and its images."""
     dmd = DMDS[args.dmd]
-    plan = weighted.plan(dmd, args.dclk, args.bits, args.low_bits)
+    plan = weighted.plan(dmd, args.dclk, args.bits, args.low_bits, best=args.best)
     trim = weighted.trim(plan, args.ratio_error, dmd) if args.ratio_error else None
     period = weighted.trimmed_frame_cycles(plan, trim, dmd) if trim else plan.plan.frame_cycles
     print(f"{dmd.name}, {args.bits}-bit as {plan.high_bits} + {plan.low_bits} bits, both boards at "

@@ -59,7 +59,7 @@ def split(image, bits, low_bits=None):
     k = default_low_bits(bits) if low_bits is None else low_bits
     depth_of(bits, k)
     image = np.asarray(image)
-    if image.dtype != np.uint16 and not np.issubdtype(image.dtype, np.unsignedinteger):
+    if not np.issubdtype(image.dtype, np.unsignedinteger):
         raise ValueError(f"need an unsigned integer image, got {image.dtype}")
     if image.size and int(image.max()) >> bits:
         raise ValueError(f"values above {(1 << bits) - 1} in a {bits}-bit image")
