@@ -1,5 +1,6 @@
 """Command line: ``python -m host send IMAGE...``, ``configure``, ``arm``/``disarm``, ``trigger`` and
-``status``; ``master ADDRESS`` for a tiled display's sync master.
+``status``; ``master ADDRESS`` for a tiled display's sync master; ``dual A B IMAGE...`` for two
+DMDs in weighted light (:mod:`host.weighted`).
 
 ``send`` sizes records to the path MTU (``--mtu`` to say it), continues after the newest frame id
 the projector has (``--frame`` to choose), sends each frame at the smallest bit depth that shows it
@@ -19,6 +20,7 @@ from spec import group_orders, plan_search, schedule
 from spec.facts import DMDS, SETTLE_READINGS
 from spec.registers import ResetMode, TriggerMode
 
+from . import weighted
 from .client import DEFAULT_PORT, DELTA_ROWS, Client, ClientError, MasterClient, period_fault
 
 __all__ = ["main", "describe"]
@@ -164,7 +166,59 @@ def _parser():
         sub.add_parser(name, help=text)
     sub.add_parser("status", help="print the projector's counters")
     _master_parser(sub)
+    _dual_parser(sub)
     return parser
+
+
+def _dual_parser(sub):
+    """``dual``: two DMDs in weighted light, each board at an address of its own."""
+    dual = sub.add_parser("dual", help="n-bit frames (up to 16) on two boards in weighted light: board A the high "
+                                       "bits at full light, board B the low bits at 2**-k of it")
+    dual.add_argument("address_a", help="board A's IPv4 address (the high bits), ADDRESS or ADDRESS:PORT")
+    dual.add_argument("address_b", help="board B's IPv4 address (the low bits), ADDRESS or ADDRESS:PORT")
+    dual.add_argument("images", nargs="*", help=".npy files of n-bit images (uint16); two or more: a stored sequence")
+    dual.add_argument("--bits", type=int, default=12, help="bits of a frame, 2..16 (default 12)")
+    dual.add_argument("--low-bits", type=int, default=None, help="bits board B shows (default: --bits // 2)")
+    dual.add_argument("--dmd", default="dlp7000", choices=sorted(DMDS))
+    dual.add_argument("--dclk", type=float, default=400e6, help="DCLK in Hz the boards were built for")
+    dual.add_argument("--ratio-error", type=float, default=0.0,
+                      help="board B's light relative to 2**-k of A's, less 1, as a flat field measured it "
+                           "(host.weighted.measure): the dim board's planes are lengthened")
+    dual.add_argument("--sync-period", type=float, default=0.0,
+                      help="the sync master's period in seconds, for the boards' clock loops (default: off)")
+    dual.add_argument("--best", action="store_true",
+                      help="both boards under the plan finder's fastest plan (spec.plan_search) at their depth")
+    dual.add_argument("--dry-run", action="store_true", help="plan and say the rate; send nothing")
+
+
+def _dual(args):
+    """``dual``: plan both boards, trim, and send each its registers and its images."""
+    dmd = DMDS[args.dmd]
+    plan = weighted.plan(dmd, args.dclk, args.bits, args.low_bits, best=args.best)
+    trim = weighted.trim(plan, args.ratio_error, dmd) if args.ratio_error else None
+    period = weighted.trimmed_frame_cycles(plan, trim, dmd) if trim else plan.plan.frame_cycles
+    print(f"{dmd.name}, {args.bits}-bit as {plan.high_bits} + {plan.low_bits} bits, both boards at "
+          f"{plan.depth} bits: {schedule.FABRIC_HZ / period:.1f} Hz; light board B at 2**-{plan.low_bits} "
+          f"of A; {describe(plan.plan)}")
+    if trim:
+        print(f"trim: lsb A {trim.lsb_a}, B {trim.lsb_b} cycles (plan {plan.lsb}), ratio error left "
+              f"{trim.residual:+.2e}")
+    if args.dry_run:
+        return
+    images = [np.load(path) for path in args.images]
+    sync = round(args.sync_period * schedule.FABRIC_HZ)
+    for board, address in (("a", args.address_a), ("b", args.address_b)):
+        parts = [plan.images(image)[board] for image in images]
+        host, _, port = address.partition(":")
+        with Client(host, int(port) if port else args.port, timeout=args.timeout) as client:
+            board_plan = dataclasses.replace(plan.plan, params=plan.board_params(board, trim, sync))
+            client.configure(board_plan, dmd)
+            client.control(bit_depth=plan.depth)
+            if len(parts) > 1:
+                client.play_sequence(parts, [{"slot": s} for s in range(len(parts))], depth=plan.depth)
+            elif parts:
+                client.send_image(parts[0], depth=plan.depth)
+        print(f"board {board.upper()} at {address}: registers and {len(parts)} frame(s) sent")
 
 
 def _send_parser(sub):
@@ -313,6 +367,9 @@ def main(argv=None):
     try:
         if args.command == "master":
             _master(args)
+            return 0
+        if args.command == "dual":
+            _dual(args)
             return 0
         if args.command == "configure":
             dmd, plan = _plan(args)

@@ -39,7 +39,7 @@ import enum
 from dataclasses import dataclass
 
 __all__ = ["Fact", "TIMING", "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "VCXO_DAC", "DmdType", "DMDS",
-           "SPARTAN6_PATH", "RowMode", "BlockMode",
+           "SPARTAN6_PATH", "RowMode", "BlockMode", "WEIGHTED",
            "TEST_DMD", "TEST_DMD4",
            "TEST_DMD_400", "TEST_DMD4_400", "MEMORY", "LIGHT_SOURCE", "ANCHORS"]
 
@@ -272,6 +272,15 @@ VCXO_DAC = {
                        "first, each taken on SCLK's falling edge; the output updates on the 24th; SYNC "
                        "high before it abandons the write"),
     "code_bits": Fact(16, "bits", "AD5662", "high", "straight binary: mid-scale 0x8000"),
+}
+
+
+#: Two DMDs in weighted light (``host.weighted``): the attenuator's error the trim is shown against
+#: (the published rates they are compared with are in :data:`ANCHORS`).
+WEIGHTED = {
+    "ratio_error": Fact(0.03, "", "assumption (a planning figure, no document)", "assumption",
+                        "board B's light off 2**-k of board A's by this fraction before the trim: an "
+                        "attenuator's tolerance of a few per cent"),
 }
 
 

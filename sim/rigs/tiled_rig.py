@@ -367,7 +367,7 @@ def _read_times(path):
 
 
 def run_tiled(dmd, params, images, *, oscillators, master=Oscillator(), frames, name, master_period_cycles,
-              depth=8, width=4, traces=True, trim=False, store_words=1, max_sim_s=None):
+              depth=8, width=4, traces=True, trim=False, store_words=1, max_sim_s=None, offered=None):
     """Run the tiled rig: one board per image of ``images`` (8-bit images of ``dmd``'s size),
     each showing its image's ``depth`` most significant planes as a frame again at every sync
     pulse, under ``params`` (a
@@ -377,7 +377,10 @@ def run_tiled(dmd, params, images, *, oscillators, master=Oscillator(), frames, 
     :meth:`TiledRun.board_run`); without, only the pulse times. ``trim``: every board's clock
     loop on (the registers' ``period`` set to the master's period in nominal board cycles, which
     must be whole); ``store_words``: 64-bit words a transfer from each board's store stand-in.
-    Returns the :class:`TiledRun`."""
+    ``offered``: per board the frame table of its store stand-in (the frames of
+    :func:`sim.tb.plane_source.contents`: a stored sequence, shown a frame a sync pulse, with
+    each entry's settings), ``images[i]`` then ``{slot: image}``; default: the image in slot 0,
+    shown again at every pulse. Returns the :class:`TiledRun`."""
     boards = len(images)
     assert len(oscillators) == boards
     sync_fs = master_period_cycles * MASTER_PERIOD_FS
@@ -388,7 +391,8 @@ def run_tiled(dmd, params, images, *, oscillators, master=Oscillator(), frames, 
     plusargs, trace_files, pulse_files = [], [], []
     for i, image in enumerate(images):
         names = board_plusargs(i)
-        tables = write_tables(directory, dmd, [(0, depth)], {0: image}, store_words, prefix=f"board{i}_")
+        frames_i, given = (offered[i], image) if offered else ([(0, depth)], {0: image})
+        tables = write_tables(directory, dmd, frames_i, given, store_words, prefix=f"board{i}_")
         plusargs += [f"+{names[table]}={path}" for table, path in tables.items()]
         trace_files.append(directory / f"board{i}_pins.txt")
         pulse_files.append(directory / f"board{i}_pulses.txt")
