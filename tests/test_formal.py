@@ -205,3 +205,15 @@ def test_sequencer_clear_rule_one_row_more_fails(dmd):
                                 build=lambda: sequencer.clear_top(dmd, extra=1)), depth=24)
     assert failure.value.result.failed == ["a row load, clear or pulse of the block within a clear's no-op rows"]
     assert failure.value.result.step == (23 if dmd.clear_row_cycles > 1 else 19)
+
+
+def test_a_check_that_does_not_end_is_a_failed_row(monkeypatch):
+    """``make formal`` goes on past a check that runs out of time, and counts it failed."""
+    import subprocess
+
+    def never_ends(check, **_kwargs):
+        raise subprocess.TimeoutExpired(["sby"], 3600)
+    monkeypatch.setattr(suite, "run", never_ends)
+    row = suite._check_row(0, quick=False)
+    assert row.status == "failed" and "3600 s" in row.detail
+    assert suite.figures([row])["formal.properties_failed"][0] == 1

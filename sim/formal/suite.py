@@ -9,6 +9,7 @@ proof that no output stream's ``valid`` has a combinational path from a consumer
 
 import concurrent.futures
 import multiprocessing
+import subprocess
 import time
 from dataclasses import dataclass, field
 
@@ -72,7 +73,13 @@ def _check_row(index, quick):
     """Row of the ``index``-th check (by index: checks build their tops from closures, which do
     not cross to a worker process)."""
     check = checks()[index]
-    result = run(check, depth=check.quick if quick else None, prove=not quick, raise_on_failure=False)
+    start = time.monotonic()
+    try:
+        result = run(check, depth=check.quick if quick else None, prove=not quick, raise_on_failure=False)
+    except subprocess.TimeoutExpired as timeout:
+        # a check that does not end in its time is a failed row, and the run goes on to the others
+        return Row(check.block, check.name, "failed", "BMC", check.depth, time.monotonic() - start,
+                   f"SymbiYosys did not end within {timeout.timeout:.0f} s")
     method = "k-induction" if result.status == "proven" else "BMC"
     detail = "" if result.status != "failed" else \
         f"step {result.step}: {'; '.join(result.failed)} (counterexample {result.vcd})"
