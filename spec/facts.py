@@ -23,12 +23,14 @@ DS162       Xilinx Spartan-6 FPGA data sheet: DC and switching characteristics (
             characteristics, -3 speed grade)
 assumption  a planning figure, no document behind it: said so in the entry
 AD5662      Analog Devices AD5662 16-bit nanoDAC data sheet (serial interface timing)
+E2E-gate    TI E2E forum answer on the DLPC410/DLP7000 (8-bit rates with the light source switched
+            during the shortest planes)
 """
 
 import enum
 from dataclasses import dataclass
 
-__all__ = ["Fact", "TIMING", "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "VCXO_DAC", "DmdType", "DMDS",
+__all__ = ["Fact", "TIMING", "LIGHT", "GATED_RATES", "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "VCXO_DAC", "DmdType", "DMDS",
            "SPARTAN6_PATH", "RowMode", "BlockMode",
            "TEST_DMD", "TEST_DMD4",
            "TEST_DMD_400", "TEST_DMD4_400"]
@@ -67,6 +69,27 @@ TIMING = {
     "t_watchdog": Fact(10.0, "s", "DLPC410", "medium", "WDT_ENBLZ low: forced reset if none issued"),
     "dclk_min": Fact(200e6, "Hz", "DLP7000 table 8-2", "high"),
     "dclk_max": Fact(400e6, "Hz", "DLP7000 table 8-2; DLPU045A (new PROM: 400 MHz only)", "high"),
+}
+
+
+#: The modulated light source the sequencer's gate pin switches (an IR LED array or a laser). Its
+#: edges are linear ramps of these lengths in the camera model; equal rise and fall make a pulse's
+#: light integrate to its gate time exactly.
+LIGHT = {
+    "t_rise": Fact(50e-9, "s", "assumption (planning figure, no document)", "assumption",
+                   "gate on to full light: a driven IR LED array or a laser diode driver; a slower "
+                   "source wants the on-times trimmed"),
+    "t_fall": Fact(50e-9, "s", "assumption (planning figure, no document)", "assumption",
+                   "gate off to no light, as the rise"),
+}
+
+#: TI's figures for 8-bit frames on the DLPC410 and DLP7000 with the light source switched during
+#: the shortest planes, to compare the gated figures with.
+GATED_RATES = {
+    "gray8_hz": Fact(1.9e3, "Hz", "E2E-gate", "medium", "8-bit frames a second, as TI quotes it"),
+    "gray8_limit_hz": Fact(2.89e3, "Hz", "E2E-gate", "medium",
+                           "8-bit frames a second in the limit: eight planes each of the shortest "
+                           "legal time"),
 }
 
 
