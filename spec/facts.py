@@ -30,7 +30,8 @@ E2E-gate    TI E2E forum answer on the DLPC410/DLP7000 (8-bit rates with the lig
 import enum
 from dataclasses import dataclass
 
-__all__ = ["Fact", "TIMING", "LIGHT", "GATED_RATES", "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "VCXO_DAC", "DmdType", "DMDS",
+__all__ = ["Fact", "TIMING", "LIGHT", "GATED_RATES",
+           "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "VCXO_DAC", "DmdType", "DMDS",
            "SPARTAN6_PATH", "RowMode", "BlockMode",
            "TEST_DMD", "TEST_DMD4",
            "TEST_DMD_400", "TEST_DMD4_400"]

@@ -3,8 +3,9 @@
 When a group pulses, the planner must know at once whether the plane it ends is its frame's last,
 whether the plane is long enough to hide the next plane's load (``hide``), and how long until the
 group's next pulse: the plane's time (the frame's least significant plane's time, shifted by the
-plane's weight; a gated plane's, ``gated_time``), or for a dark pulse the dark gap (at a frame's end, the frame's own dark time if
-longer). These take a shift and 40-bit comparisons, too much for the cycle of a decision; but a
+plane's weight; a gated plane's, ``gated_time``), or for a dark pulse the dark gap (at a frame's
+end, the frame's own dark time if longer). These take a shift and 40-bit comparisons, too much
+for the cycle of a decision; but a
 group's position and frame change only when it pulses (or every group's, when the frame control
 starts or retakes a frame), and its next pulse comes long after. So one pipeline works them out
 for each group in turn and keeps the answers per group; an answer is ``fresh`` once it was
@@ -143,7 +144,8 @@ class PlaneInfo(wiring.Component):
         edark2 = Signal(DURATION_BITS)
         e2, e3, e4 = Signal(3), Signal(3), Signal(3)
         m.d.sync += [e2.eq(e1), e3.eq(e2), e4.eq(e3)]
-        m.d.sync += [plane.eq(Mux(gated1, regs.gated_time, lsb1 << e1)), last2.eq(last1), dark2.eq(dark1), nodark2.eq(nodark1),
+        m.d.sync += [plane.eq(Mux(gated1, regs.gated_time, lsb1 << e1)), last2.eq(last1), dark2.eq(dark1),
+                     nodark2.eq(nodark1),
                      edark2.eq(edark1)]
 
         # 4: the comparisons, a limb at a time

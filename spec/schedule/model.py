@@ -13,8 +13,9 @@ timeline; group ``g`` runs ``g * stagger`` cycles behind group 0.
 A frame of bit depth ``d`` is shown as ``d`` planes in the configured order; the plane of weight
 ``2**e`` is shown for ``lsb << e`` cycles, measured from its clocking pulse to the next pulse of
 the same group; a gated plane (bit ``e`` of ``gated_planes``) for ``gated_time`` cycles, its light
-on for ``light_times[e]`` of them (the gate pin; :mod:`gateware.dlpc410.light_gate`). After each pulse the group's memory is frozen for ``t_rst + t_settle`` cycles;
-then the group is loaded with what its next pulse shows:
+on for ``light_times[e]`` of them (the gate pin; :mod:`gateware.dlpc410.light_gate`). After
+each pulse the group's memory is frozen for ``t_rst + t_settle`` cycles; then the group is
+loaded with what its next pulse shows:
 
 * a plane at least ``hide`` long has the next plane loaded behind it, and the next pulse comes
   exactly ``lsb << e`` after this one;

@@ -189,8 +189,8 @@ def plan_gated(dmd, dclk_hz, *, depth=8, chain=False, **options):
     plan's (:func:`plan`, global reset mode, ``options`` as its) reload, which every plane then
     hides behind it, or what the mirrors' settle, the largest plane's light and the source's
     fall need if longer; the least significant plane's light, ``light_times[0]``, is the most
-    that lets the largest plane's light end by the next pulse (``lsb`` stays the binary plan's). ``frame_cycles`` is measured
-    on the model as :func:`plan`'s; ``binds`` names what sets ``T``."""
+    that lets the largest plane's light end by the next pulse (``lsb`` stays the binary plan's).
+    ``frame_cycles`` is measured on the model as :func:`plan`'s; ``binds`` names what sets ``T``."""
     binary = plan(dmd, dclk_hz, depth=depth, reset_mode=ResetMode.GLOBAL, chain=chain, **options)
     p = binary.params
     reload = p.hide
