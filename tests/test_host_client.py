@@ -742,7 +742,8 @@ def test_trigger_sends_the_software_trigger_alone(master):
         client.configure(mode=TriggerMode.SOFTWARE, armed=True)
         client.trigger()
         assert client.status()["pulses"] == 1
-    assert master.received[2] == struct.pack(HEADER + "BB", 0x444D, records.VERSION, MASTER_CONTROL, 2, 0, 1) + bytes(14)
+    assert master.received[2] == (struct.pack(HEADER + "BB", 0x444D, records.VERSION, MASTER_CONTROL, 2, 0, 1)
+                                  + bytes(14))
     assert master.config == {"mode": 2, "armed": 1, "period": 0, "min_period": 125_000, "width": 125}
 
 
