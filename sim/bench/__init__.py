@@ -14,6 +14,7 @@ MODULES = [
     "sim.bench.camera_figures",
     "sim.bench.dlpc410_model_figures",
     "sim.bench.formal_figures",
+    "sim.bench.gated_figures",
     "sim.bench.host_figures",
     "sim.bench.mac_figures",
     "sim.bench.net_figures",
