@@ -23,7 +23,7 @@ import math
 from dataclasses import dataclass
 
 from .ceiling import facts_cycles
-from .facts import LIGHT_SOURCE, MEMORY, TIMING
+from .facts import LIGHT, MEMORY, TIMING
 from .schedule import FABRIC_HZ, beats_at, row_cycles
 
 __all__ = ["Bound", "Paces", "one", "gated", "dual", "dual_gated", "plane_time", "gate_lead", "LEADS",
@@ -101,7 +101,9 @@ def gate_lead(lead="settle"):
 
 
 def _edge():
-    return math.ceil(LIGHT_SOURCE["t_edge"].value * FABRIC_HZ - 1e-9)
+    """Cycles of the source's slower edge (:data:`spec.facts.LIGHT`): the light is off this long
+    after the gate falls, and at full light this long after it rises."""
+    return math.ceil(max(LIGHT["t_rise"].value, LIGHT["t_fall"].value) * FABRIC_HZ - 1e-9)
 
 
 #: The shortest light pulse of a gated frame, by name: ``cycle`` one ``dmd`` cycle (the gate's

@@ -38,10 +38,11 @@ SVEC        CERN SVEC carrier: DDR3 on bank 4 (svec_base_ddr4.ucf: 14 row addres
 import enum
 from dataclasses import dataclass
 
-__all__ = ["Fact", "TIMING", "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "VCXO_DAC", "DmdType", "DMDS",
+__all__ = ["Fact", "TIMING", "LIGHT",
+           "SettleReading", "SETTLE_READINGS", "PHY", "SPARTAN6", "VCXO_DAC", "DmdType", "DMDS",
            "SPARTAN6_PATH", "RowMode", "BlockMode", "WEIGHTED",
            "TEST_DMD", "TEST_DMD4",
-           "TEST_DMD_400", "TEST_DMD4_400", "MEMORY", "LIGHT_SOURCE", "ANCHORS"]
+           "TEST_DMD_400", "TEST_DMD4_400", "MEMORY", "ANCHORS"]
 
 
 @dataclass(frozen=True)
@@ -79,6 +80,17 @@ TIMING = {
     "dclk_max": Fact(400e6, "Hz", "DLP7000 table 8-2; DLPU045A (new PROM: 400 MHz only)", "high"),
 }
 
+
+#: The modulated light source the sequencer's gate pin switches (an IR LED array or a laser). Its
+#: edges are linear ramps of these lengths in the camera model; equal rise and fall make a pulse's
+#: light integrate to its gate time exactly.
+LIGHT = {
+    "t_rise": Fact(50e-9, "s", "assumption (planning figure, no document)", "assumption",
+                   "gate on to full light: a driven IR LED array or a laser diode driver; a slower "
+                   "source wants the on-times trimmed"),
+    "t_fall": Fact(50e-9, "s", "assumption (planning figure, no document)", "assumption",
+                   "gate off to no light, as the rise"),
+}
 
 @dataclass(frozen=True)
 class SettleReading:
@@ -196,13 +208,6 @@ MEMORY = {
                              "medium", "the DDR3 on bank 4; the store sizes its slots by ``bytes`` and uses half"),
 }
 
-
-#: A light source gated on and off inside each bit-plane (``docs/bounds.md``, "Beyond one DMD").
-LIGHT_SOURCE = {
-    "t_edge": Fact(50e-9, "s", "assumption (planning figure, no document)", "assumption",
-                   "rise or fall time of a current-switched laser or LED driver; the gate stops this long "
-                   "before the next pulse, and the shortest light pulse is its rise and fall"),
-}
 
 
 #: Frame rates others reached or TI states past one DMD's PWM, to set the bounds beside.

@@ -32,13 +32,15 @@ import operator as _operator
 
 from . import facts
 from . import registers as _registers
+from .schedule.terms import LIGHT_FALL as _LIGHT_FALL
+from .schedule.terms import MIRRORS_SETTLED as _MIRRORS_SETTLED
 from .wire import size
 
 #: ``"DM"``: first two bytes of every record.
 MAGIC = 0x444D
 #: Protocol version this tree speaks; records with any other version are dropped and counted.
 #: ``magic`` and ``version`` keep their places in every version, so that a projector can tell.
-VERSION = 10
+VERSION = 11
 #: IPv4 and UDP headers around a record: a record fills an MTU less these.
 UDP_IP_OVERHEAD = 28
 #: Largest record: a UDP payload inside a 9000-byte IP MTU (9000 - 20 IPv4 - 8 UDP).
@@ -370,7 +372,19 @@ def register_faults(wire, dmd, beats=1, *, reload_terms=None):
     <spec.registers.PlaneOrder.GROUPS>` every one of the group tables (used by the reset mode or
     not), names each weight exponent 0..7 once: a table that repeats a plane would show wrong
     levels. A frame of fewer planes plays only if the first entries of each table in force name
-    its planes (the sequencer drops any other, and counts it)."""
+    its planes (the sequencer drops any other, and counts it).
+
+    Gated planes (``gated_planes`` not 0: the gate pin switches the light source, one source for
+    the whole DMD): ``gated_planes_whole``, every plane of a frame is gated or none (a plane lit
+    through its mirrors' transitions beside one lit only while they rest would be off by part of
+    a transition: the mask is 0 or 255); ``gated_global``, only in the global reset mode (phased
+    groups show different planes at once); ``gated_time_even``; ``gated_time_keepable``, a gated
+    plane is held to what a plane of its length needs, as the least significant plane is (its
+    group's clears behind the settle, and the ``hide`` rule); ``light_lead_keepable``, the light
+    comes no sooner than the mirrors settle (:data:`spec.schedule.MIRRORS_SETTLED` cycles after
+    the pulse); ``light_times_keepable``, each gated plane's light is off, the source's fall
+    (:data:`spec.schedule.LIGHT_FALL`) included, by the next pulse: ``light_lead +
+    light_times[e] + fall <= gated_time``."""
     row_cycles, clear_row_cycles = _row_cycles(dmd, beats), dmd.clear_row_cycles
     faults = {}
     for f, (_, wire_width) in zip(_registers.FIELDS, SEQUENCER, strict=True):
@@ -409,7 +423,25 @@ def register_faults(wire, dmd, beats=1, *, reload_terms=None):
     faults["group_tables_permutation"] = ((wire["order"] == _registers.PlaneOrder.GROUPS.value)
                                           & (_all([_permutation(wire["group_tables"], g)
                                                     for g in range(_registers.MAX_GROUPS)]) == 0))
+    _gated_faults(faults, wire, settle + clears, reload)
     return faults
+
+
+def _gated_faults(faults, wire, shortest, reload):
+    """:func:`register_faults`'s checks of gated planes, with ``shortest`` (a plane ended by a
+    dark pulse: the settle and the group's clears) and ``reload`` (the group's) worked out."""
+    mask, time, lead = wire["gated_planes"], wire["gated_time"], wire["light_lead"]
+    gated = mask != 0
+    faults["gated_planes_whole"] = gated & (mask != 0xFF)
+    faults["gated_global"] = gated & (wire["reset_mode"] != _registers.ResetMode.GLOBAL.value)
+    faults["gated_time_even"] = (time & 1) != 0
+    faults["gated_time_keepable"] = gated & ((time < shortest)
+                                             | ((wire["hide"] < reload) & (wire["hide"] <= time) & (time < reload)))
+    faults["light_lead_keepable"] = gated & (lead < _MIRRORS_SETTLED)
+    width = next(f.width for f in _registers.FIELDS if f.name == "light_times")
+    faults["light_times_keepable"] = _any([(_bits(mask, e, 1) != 0)
+                                           & (lead + _bits(wire["light_times"], width * e, width) + _LIGHT_FALL > time)
+                                           for e in range(8)])
 
 
 def group_reload(wire, dmd, beats=1):

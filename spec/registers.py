@@ -159,6 +159,14 @@ FIELDS = [
           doc="with PlaneOrder.GROUPS: entry g is the cycles from the first pulse a trigger times "
               "at once to group g's first pulse (0: at once; even, 0 or at least a block clear's "
               "row cycles, as stagger; group 0's 0: its first pulse starts the frame)"),
+    Field("gated_planes", 8, doc="bit e: the plane of weight 2**e is gated: it lasts gated_time, and "
+                                 "the light source (the gate pin) is on only for its light_times[e], "
+                                 "light_lead after its pulse. 0: no plane gated, the gate stays on"),
+    Field("gated_time", 24, doc="duration of a gated plane (even; the shortest legal plane: the "
+                                "mirrors' settle and the reload)"),
+    Field("light_lead", 16, doc="from a gated plane's pulse to its light on (the mirrors settled)"),
+    Field("light_times", 24, count=8,
+          doc="entry e: the light's on-time in the gated plane of weight 2**e (the host trims each)"),
 ]
 
 _BY_NAME = {f.name: f for f in FIELDS}

@@ -13,7 +13,7 @@ import pytest
 
 from spec import bounds, schedule
 from spec.ceiling import ceiling_of_mode
-from spec.facts import DMDS, LIGHT_SOURCE, TEST_DMD4_400, TEST_DMD_400
+from spec.facts import DMDS, LIGHT, TEST_DMD4_400, TEST_DMD_400
 from spec.plan_search import find
 from spec.registers import ResetMode
 from spec.schedule import Frame
@@ -87,7 +87,7 @@ def test_a_gated_plane_is_what_a_binary_pattern_needs(dmd, words):
 def test_a_gated_frame_fits_its_light_in_its_planes():
     """Every plane's light, ``lsb << e``, starts after the lead and ends a source edge before
     the next pulse; the LSB is the shortest pulse asked for at least."""
-    edge = math.ceil(LIGHT_SOURCE["t_edge"].value * schedule.FABRIC_HZ - 1e-9)
+    edge = math.ceil(max(LIGHT["t_rise"].value, LIGHT["t_fall"].value) * schedule.FABRIC_HZ - 1e-9)
     for dmd in (XGA, DMDS["dlp9500"]):
         for period in (None, 22, 42):
             paces = bounds.Paces.of(dmd, DCLK, period)

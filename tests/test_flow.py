@@ -29,6 +29,8 @@ def test_ise_tree_has_verilog_ucf_and_scripts():
     assert "trigger_in_0__io" in ucf
     # a tiled display's board: the sync master's pulse in, the ready line back
     assert 'NET "sync_in_0__io" LOC=' in ucf and 'NET "ready_out_0__io" LOC=' in ucf
+    # the light gate out, on PMOD JB pin 8
+    assert 'NET "light_gate_out_0__io" LOC=' in ucf
     v = (out / f"{top}.v").read_text()
     for primitive in ("PLL_BASE", "BUFG", "ODDR2", "OBUFTDS"):
         assert primitive in v, primitive

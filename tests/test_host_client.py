@@ -585,7 +585,7 @@ def test_cli_sequence_plays_an_entry_table(projector, tmp_path):
 
 def control_bytes(sequence, apply, action, mode=0, armed=0, period=0, min_period=0, width=0):
     """A master control record (21 bytes), field by field."""
-    return (struct.pack(HEADER + "BBBB", 0x444D, 10, MASTER_CONTROL, sequence, apply, action, mode, armed)
+    return (struct.pack(HEADER + "BBBB", 0x444D, records.VERSION, MASTER_CONTROL, sequence, apply, action, mode, armed)
             + period.to_bytes(5, "big") + min_period.to_bytes(5, "big") + struct.pack(">H", width))
 
 
@@ -614,7 +614,7 @@ class FakeMaster(LoopbackDevice):
         if len(raw) < 5 or struct.unpack_from(">H", raw)[0] != 0x444D:
             return self._drop("drop_app_magic")
         _magic, version, kind, sequence = struct.unpack_from(HEADER, raw)
-        if version != 10:
+        if version != records.VERSION:
             return self._drop("drop_app_version")
         if kind not in (STATUS_QUERY, MASTER_CONTROL):
             return self._drop("drop_app_type")
@@ -671,7 +671,7 @@ def test_master_status_reply_decodes():
     values = {"records_status": 11, "uptime_cycles": 2**47 + 5, "clock_hz": 125_000_000, "boards": 4,
               "ready": 0b1011, "pulses": 77, "mode": 1, "period": 2**39 + 1, "width": 125, "mac_tx_underruns": 3}
     raw = codec.master_status_reply(300, values)
-    assert len(raw) == 192 and struct.unpack_from(HEADER, raw) == (0x444D, 10, MASTER_STATUS, 300 & 0xFF)
+    assert len(raw) == 192 and struct.unpack_from(HEADER, raw) == (0x444D, records.VERSION, MASTER_STATUS, 300 & 0xFF)
     assert struct.unpack_from(">I", raw, 93)[0] == 11                   # records_status
     assert int.from_bytes(raw[121:127], "big") == 2**47 + 5              # uptime_cycles
     assert struct.unpack_from(">IBHI", raw, 127) == (125_000_000, 4, 0b1011, 77)
@@ -742,7 +742,8 @@ def test_trigger_sends_the_software_trigger_alone(master):
         client.configure(mode=TriggerMode.SOFTWARE, armed=True)
         client.trigger()
         assert client.status()["pulses"] == 1
-    assert master.received[2] == struct.pack(HEADER + "BB", 0x444D, 10, MASTER_CONTROL, 2, 0, 1) + bytes(14)
+    assert master.received[2] == (struct.pack(HEADER + "BB", 0x444D, records.VERSION, MASTER_CONTROL, 2, 0, 1)
+                                  + bytes(14))
     assert master.config == {"mode": 2, "armed": 1, "period": 0, "min_period": 125_000, "width": 125}
 
 

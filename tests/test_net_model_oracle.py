@@ -18,7 +18,7 @@ from sim.models.endpoint_traffic import BAD_REGISTERS, GOOD_WIRE
 from spec import records
 from spec.facts import DMDS, TEST_DMD
 from spec.registers import lead_cycles
-from spec.schedule import row_cycles
+from spec.schedule import LIGHT_FALL, MIRRORS_SETTLED, row_cycles
 
 SOURCE = Path(net.__file__)
 #: The spec modules the model may take tables and the DMD's numbers from.
@@ -28,6 +28,8 @@ WIDTHS = dict(records.SEQUENCER)
 #: DMDs and DCLK beats per cycle the rules are compared on.
 GEOMETRIES = [(dmd, beats) for dmd in DMDS.values() for beats in (1, 2) if dmd.dclk_per_row % beats == 0]
 PLANES, GROUPS, OFFSET_BITS = 8, 16, 24
+#: The light times' entries' width.
+LIGHT_BITS = WIDTHS["light_times"] // PLANES
 
 
 def imported(tree):
@@ -92,6 +94,9 @@ def taken_sets(draw, geometry):
         out[name] = draw(st.integers(0, largest))
     for name in ("chain", "strict_rst", "source", "ns_flip", "park", "trigger_hold"):
         out[name] = draw(st.integers(0, 1))
+    gated = draw(st.booleans())
+    if gated:
+        out["reset_mode"] = 0            # (gating only in the global mode)
     out["t_rst"], out["t_settle"] = draw(small), draw(st.integers(3, 1000))
     out["row_period"] = draw(st.integers(row_cycle, 255))
     group, reload = group_terms(out, dmd, beats)
@@ -107,6 +112,17 @@ def taken_sets(draw, geometry):
     offsets = [first] + [rng.choice([first, even(rng.randint(max(first, shortest), 20_000))])
                          for _ in range(GROUPS - 1)]
     out["group_offsets"] = packed(offsets, OFFSET_BITS)
+    out["gated_time"] = even(out["gated_time"] % (1 << WIDTHS["gated_time"] - 1))
+    if gated:
+        # every plane gated: the light inside each plane, behind the mirrors
+        out["gated_planes"] = 255
+        out["light_lead"] = draw(st.integers(MIRRORS_SETTLED, 5000))
+        light = [rng.randint(0, 2000) for _ in range(PLANES)]
+        out["light_times"] = packed(light, LIGHT_BITS)
+        out["gated_time"] = even(max(reload, out["light_lead"] + max(light) + LIGHT_FALL,
+                                     out["t_rst"] + out["t_settle"] + group * even(clear)) + draw(small))
+    else:
+        out["gated_planes"] = 0
     return out
 
 
@@ -123,7 +139,7 @@ def near_boundaries(draw):
     bounds = [row_cycle, clear, 4, max(clear, 4), lead_cycles(row_cycle, dmd.clear_row_cycles),
               registers["t_rst"] + registers["t_settle"] + clear,
               registers["t_rst"] + registers["t_settle"] + group * even(clear), registers["lsb"], reload,
-              registers["lsb"] * 128, registers["hide"]]
+              registers["lsb"] * 128, registers["hide"], MIRRORS_SETTLED, registers["gated_time"]]
     near = st.tuples(st.sampled_from(bounds), st.integers(-3, 3)).map(lambda b: max(0, sum(b)))
     for _ in range(draw(st.integers(1, 3))):
         name = draw(st.sampled_from(sorted(WIDTHS)))
@@ -136,6 +152,13 @@ def near_boundaries(draw):
             offsets[draw(st.one_of(st.just(0), st.integers(0, GROUPS - 1)))] = value & mask
             registers[name] = packed(offsets, OFFSET_BITS)
             registers["order"] = draw(st.sampled_from([registers["order"], 3]))
+        elif name == "light_times":
+            # one gated plane's light moved near the end of its plane
+            e, mask = draw(st.integers(0, PLANES - 1)), (1 << LIGHT_BITS) - 1
+            light = [registers[name] >> LIGHT_BITS * k & mask for k in range(PLANES)]
+            end = registers["gated_time"] - registers["light_lead"] - LIGHT_FALL
+            light[e] = max(0, end + draw(st.integers(-3, 3))) & mask
+            registers[name] = packed(light, LIGHT_BITS)
         elif name in ("order_table", "group_tables"):
             # one entry of one table changed
             j = draw(st.integers(0, width // 3 - 1))

@@ -102,6 +102,63 @@ def test_each_bound_refuses_alone():
     assert faults(TEST_DMD, dataclasses.replace(at, lsb=long_lsb, hide=0, chain=True, dark_gap=2)) == []
 
 
+@pytest.mark.parametrize("name,dclk", GEOMETRIES)
+def test_the_gated_plans_pass(name, dclk):
+    dmd = DMDS[name]
+    p = schedule.plan_gated(dmd, dclk, t_rst_s=80 / dclk, t_settle_s=60 / dclk).params
+    assert faults(dmd, p) == []
+
+
+def test_each_gated_bound_refuses_alone():
+    """Gated planes: one step past each bound is refused by that check alone; at it, taken."""
+    at = schedule.plan_gated(TEST_DMD, 200e6, t_rst_s=80 / 200e6, t_settle_s=60 / 200e6).params
+    floor, reload = bounds(TEST_DMD, at)
+    at = dataclasses.replace(at, light_lead=schedule.MIRRORS_SETTLED)
+    end = at.gated_time - at.light_lead - schedule.LIGHT_FALL
+    at = dataclasses.replace(at, light_times=(1,) * 7 + (end,))
+    assert faults(TEST_DMD, at) == []
+    assert faults(TEST_DMD, dataclasses.replace(at, light_times=(1,) * 7 + (end + 1,))) == ["light_times_keepable"]
+    assert faults(TEST_DMD, dataclasses.replace(at, light_lead=at.light_lead - 1)) == ["light_lead_keepable"]
+    assert faults(TEST_DMD, dataclasses.replace(at, gated_time=at.gated_time + 1)) == ["gated_time_even"]
+    assert faults(TEST_DMD, dataclasses.replace(at, gated_planes=0x7F)) == ["gated_planes_whole"]
+    phased = dataclasses.replace(at, reset_mode=ResetMode.DUAL, stagger=0)
+    assert "gated_global" in faults(TEST_DMD, phased)
+    assert "gated_global" not in faults(TEST_DMD, dataclasses.replace(phased, gated_planes=0))
+    # a gated plane shorter than the reload that hides, or than a dark pulse's settle and clears:
+    # refused as such an LSB would be (its light, behind the mirrors' settle, cannot fit either)
+    short = dataclasses.replace(at, gated_time=reload - reload % 2 - 2, light_times=(0,) * 8, hide=floor)
+    assert short.gated_time >= floor and "gated_time_keepable" in faults(TEST_DMD, short)
+    assert "gated_time_keepable" not in faults(TEST_DMD, dataclasses.replace(short, hide=reload))
+    assert "gated_time_keepable" in faults(TEST_DMD, dataclasses.replace(short, gated_time=floor - floor % 2 - 2,
+                                                                          hide=reload))
+
+
+@st.composite
+def gated_sets(draw):
+    """A gated plan's set with its gated time, lead and largest light moved near their bounds."""
+    name, dclk = draw(st.sampled_from(GEOMETRIES))
+    dmd = DMDS[name]
+    base = schedule.plan_gated(dmd, dclk, t_rst_s=draw(st.sampled_from([40, 200])) / dclk,
+                               t_settle_s=draw(st.sampled_from([6, 120])) / dclk,
+                               chain=draw(st.booleans())).params
+    floor, reload = bounds(dmd, base)
+    near = st.integers(-6, 6).map(lambda k: 2 * k)
+    gated_time = max(2, draw(st.sampled_from([floor, reload, base.gated_time])) + draw(near))
+    hide = draw(st.sampled_from([base.hide, 0, 1 << 30]))
+    lead = schedule.MIRRORS_SETTLED + draw(st.integers(-2, 4))
+    light = max(0, gated_time - lead - schedule.LIGHT_FALL + draw(st.integers(-3, 2)))
+    return dmd, dataclasses.replace(base, gated_time=gated_time, hide=hide, light_lead=lead,
+                                    light_times=base.light_times[:7] + (light,))
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(gated_sets())
+def test_gated_sets_the_rule_takes_play_on_time(case):
+    dmd, p = case
+    if not faults(dmd, p):
+        assert schedule.on_time(dmd, p, schedule.Frame(0, 8)), p
+
+
 #: The gateware check: sets drawn on the test DMD at one beat (the endpoint's and the rig's
 #: build), triggered (a frame a trigger, so that each run ends).
 ON_GATEWARE = [("test", 200e6)]

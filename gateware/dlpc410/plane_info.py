@@ -3,8 +3,9 @@
 When a group pulses, the planner must know at once whether the plane it ends is its frame's last,
 whether the plane is long enough to hide the next plane's load (``hide``), and how long until the
 group's next pulse: the plane's time (the frame's least significant plane's time, shifted by the
-plane's weight), or for a dark pulse the dark gap (at a frame's end, the frame's own dark time if
-longer). These take a shift and 40-bit comparisons, too much for the cycle of a decision; but a
+plane's weight; a gated plane's, ``gated_time``), or for a dark pulse the dark gap (at a frame's
+end, the frame's own dark time if longer). These take a shift and 40-bit comparisons, too much
+for the cycle of a decision; but a
 group's position and frame change only when it pulses (or every group's, when the frame control
 starts or retakes a frame), and its next pulse comes long after. So one pipeline works them out
 for each group in turn and keeps the answers per group; an answer is ``fresh`` once it was
@@ -40,7 +41,8 @@ class PlaneInfo(wiring.Component):
     Members
     -------
     regs : In(:class:`~gateware.registers.Registers`)
-        ``order``, ``order_table``, ``group_tables``, ``anchor``, ``lsb``, ``hide``, ``dark_gap``.
+        ``order``, ``order_table``, ``group_tables``, ``anchor``, ``lsb``, ``hide``, ``dark_gap``,
+        ``gated_planes``, ``gated_time``.
     pos : In(ArrayLayout(3, blocks)); dark : In(blocks); frame : In(ArrayLayout(FRAME, blocks))
         Each group's display position, whether its next pulse is a dark one, and its frame.
     changed : In(blocks)
@@ -56,6 +58,9 @@ class PlaneInfo(wiring.Component):
         dark pulse the dark gap (at the last plane, the frame's dark time if longer).
     fresh : Out(blocks)
         Bit g: the answers for group g follow from its state as it is.
+    exponent : Out(3)
+        The weight exponent of the plane at group 0's position (the light gate's: gating is
+        global, one group).
     """
 
     def __init__(self, dmd):
@@ -72,6 +77,7 @@ class PlaneInfo(wiring.Component):
             "keeps_dark": Out(blocks),
             "delay": Out(data.ArrayLayout(DURATION_BITS, blocks)),
             "fresh": Out(blocks),
+            "exponent": Out(3),
         })
 
     def elaborate(self, platform):
@@ -119,9 +125,11 @@ class PlaneInfo(wiring.Component):
                      lsb.eq(show.lsb_or(regs.lsb)), last0.eq(pos == depth - 1),
                      dark0.eq(dark), edark0.eq(show.dark), nodark0.eq(show.dark == 0)]
 
-        # 2: the plane's weight
+        # 2: the plane's weight, and whether it is gated
         advance(2)
         e = each[at]
+        gated1 = Signal()
+        m.d.sync += gated1.eq(regs.gated_planes.bit_select(e, 1))
         last1, dark1, nodark1 = Signal(), Signal(), Signal()
         edark1 = Signal.like(show.dark)
         lsb1 = Signal.like(regs.lsb)
@@ -134,7 +142,10 @@ class PlaneInfo(wiring.Component):
         plane = Signal(DURATION_BITS)
         last2, dark2, nodark2 = Signal(), Signal(), Signal()
         edark2 = Signal(DURATION_BITS)
-        m.d.sync += [plane.eq(lsb1 << e1), last2.eq(last1), dark2.eq(dark1), nodark2.eq(nodark1),
+        e2, e3, e4 = Signal(3), Signal(3), Signal(3)
+        m.d.sync += [e2.eq(e1), e3.eq(e2), e4.eq(e3)]
+        m.d.sync += [plane.eq(Mux(gated1, regs.gated_time, lsb1 << e1)), last2.eq(last1), dark2.eq(dark1),
+                     nodark2.eq(nodark1),
                      edark2.eq(edark1)]
 
         # 4: the comparisons, a limb at a time
@@ -160,6 +171,8 @@ class PlaneInfo(wiring.Component):
             with m.If(valid[-1] & hot[g] & ~changed[g]):
                 m.d.sync += [self.last[g].eq(last4), self.big[g].eq(big), self.keeps_dark[g].eq(nodark4),
                              self.delay[g].eq(delay), self.fresh[g].eq(1)]
+                if g == 0:
+                    m.d.sync += self.exponent.eq(e4)
             with m.If(self.changed[g]):
                 m.d.sync += self.fresh[g].eq(0)
         return m

@@ -111,6 +111,9 @@ class Planner(wiring.Component):
         ``retake`` of a newer one) clears it.
     frame_start, camera_start : Out(1)
         The pulse applied now is the first of a frame (that pulses the camera).
+    light_pulse, light_exponent : Out(1), Out(3)
+        Group 0's pulse applied now shows a plane (not a dark pulse), of that weight exponent
+        (for the light gate: gating is global, one group).
     sync_out : Out(1)
         High while a frame is shown, with the pins (group 0's first pulse to the final dark pulse
         of the last group to end).
@@ -157,6 +160,8 @@ class Planner(wiring.Component):
             "ended": Out(1),
             "frame_start": Out(1),
             "camera_start": Out(1),
+            "light_pulse": Out(1),
+            "light_exponent": Out(3),
             "sync_out": Out(1),
             "frames_started": Out(COUNTER_BITS),
             "late": Out(COUNTER_BITS),
@@ -237,7 +242,8 @@ class Planner(wiring.Component):
         m.d.comb += [frames.take.eq(take), times.pulse.eq(decided), times.pulse_any.eq(decided_any),
                      watch.pulse.eq(decided), watch.pulse_any.eq(decided_any),
                      info.changed.eq(decided | Mux(every.valid, (1 << blocks) - 1, 0)),
-                     self.frame_start.eq(starts), self.camera_start.eq(camera)]
+                     self.frame_start.eq(starts), self.camera_start.eq(camera),
+                     self.light_pulse.eq(decided[0] & ~dark[0]), self.light_exponent.eq(info.exponent)]
         for g in range(blocks):
             with m.If(decided[g]):
                 m.d.sync += loaded[g].eq(0)

@@ -20,7 +20,8 @@ Its parts, joined by streams::
 * :class:`~.row_source.RowSource`: the store's words as beats, or the on-chip pattern source;
 * :class:`~.bus.Bus`: every even free cycle, a due pulse, else a dark pulse's next clear, else the
   next row or clear, else nothing;
-* :class:`~.camera.CameraTrigger`, :class:`~.init.Init`, :class:`~.trigger.Trigger`.
+* :class:`~.camera.CameraTrigger`, :class:`~.light_gate.LightGate`, :class:`~.init.Init`,
+  :class:`~.trigger.Trigger`.
 """
 
 from amaranth import Cat, Module, Mux, Signal
@@ -38,6 +39,7 @@ from .camera import CameraTrigger
 from .control import FrameControl
 from .init import TRAINING_EDGES, Init
 from .layouts import Status, dark_load, group_span, load_job, ready_load
+from .light_gate import LightGate
 from .period_watch import PeriodWatch
 from .planner import Planner
 from .requester import Requester
@@ -87,6 +89,10 @@ class Sequencer(wiring.Component):
     camera_out : Out(1)
         Camera trigger: ``camera_width`` cycles, starting ``camera_offset`` cycles after the
         frame's first clocking pulse appears on the pins.
+    gate_out : Out(1)
+        Light gate (:class:`~.light_gate.LightGate`): for a gated plane, high ``light_lead``
+        cycles after its pulse appears on the pins, for the plane's ``light_times`` entry; high
+        throughout while no plane is gated.
     ready : Out(1)
         A trigger (or sync pulse) now would be obeyed at once: every group holds its first plane
         and waits (the ready line a tiled display's sync master reads).
@@ -130,6 +136,7 @@ class Sequencer(wiring.Component):
             "soft_trigger": In(1),
             "sync_out": Out(1),
             "camera_out": Out(1),
+            "gate_out": Out(1),
             "ready": Out(1),
             "frames": In(stream.Signature(FrameInfo)),
             "requests": Out(stream.Signature(PlaneRequest)),
@@ -159,6 +166,7 @@ class Sequencer(wiring.Component):
         m.submodules.row_source = source = RowSource(dmd, beats=beats, store_words=self._store_words)
         m.submodules.bus = bus = Bus(dmd, beats=beats)
         m.submodules.camera = camera = CameraTrigger()
+        m.submodules.light_gate = light_gate = LightGate()
         m.submodules.period_watch = period_watch = PeriodWatch()
         # the parts joined by streams, by name (the formal stream rules check each one's)
         self.parts = {"init": init, "planner": planner, "jobs": jobs, "requester": requester, "loads": loads,
@@ -188,7 +196,7 @@ class Sequencer(wiring.Component):
         # (registered: the registers hold still while anything reads it)
         active = Signal(blocks)
         m.d.sync += active.eq(Cat(g < n_groups for g in range(blocks)))
-        for part in (planner, control, requester, source, bus, camera, period_watch):
+        for part in (planner, control, requester, source, bus, camera, light_gate, period_watch):
             m.d.comb += part.regs.eq(regs)
         for part in (control, requester):
             m.d.comb += part.n_groups.eq(n_groups)
@@ -248,15 +256,18 @@ class Sequencer(wiring.Component):
         wiring.connect(m, planner.bus, bus.planner)
 
         # ---- outputs and counters ----
-        self._outputs(m, init, planner, control, bus, camera, period_watch)
+        self._outputs(m, init, planner, control, bus, camera, light_gate, period_watch)
         self._drive_pins(m, init, bus)
         return m
 
-    def _outputs(self, m, init, planner, control, bus, camera, period_watch):
-        """The camera, sync and status outputs: the frame's marks to the camera trigger and the
-        period watch, and every part's counters to ``status``."""
+    def _outputs(self, m, init, planner, control, bus, camera, light_gate, period_watch):
+        """The camera, gate, sync and status outputs: the frame's marks to the camera trigger and
+        the period watch, the planes' pulses to the light gate, and every part's counters to
+        ``status``."""
         m.d.comb += [
             camera.frame_start.eq(planner.camera_start),
+            light_gate.pulse.eq(planner.light_pulse), light_gate.exponent.eq(planner.light_exponent),
+            self.gate_out.eq(light_gate.out),
             period_watch.frame_start.eq(planner.frame_start), period_watch.depth.eq(planner.depth),
             period_watch.lsb.eq(planner.lsb),
             self.camera_out.eq(camera.out),

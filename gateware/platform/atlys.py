@@ -3,7 +3,7 @@ projector's board: amaranth-boards' platform plus the DLPC410 adapter and trigge
 
 from amaranth_boards.atlys import AtlysPlatform
 
-from .dlpc410_adapter import dlpc410_resources, trigger_resources
+from .dlpc410_adapter import dlpc410_resources, gate_resource, trigger_resources
 from .mcb_instance import ATLYS_DDR2
 from .pins import GmiiPins
 
@@ -18,7 +18,9 @@ class AtlysProjectorPlatform(AtlysPlatform):
     and the platform top drives only what the board can carry.
     """
 
-    resources = AtlysPlatform.resources + dlpc410_resources() + trigger_resources()
+    resources = AtlysPlatform.resources + dlpc410_resources() + trigger_resources() + [gate_resource()]
+    #: the light gate's pin (``light_gate_out``) is placed
+    light_gate = True
     dlpc410_complete = any(c.name == "dlpc410_ext" for c in AtlysPlatform.connectors)
     #: the VHDCI adapter's buses (a two-bus DMD: DLP7000)
     dlpc410_buses = 2

@@ -23,7 +23,7 @@ board's platform; the core never names pins.
 
 from amaranth.build import Attrs, DiffPairs, Pins, Resource, Subsignal
 
-__all__ = ["VHDCI_PAIRS", "FMC_PAIRS", "CONTROL_LINES", "TRIGGER_LINES", "dlpc410_resources",
+__all__ = ["VHDCI_PAIRS", "FMC_PAIRS", "CONTROL_LINES", "TRIGGER_LINES", "dlpc410_resources", "gate_resource",
            "dlpc410_fmc_resources", "trigger_resources", "control_subsignals"]
 
 LVDS = Attrs(IOSTANDARD="LVDS_25")
@@ -120,6 +120,12 @@ def dlpc410_fmc_resources(control_conn, control_pins):
                     *pair_subsignals(fmc_use("c", "d"), FMC_PAIRS, ("fmc", 1)))
     ext = Resource("dlpc410_ext", 0, *control_subsignals(control_pins, control_conn))
     return [fast, ext]
+
+
+def gate_resource(conn=("pmod", 0), pin="8", attrs=LVCMOS33):
+    """The light gate's output (``light_gate_out``, to the light source's driver) on connector
+    ``conn``'s ``pin``: by default the Atlys's PMOD JB pin 8, beside the trigger lines."""
+    return Resource("light_gate_out", 0, Pins(pin, dir="o", conn=conn), attrs)
 
 
 def trigger_resources(conn=("pmod", 0), pins=("1", "2", "3", "4", "7"), attrs=LVCMOS33):

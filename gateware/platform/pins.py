@@ -277,8 +277,9 @@ class Dlpc410Pins(Elaboratable):
 
 class TriggerPins(Elaboratable):
     """Trigger in (an IOB register on ``dmd``), sync in (a DDR input register on ``dmd``: its
-    rising and its falling half), sync out, camera-trigger out and the ready line to a sync
-    master (IOB registers).
+    rising and its falling half), sync out, camera-trigger out, the ready line to a sync
+    master and, on a board that places it (``platform.light_gate``), the light gate out (IOB
+    registers).
 
     The inputs' IOB registers are the first synchronising stage; the core adds the rest. The sync
     input's falling half is the clock loop's phase detector: the loop holds the pulse's edge at
@@ -287,7 +288,7 @@ class TriggerPins(Elaboratable):
     Attributes
     ----------
     trigger, sync_in, sync_in_fall : Signal, to the core (``dmd``, not yet synchronised)
-    sync, camera, ready : Signal, from the core
+    sync, camera, ready, gate : Signal, from the core
     """
 
     def __init__(self):
@@ -297,6 +298,7 @@ class TriggerPins(Elaboratable):
         self.sync = Signal()
         self.camera = Signal()
         self.ready = Signal()
+        self.gate = Signal()
 
     def elaborate(self, platform):
         m = Module()
@@ -313,6 +315,8 @@ class TriggerPins(Elaboratable):
         m.d.comb += [self.trigger.eq(trig.i), self.sync_in.eq(sync_in.i[0]), self.sync_in_fall.eq(sync_in.i[1]),
                      sync.o.eq(self.sync),
                      cam.o.eq(self.camera), ready.o.eq(self.ready)]
+        if getattr(platform, "light_gate", False):
+            m.d.comb += pad("o", "light_gate_out").o.eq(self.gate)
         return m
 
 

@@ -132,6 +132,8 @@ class SvecProjectorPlatform(SvecPlatform):
         + trigger_resources(("vme_p2", 0), P2_PINS[_CONTROL_PINS:], LVCMOS25)
     dlpc410_complete = True
     dlpc410_buses = 4
+    #: no light gate pin: every pin of P2 this tree places is taken (constraints/README.md)
+    light_gate = False
     #: the memory the store uses and its controller
     memory = SVEC_DDR3
     #: the Ethernet PHY: the SFP cage through a 1000BASE-X PCS inside the FPGA

@@ -89,6 +89,7 @@ class PlatformTop(Elaboratable):
             projector.sync_in_fall.eq(trigger.sync_in_fall),
             trigger.sync.eq(projector.sync_out),
             trigger.camera.eq(projector.camera_out),
+            trigger.gate.eq(projector.gate_out),
             trigger.ready.eq(projector.ready_out),
         ]
         # ---- The VCXO's DAC, on a board that carries one: the clock loop pulls the oscillator --

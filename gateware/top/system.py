@@ -112,6 +112,9 @@ class Projector(wiring.Component):
         ``sync_in``), for the clock loop's phase detector.
     sync_out, camera_out : Out(1)
         Frame shown; camera trigger (``dmd``).
+    gate_out : Out(1)
+        The light gate (``dmd``): switches a modulated light source during gated planes
+        (:class:`gateware.dlpc410.light_gate.LightGate`); high while no plane is gated.
     ready_out : Out(1)
         A trigger or sync pulse now would be obeyed at once (``dmd``): the ready line to a tiled
         display's sync master.
@@ -151,6 +154,7 @@ class Projector(wiring.Component):
             **({"sync_in_fall": In(1)} if sync_pad_sampled else {}),
             "sync_out": Out(1),
             "camera_out": Out(1),
+            "gate_out": Out(1),
             "ready_out": Out(1),
             "shown": Out(ShownFrame),
             "vcxo_trim": Out(signed(TRIM_BITS)),
@@ -223,6 +227,7 @@ class Projector(wiring.Component):
             seq.sync_in.eq(self.sync_in),
             self.sync_out.eq(seq.sync_out),
             self.camera_out.eq(seq.camera_out),
+            self.gate_out.eq(seq.gate_out),
             self.ready_out.eq(seq.ready),
         ]
         m.submodules.soft_trigger = soft = PulseSynchronizer(i_domain="sync", o_domain="dmd")

@@ -16,6 +16,7 @@ MODULES = [
     "sim.bench.dlpc410_model_figures",
     "sim.bench.dual_figures",
     "sim.bench.formal_figures",
+    "sim.bench.gated_figures",
     "sim.bench.host_figures",
     "sim.bench.mac_figures",
     "sim.bench.net_figures",

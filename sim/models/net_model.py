@@ -10,6 +10,7 @@ assembled from the image records' pixels as the page says (:class:`Rows`): a row
 all of it has come in consecutive records of one frame.
 """
 
+import math
 from dataclasses import dataclass, field
 
 from spec import facts, records, wire
@@ -31,6 +32,14 @@ GLOBAL, BY_TABLE, BY_GROUP, PERIODIC = 0, 2, 3, 1
 #: Pulse groups, their offsets' width and the entries of one plane order table (the page's
 #: ``group_offsets`` and ``group_tables``).
 GROUPS, OFFSET_BITS, PLANES = 16, 24, 8
+#: The page's ``dmd`` clock, and the gated planes' times in its whole cycles: the mirrors settled
+#: (pulse to motion, then the switching time) and the light source's fall.
+DMD_HZ = 200e6
+MIRRORS_SETTLED = math.ceil((facts.TIMING["t_pulse_to_mirror"].value + facts.TIMING["t_switch"].value) * DMD_HZ
+                            - 1e-9)
+LIGHT_FALL = math.ceil(facts.LIGHT["t_fall"].value * DMD_HZ - 1e-9)
+#: The light times' entries are 24 bits each.
+LIGHT_TIME_BITS = 24
 
 
 def newer(frame, than):
@@ -81,7 +90,22 @@ def sequencer_refusals(registers, dmd, beats=1):
         ("order_table not each plane once", r["order"] == BY_TABLE and not names_each_plane_once(r["order_table"], 0)),
         ("a group table not each plane once", r["order"] == BY_GROUP
          and not all(names_each_plane_once(r["group_tables"], g) for g in range(GROUPS))),
+        ("gated_time odd", r["gated_time"] % 2),
     ]
+    if r["gated_planes"]:
+        gated_time, lead = r["gated_time"], r["light_lead"]
+        light = [r["light_times"] >> LIGHT_TIME_BITS * e & ((1 << LIGHT_TIME_BITS) - 1) for e in range(PLANES)]
+        checks += [
+            ("some planes gated, not all", r["gated_planes"] != 255),
+            ("gated in a phased reset mode", r["reset_mode"] != GLOBAL),
+            ("gated_time shorter than t_rst + t_settle and the group's clears",
+             gated_time < r["t_rst"] + r["t_settle"] + group_clears),
+            ("gated_time below the group's reload where it hides the next plane",
+             r["hide"] < reload and r["hide"] <= gated_time < reload),
+            ("light_lead shorter than the mirrors' settle", lead < MIRRORS_SETTLED),
+            ("a gated plane's light on at its next pulse", any(
+                r["gated_planes"] >> e & 1 and lead + light[e] + LIGHT_FALL > gated_time for e in range(PLANES))),
+        ]
     return reasons + [reason for reason, failed in checks if failed]
 
 

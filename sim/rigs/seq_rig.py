@@ -83,10 +83,11 @@ def event_layout():
 def rig_layout(buses, beats=1):
     """The pin trace's record: :func:`sim.rigs.fast_system_rig.pin_layout`'s fields, ``running``
     (the time base counts: ``now`` is 1 on the first cycle it is high), the release stream (its
-    ``ready`` is always high: each cycle with ``release_valid`` hands ``release_slot`` back) and the
-    sequencer's ``ready`` line (a trigger now would be obeyed at once)."""
+    ``ready`` is always high: each cycle with ``release_valid`` hands ``release_slot`` back), the
+    sequencer's ``ready`` line (a trigger now would be obeyed at once) and its light gate."""
     return data.StructLayout({**{name: field.shape for name, field in pin_layout(buses, beats)},
-                              "running": 1, "release_valid": 1, "release_slot": SLOT_BITS, "ready": 1})
+                              "running": 1, "release_valid": 1, "release_slot": SLOT_BITS, "ready": 1,
+                              "gate_out": 1})
 
 
 class EventPlayer(wiring.Component):
@@ -213,7 +214,7 @@ class SequencerRig(wiring.Component):
                      extra={"trigger_in": core.trigger_in, "sync_out": core.sync_out,
                             "camera_out": core.camera_out, "running": self.running,
                             "release_valid": core.release.valid, "release_slot": core.release.payload,
-                            "ready": core.ready},
+                            "ready": core.ready, "gate_out": core.gate_out},
                      **{name: getattr(self.timing, name) for name, _ in Timing.as_shape()})
         return m
 
@@ -354,7 +355,7 @@ def analyse(model, pins, dmd, *, until_now=None):
     until = None if until_now is None else until_now - shift
     trace.replay_dlpc410(model, pins, layout, until=until)
     run = Run(model, shift=shift)
-    last = {"sync_out": 0, "camera_out": 0, "ready": 0}
+    last = {"sync_out": 0, "camera_out": 0, "ready": 0, "gate_out": 0}
     for cycle, value in pins:
         if until is not None and cycle > until:
             break
@@ -363,7 +364,7 @@ def analyse(model, pins, dmd, *, until_now=None):
             continue
         if field(value, "release_valid"):
             run.releases.append((now, field(value, "release_slot")))
-        for name, offset in (("sync_out", -1), ("camera_out", 0), ("ready", 0)):
+        for name, offset in (("sync_out", -1), ("camera_out", 0), ("ready", 0), ("gate_out", 0)):
             level = field(value, name)
             if level != last[name]:
                 getattr(run, name).append((now + offset, level))

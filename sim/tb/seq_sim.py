@@ -48,6 +48,7 @@ class Run:
     sync_out: list = field(default_factory=list)     # (now, level) at each change
     camera_out: list = field(default_factory=list)
     ready: list = field(default_factory=list)        # (now, level) at each change (the rig's trace)
+    gate_out: list = field(default_factory=list)     # (now, level) at each change (the rig's trace)
     releases: list = field(default_factory=list)     # (now, slot) handed back
     lights: list = field(default_factory=list)       # camera images of the frames (frame_lights)
     report: dict = field(default_factory=dict)       # on the rig: the testbench's (sim.rigs.seq_rig)

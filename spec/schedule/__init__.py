@@ -27,6 +27,7 @@ from .planner import (  # noqa: F401
     bound,
     paper_eq_rate_hz,
     plan,
+    plan_gated,
     timeline,
 )
 from .terms import (  # noqa: F401
@@ -35,7 +36,10 @@ from .terms import (  # noqa: F401
     FABRIC_HZ,
     FALL_LATENCY,
     INIT_TO_DVALID,
+    LIGHT_FALL,
+    LIGHT_RISE,
     MIN_SETTLE,
+    MIRRORS_SETTLED,
     OFFER_LAG,
     PACE_LAG,
     PAPER_SETTLE_CYCLES,

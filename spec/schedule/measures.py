@@ -18,7 +18,8 @@ __all__ = ["level_light", "ready_cycle", "on_time", "frame_period", "back_to_bac
 
 
 def level_light(dmd, p, result, images):
-    """On-cycles per pixel from the model's pulses: {frame index: (rows, columns) int array},
+    """On-cycles per pixel from the model's pulses (a gated plane's: its light's on-time):
+    {frame index: (rows, columns) int array},
     ``images[i]`` being the 8-bit image of the i-th frame taken (the planes it shows:
     :meth:`Frame.stored_plane`)."""
     group_blocks = groups(dmd, p.reset_mode)
@@ -34,7 +35,7 @@ def level_light(dmd, p, result, images):
             img = np.asarray(images[fi], dtype=np.int64)
             bit = (img[rows] >> result.shown[fi].stored_plane(e)) & 1
             acc = light.setdefault(fi, np.zeros(img.shape, dtype=np.int64))
-            acc[rows] += bit * (t2 - t)
+            acc[rows] += bit * (p.light_times[e] if p.gated(e) else t2 - t)
     return light
 
 

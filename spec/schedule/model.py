@@ -12,8 +12,10 @@ timeline; group ``g`` runs ``g * stagger`` cycles behind group 0.
 
 A frame of bit depth ``d`` is shown as ``d`` planes in the configured order; the plane of weight
 ``2**e`` is shown for ``lsb << e`` cycles, measured from its clocking pulse to the next pulse of
-the same group. After each pulse the group's memory is frozen for ``t_rst + t_settle`` cycles;
-then the group is loaded with what its next pulse shows:
+the same group; a gated plane (bit ``e`` of ``gated_planes``) for ``gated_time`` cycles, its light
+on for ``light_times[e]`` of them (the gate pin; :mod:`gateware.dlpc410.light_gate`). After
+each pulse the group's memory is frozen for ``t_rst + t_settle`` cycles; then the group is
+loaded with what its next pulse shows:
 
 * a plane at least ``hide`` long has the next plane loaded behind it, and the next pulse comes
   exactly ``lsb << e`` after this one;
@@ -261,7 +263,7 @@ class _Model:
         last = j == len(exps) - 1
         follow = last and self.follows(g, t)
         if kind == "plane":
-            d = (frame.lsb or p.lsb) << exps[j]
+            d = p.plane_time(exps[j], frame.lsb)
             s.pulse_at = t + d
             if d >= p.hide and (not last or (follow and not frame.dark)):
                 nfi, nj = (fi, j + 1) if not last else (self.next_frame_for(g), 0)

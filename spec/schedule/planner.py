@@ -23,6 +23,8 @@ from .measures import (
 from .terms import (
     FABRIC_HZ,
     FALL_LATENCY,
+    LIGHT_FALL,
+    MIRRORS_SETTLED,
     PAPER_SETTLE_CYCLES,
     RELOAD_LEAD,
     RST_MARGIN,
@@ -36,7 +38,7 @@ from .terms import (
 )
 
 __all__ = [
-    "Plan", "plan", "bound", "paper_eq_rate_hz", "timeline",
+    "Plan", "plan", "plan_gated", "bound", "paper_eq_rate_hz", "timeline",
 ]
 
 
@@ -179,6 +181,32 @@ def plan(dmd, dclk_hz, *, depth=8, order=PlaneOrder.MSB_FIRST, reset_mode=ResetM
                      if p.lsb == even(lsb_min) else
                      "load queue order + pulse spacing (groups spread, LSB above the settle path)")
     return Plan(p, frame_cycles, lsb_min, binds, dclk_hz)
+
+
+def plan_gated(dmd, dclk_hz, *, depth=8, chain=False, **options):
+    """A gated plan: every plane of a ``depth``-bit frame gated (the gate pin switches the light),
+    each the same shortest legal time ``T``, its light on ``light_times[0] << e`` of it. ``T`` is the binary
+    plan's (:func:`plan`, global reset mode, ``options`` as its) reload, which every plane then
+    hides behind it, or what the mirrors' settle, the largest plane's light and the source's
+    fall need if longer; the least significant plane's light, ``light_times[0]``, is the most
+    that lets the largest plane's light end by the next pulse (``lsb`` stays the binary plan's).
+    ``frame_cycles`` is measured on the model as :func:`plan`'s; ``binds`` names what sets ``T``."""
+    binary = plan(dmd, dclk_hz, depth=depth, reset_mode=ResetMode.GLOBAL, chain=chain, **options)
+    p = binary.params
+    reload = p.hide
+    lead = even(MIRRORS_SETTLED)
+    need = lead + (1 << (depth - 1)) * 2 + LIGHT_FALL
+    gated_time = even(max(reload, need, p.t_rst + p.t_settle + clear_cycles(row_cycles(dmd, p.beats),
+                                                                            dmd.clear_row_cycles) * dmd.blocks))
+    binds = "reload (t_rst + t_settle + the rows)" if gated_time == even(reload) else "mirror settle + light"
+    unit = (gated_time - lead - LIGHT_FALL) >> (depth - 1)
+    mask = 0xFF
+    q = replace(p, gated_planes=mask, gated_time=gated_time, light_lead=lead,
+                light_times=tuple(unit << e for e in range(8)))
+    fr = Frame(0, depth)
+    if not on_time(dmd, q, fr):
+        raise ValueError("the gated plan makes a pulse late")
+    return Plan(q, frame_period(dmd, q, fr), gated_time, binds, dclk_hz)
 
 
 def timeline(exps, lsb, hide, dark_gap):

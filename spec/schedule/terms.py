@@ -5,9 +5,10 @@ The ``dmd`` domain's clock, the sequencer pipeline's fixed latencies, a plan's p
 row cycle and the time a reload takes (:func:`reload_bound`).
 """
 
+import math
 from dataclasses import dataclass, field
 
-from ..facts import TIMING, BlockMode
+from ..facts import LIGHT, TIMING, BlockMode
 from ..registers import (
     MAX_GROUPS,
     MIN_SETTLE,
@@ -23,7 +24,7 @@ __all__ = [
     "Params", "Frame", "Result", "exponents", "groups", "pulse_encoding", "FABRIC_HZ", "beats_at",
     "row_cycles", "row_rate_words", "INIT_TO_DVALID", "RELOAD_LEAD", "WORD_FIFO_ROWS", "flush_rows",
     "PAPER_SETTLE_CYCLES", "MIN_SETTLE", "RST_MARGIN", "FALL_LATENCY", "DECISION_TO_PINS",
-    "PACE_LAG", "even", "trigger_lead", "reload_bound", "reload_cycles",
+    "PACE_LAG", "MIRRORS_SETTLED", "LIGHT_RISE", "LIGHT_FALL", "even", "trigger_lead", "reload_bound", "reload_cycles",
 ]
 
 
@@ -57,6 +58,21 @@ def trigger_lead(dmd, beats=1):
     """The least offset of group 0 in GROUPS by which a trigger may come while other groups'
     loads run (:meth:`_Model.steady`): :func:`spec.registers.lead_cycles` of ``dmd``."""
     return lead_cycles(row_cycles(dmd, beats), dmd.clear_row_cycles)
+
+
+def _at_least(seconds):
+    """The least whole number of cycles that lasts ``seconds``."""
+    return math.ceil(seconds * FABRIC_HZ - 1e-9)
+
+
+#: Cycles from a clocking pulse on the pins to its mirrors settled: the pulse to the start of
+#: their motion, then the switching time (crossover and settling). A gated plane's light comes
+#: no sooner.
+MIRRORS_SETTLED = _at_least(TIMING["t_pulse_to_mirror"].value + TIMING["t_switch"].value)
+#: Cycles the light source takes to reach full light after the gate rises, and to go dark after
+#: it falls (assumptions: :data:`spec.facts.LIGHT`).
+LIGHT_RISE = _at_least(LIGHT["t_rise"].value)
+LIGHT_FALL = _at_least(LIGHT["t_fall"].value)
 
 
 #: First load this many cycles after INIT_ACTIVE falls (DLPC910: first DVALID >= 64 clocks).
@@ -165,6 +181,13 @@ class Params:
     # one timeline, in place of ``order_table`` and ``g * stagger``), one entry a group
     group_tables: tuple = ()
     group_offsets: tuple = ()
+    # gated planes (the gate pin switches the light): bit e of ``gated_planes`` gates the plane of
+    # weight 2**e, which lasts ``gated_time``, its light on ``light_times[e]`` from ``light_lead``
+    # after its pulse
+    gated_planes: int = 0
+    gated_time: int = 0
+    light_lead: int = 0
+    light_times: tuple = (0,) * 8
 
     def __post_init__(self):
         if (self.order == PlaneOrder.GROUPS) != bool(self.group_tables) or \
@@ -175,7 +198,7 @@ class Params:
         """The values of :class:`~gateware.registers.Registers`, as a dict."""
         regs = {k: getattr(self, k) for k in (
             "lsb", "t_rst", "t_settle", "hide", "dark_gap", "stagger", "period", "reload_lead",
-            "camera_offset", "camera_width", "anchor")}
+            "camera_offset", "camera_width", "anchor", "gated_planes", "gated_time", "light_lead")}
         unused = MAX_GROUPS - len(self.group_tables)
         tables = [list(t) + list(range(len(t), 8)) for t in self.group_tables] + [list(range(8))] * unused
         regs.update(reset_mode=self.reset_mode, order=self.order, order_table=list(self.order_table),
@@ -185,8 +208,17 @@ class Params:
                     chain=int(self.chain), strict_rst=int(self.strict_rst), trigger=self.trigger,
                     trigger_hold=int(self.trigger_hold),
                     source=self.source, row_period=self.row_period or row_cycles(dmd, self.beats),
-                    ns_flip=int(self.ns_flip), park=int(self.park))
+                    ns_flip=int(self.ns_flip), park=int(self.park), light_times=list(self.light_times))
         return regs
+
+    def gated(self, e):
+        """Whether the plane of weight ``2**e`` is gated."""
+        return bool(self.gated_planes >> e & 1)
+
+    def plane_time(self, e, lsb=0):
+        """The plane of weight ``2**e``'s time, pulse to pulse: ``gated_time`` if it is gated, else
+        ``lsb`` (a frame's own, 0: the register's) shifted by ``e``."""
+        return self.gated_time if self.gated(e) else (lsb or self.lsb) << e
 
 
 @dataclass
