@@ -24,7 +24,7 @@ from spec import plan_search, schedule
 from spec.facts import TEST_DMD
 from spec.registers import TriggerMode
 
-__all__ = ["misalignment", "run", "SHIFTS_PCT"]
+__all__ = ["misalignment", "run", "SHIFTS_PCT", "SHOWN_PCT", "worst_by_shift", "write_one_curve"]
 
 #: Window start minus the ramp frame's first pulse, in % of the frame period (- leads, + lags).
 SHIFTS_PCT = tuple(sorted({*range(-100, 101, 5), -1, 1}))
@@ -77,6 +77,35 @@ def _write(curves):
     label(axes[-1], "window start - frame start (% of a frame; - leads, + lags)", "max |error| (LSB)",
           "largest error against misalignment")
     save_figure(plt, fig, "camera_misalignment")
+
+
+def worst_by_shift(by_shift, shown=SHOWN_PCT):
+    """The largest error (LSB, absolute) of the aligned window and of each shift ``shown``, by the
+    part of a figure's name that says when the window starts: ``aligned``, ``lag_<p>pct``,
+    ``lead_<p>pct``."""
+    out = {"aligned": float(np.abs(by_shift[0]).max())}
+    for pct in shown:
+        out[f"lag_{pct}pct" if pct > 0 else f"lead_{-pct}pct"] = float(np.abs(by_shift[pct]).max())
+    return out
+
+
+def write_one_curve(name, by_shift, title):
+    """``build/<name>.csv`` and ``.png`` of one mode's experiment (``{shift: error of each grey
+    level}``): the error against the grey level at the shifts of 10 % and more, and the largest
+    error against the shift."""
+    levels = len(next(iter(by_shift.values())))
+    write_table(name, ["shift_pct_of_frame", *[f"error_lsb_grey_{g}" for g in range(levels)]],
+                [[pct, *[f"{e:.3f}" for e in errors]] for pct, errors in by_shift.items()])
+    plt = pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for pct in (p for p in SHOWN_PCT if abs(p) >= 10 and p in by_shift):
+        axes[0].plot(range(levels), by_shift[pct], label=f"{pct:+d} %")
+    label(axes[0], "grey level", "camera error (LSB)", f"{title}: error against grey level",
+          legend_title="window start (% of a frame)")
+    axes[1].plot(list(by_shift), [np.abs(e).max() for e in by_shift.values()], "o-", label=title)
+    label(axes[1], "window start - frame start (% of a frame; - leads, + lags)", "max |error| (LSB)",
+          "largest error against misalignment")
+    save_figure(plt, fig, name)
 
 
 #: Where the camera figures come from (:mod:`flow.bench`).

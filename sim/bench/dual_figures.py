@@ -36,8 +36,7 @@ import math
 import numpy as np
 
 from host import weighted
-from sim.bench.camera_figures import SHIFTS_PCT
-from sim.bench.tables import label, pyplot, save_figure, write_table
+from sim.bench.camera_figures import SHIFTS_PCT, worst_by_shift, write_one_curve
 from sim.models import weighted_light_model as light
 from sim.rigs.tiled_rig import BOARD_PERIOD_FS, MASTER_PERIOD_FS, Oscillator, run_tiled
 from spec.facts import DMDS, WEIGHTED
@@ -194,22 +193,6 @@ def misalignment(bits=8, shifts=SHIFTS_PCT):
     return out
 
 
-def _write(curves, bits):
-    name = "dual_misalignment"
-    write_table(name, ["shift_pct_of_frame", *[f"error_lsb_grey_{g}" for g in range(1 << bits)]],
-                [[pct, *[f"{e:.3f}" for e in errors]] for pct, errors in curves.items()])
-    plt = pyplot()
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    for pct in (p for p in (-50, -10, 10, 50) if p in curves):
-        axes[0].plot(range(1 << bits), curves[pct], label=f"{pct:+d} %")
-    label(axes[0], "grey level", "camera error (LSB)", f"{bits}-bit dual frame: error against grey level",
-          legend_title="window start (% of a frame)")
-    axes[1].plot(list(curves), [np.abs(e).max() for e in curves.values()], "o-")
-    label(axes[1], "window start - frame start (% of a frame; - leads, + lags)", "max |error| (LSB)",
-          "largest error against misalignment")
-    save_figure(plt, fig, name)
-
-
 def run():
     figures = {}
     for bits in BITS:
@@ -218,12 +201,10 @@ def run():
             _trimmed(bits, dual, run_, boards, slots, figures)
         _rate(bits, figures, best=True)
     curves = misalignment(8)
-    _write(curves, 8)
+    write_one_curve("dual_misalignment", curves, "8-bit dual frame")
     source = SOURCE.format(name="dual_misalignment_gray8") + ", the ramp between black frames, window of a frame period"
-    figures["dual.cam_aligned_error_lsb_max_gray8"] = (float(np.abs(curves[0]).max()), "LSB", source)
-    for pct in SHOWN_PCT:
-        when = f"lag_{pct}pct" if pct > 0 else f"lead_{-pct}pct"
-        figures[f"dual.cam_{when}_error_lsb_max_gray8"] = (float(np.abs(curves[pct]).max()), "LSB", source)
+    for when, worst in worst_by_shift(curves, SHOWN_PCT).items():
+        figures[f"dual.cam_{when}_error_lsb_max_gray8"] = (worst, "LSB", source)
     return figures
 
 

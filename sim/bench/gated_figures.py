@@ -25,8 +25,8 @@ or lagging by 0-100 % of a frame): ``build/camera_misalignment_gated.csv`` and `
 import numpy as np
 
 from gateware.dlpc410.trigger import PIN_TO_STROBE
+from sim.bench.camera_figures import worst_by_shift, write_one_curve
 from sim.bench.rig_rate import median_period, ready, same_as_model
-from sim.bench.tables import label, pyplot, save_figure, write_table
 from sim.models.camera_model import Camera, to_lsb
 from sim.models.mcb_model import McbTiming
 from sim.rigs.fast_system_rig import read_rate
@@ -123,21 +123,6 @@ def misalignment(shifts=SHIFTS_PCT, name="camera_gated"):
     return out
 
 
-def _write(by_shift):
-    write_table("camera_misalignment_gated", ["shift_pct_of_frame", *[f"error_lsb_grey_{g}" for g in range(256)]],
-                [[pct, *[f"{e:.3f}" for e in errors]] for pct, errors in by_shift.items()])
-    plt = pyplot()
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    for pct in (-50, -10, 10, 50):
-        axes[0].plot(range(256), by_shift[pct], label=f"{pct:+d} %")
-    label(axes[0], "grey level", "camera error (LSB)", "gated, MSB first: error against grey level",
-          legend_title="window start (% of a frame)")
-    axes[1].plot(list(by_shift), [np.abs(e).max() for e in by_shift.values()], "o-", label="gated")
-    label(axes[1], "window start - frame start (% of a frame; - leads, + lags)", "max |error| (LSB)",
-          "largest error against misalignment")
-    save_figure(plt, fig, "camera_misalignment_gated")
-
-
 def run():
     figures = {}
     paces = {"": (schedule.row_rate_words(XGA, DCLK), BUS),
@@ -168,13 +153,11 @@ def run():
                 figures[gated][0] / fact.value, "1", f"arithmetic: {gated} / TI's {fact.value:g} Hz "
                                                      f"(spec.facts.ANCHORS {key})")
     curves = misalignment()
-    _write(curves)
+    write_one_curve("camera_misalignment_gated", curves, "gated, MSB first")
     cam = ("gateware: sequencer Verilog (sim.rigs.seq_rig), test DMD, the gated plan, three frames triggered at "
            "the frame rate; pins through the DLPC410 rule model, light through the camera model with the gate pin")
-    figures["cam.aligned_error_lsb_max_gated"] = (float(np.abs(curves[0]).max()), "LSB", cam)
-    for pct in (-50, -10, -1, 1, 10, 50):
-        when = f"lag_{pct}pct" if pct > 0 else f"lead_{-pct}pct"
-        figures[f"cam.{when}_error_lsb_max_gated"] = (float(np.abs(curves[pct]).max()), "LSB", cam)
+    for when, worst in worst_by_shift(curves).items():
+        figures[f"cam.{when}_error_lsb_max_gated"] = (worst, "LSB", cam)
     return figures
 
 
