@@ -167,12 +167,15 @@ async def link_life(dut):
     # frames both ways, back to back at line rate, offsets absorbed between frames
     out = random_frames(rng, count)
     received, elapsed = await bench.to_partner(out, 40 * count)
+    results["tx_lost"] = sum(got[-len(f) - 4:] != with_fcs(f) for f, got in zip(out, received, strict=True))
     check_at_partner(out, received)
     assert bench.partner.bad_frames == 0 and bench.partner.invalid == invalid, "code-groups invalid at the partner"
     results["tx_bytes"], results["tx_us"] = sum(len(f) + 4 for f in out), elapsed
     back = random_frames(rng, count)
     start = cocotb.utils.get_sim_time("us")
-    check_at_board(back, await bench.from_partner(back, 40 * count))
+    got = await bench.from_partner(back, 40 * count)
+    results["rx_lost"] = sum(bad or data != frame for frame, (data, bad) in zip(back, got, strict=True))
+    check_at_board(back, got)
     results["rx_bytes"], results["rx_us"] = sum(len(f) + 4 for f in back), cocotb.utils.get_sim_time("us") - start
     await Timer(1, "us")        # the counters' crossing into sync
     assert bench.counters()["good"] == count and bench.board("rx_dropped") == 0
