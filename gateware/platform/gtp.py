@@ -36,11 +36,17 @@ from a 125 MHz reference follow CERN's White Rabbit core for the Spartan-6 (wr-c
 * Reset: GTPRESET while the board is in reset; each user-clock domain is held in reset until
   both PLLLKDET and RESETDONE are set.
 
-Not confirmed (no copy of UG386 at hand): the bit order of the 10-bit word on the line in
-8b/10b bypass, and which of RXDISPERR/RXRUNDISP carries bit 9 received. Xilinx's RocketIO guide
-(UG024) maps TXCHARDISPMODE to the first bit sent ("a") and TXDATA[0] to the last ("j"); this
-wrapper takes the first bit sent to be bit 0 of :attr:`tx_code` by default and reverses the word
-with ``msb_first=True``. Which GTP lane (0 or 1) the SVEC's SFP is on is also taken from the
+Bit order in 8b/10b bypass: UG386 itself was not at hand. Xilinx's later transceiver guides
+say the GTP and GTX "always" send and receive "the right-most bit first" (TXDATA[0], RXDATA[0]:
+hence their 8b/10b encoder and decoder reverse the code-group so that ``a`` goes first), and,
+with the decoder bypassed and a 10-bit data width, that "RXDISPERR represents the 9th bit" and
+"RXCHARISK the 8th bit" (7 Series GTP, UG482 v1.9, "RX 8B/10B Decoder"; Virtex-6 GTX, UG366
+v2.5, "8B/10B Decoder Bit and Byte Order"); TXCHARDISPMODE and TXCHARDISPVAL are bits 9 and 8
+on the transmit side. This wrapper follows them: bit 0 of :attr:`tx_code` (``a``) first on the
+line, bit 9 received on RXDISPERR. The older RocketIO (UG024) is the other way round
+(TXCHARDISPMODE first, RXRUNDISP as a received bit); ``msb_first=True`` reverses the word
+should the Spartan-6 GTP turn out to be like it (to check on hardware, with UG386: see
+``constraints/README.md``). Which GTP lane (0 or 1) the SVEC's SFP is on is also taken from the
 board's pins, not confirmed from its schematic: ``lane`` says.
 """
 
@@ -113,6 +119,7 @@ class Gtp(wiring.Component):
         gtpclkout = Signal(2)
         txdata, rxdata = Signal(32), Signal(32)
         rxcharisk, rxdisperr = Signal(4), Signal(4)
+        # bit 0 first on the line and RXDISPERR as bit 9 (UG482, UG366: see the module's notes)
         order = (lambda v: v[::-1]) if self._msb_first else (lambda v: v)
         tx_word, rx_word = order(self.tx_code), Signal(10)
         m.d.comb += [txdata.eq(tx_word[:8]), rx_word.eq(Cat(rxdata[:8], rxcharisk[0], rxdisperr[0])),

@@ -6,15 +6,16 @@ vendor primitives, and these adapters are checked by building the Spartan-6 tree
 """
 
 from amaranth import ClockDomain, ClockSignal, Const, Elaboratable, Instance, Module, Mux, ResetSignal, Signal
-from amaranth.lib import io
+from amaranth.lib import io, wiring
 from amaranth.lib.cdc import FFSynchronizer, ResetSynchronizer
+from amaranth.lib.wiring import In, Out
 
 from gateware.dlpc410.interface import Signature as Dlpc410Signature
 from gateware.mac.gmii import RxPins, TxPins
 
 from .serdes import DCLK_BITS, Oserdes4, lane_bits
 
-__all__ = ["GmiiPins", "SfpGmiiPins", "GmiiTxElastic", "Dlpc410Pins", "TriggerPins", "VcxoDacPins"]
+__all__ = ["GmiiPins", "SfpGmiiPins", "SfpPhy", "GmiiTxElastic", "Dlpc410Pins", "TriggerPins", "VcxoDacPins"]
 
 class EthernetPins(Elaboratable):
     """What the core's MAC sees of the Ethernet PHY, whichever it is: GMII and management.
@@ -113,24 +114,70 @@ class SfpGmiiPins(EthernetPins):
     """
 
     def elaborate(self, platform):
+        m = Module()
+        sfp = platform.request("sfp", 0, dir="-")
+        refclk = platform.request("sfp_refclk", 0, dir="-")
+        m.submodules.phy = phy = SfpPhy(sfp, refclk)
+        m.d.comb += [phy.reset.eq(~self.phy_reset_n), phy.locked.eq(self._locked), phy.tx.eq(self.tx),
+                     self.rx.eq(phy.rx)]
+        m.submodules.tx_disable = tx_disable = io.Buffer("o", sfp.tx_disable)
+        m.d.comb += [tx_disable.o.eq(0), self.mdio_i.eq(1)]
+        return m
+
+
+class SfpPhy(wiring.Component):
+    """The SFP's GMII PHY in the FPGA: the GTP lane, our PCS and the transmit elastic buffer.
+
+    Drives ``ClockSignal("gmii_rx")`` from the GTP's recovered clock and holds ``gmii_rx`` in
+    reset until ``locked`` and the GTP is ready; ``gmii_tx`` is the caller's. The PCS's own
+    domains (``sfp_tx``, ``sfp_rx``) are local.
+
+    Parameters
+    ----------
+    pads, refclk :
+        As :class:`.gtp.Gtp`'s: the SFP's ``tx``, ``rx`` pairs and its reference clock pair.
+    link_timer : int
+        Auto-negotiation's link timer in cycles (10 ms nominal; shorter in simulation).
+
+    Members
+    -------
+    reset : In(1)
+        Holds the GTP in reset.
+    locked : In(1)
+        The fabric's clocks are locked.
+    tx : In(TxPins), in ``gmii_tx``
+    rx : Out(RxPins), in ``gmii_rx``, registered once
+    sync_status, mr_an_complete, losses, slips, restarts, xmit : Out
+        The PCS's, in ``gmii_rx``.
+    """
+
+    def __init__(self, pads, refclk, *, link_timer=1_250_000, counter_width=16):
+        from gateware.pcs.autoneg import Xmit
+        self._pads, self._refclk, self._link_timer, self._counter_width = pads, refclk, link_timer, counter_width
+        super().__init__({
+            "reset": In(1), "locked": In(1), "tx": In(TxPins), "rx": Out(RxPins),
+            "sync_status": Out(1), "mr_an_complete": Out(1), "xmit": Out(Xmit),
+            "losses": Out(counter_width), "slips": Out(counter_width), "restarts": Out(counter_width),
+        })
+
+    def elaborate(self, platform):
         from gateware.pcs import Pcs
 
         from .gtp import Gtp
         m = Module()
-        sfp = platform.request("sfp", 0, dir="-")
-        refclk = platform.request("sfp_refclk", 0, dir="-")
         m.domains += [ClockDomain("sfp_tx", local=True), ClockDomain("sfp_rx", local=True)]
-        m.submodules.gtp = gtp = Gtp(sfp, refclk, ~self.phy_reset_n, tx_domain="sfp_tx", rx_domain="sfp_rx")
-        m.submodules.pcs = pcs = Pcs(tx_domain="sfp_tx", rx_domain="sfp_rx")
+        m.submodules.gtp = gtp = Gtp(self._pads, self._refclk, self.reset, tx_domain="sfp_tx", rx_domain="sfp_rx")
+        m.submodules.pcs = pcs = Pcs(tx_domain="sfp_tx", rx_domain="sfp_rx", link_timer=self._link_timer,
+                                     counter_width=self._counter_width)
         m.d.comb += [pcs.rx_bits.eq(gtp.rx_bits), gtp.tx_code.eq(pcs.tx_code)]
         m.submodules.tx_elastic = elastic = GmiiTxElastic("gmii_tx", "sfp_tx")
         m.d.comb += [elastic.i.eq(self.tx), pcs.gmii_tx.eq(elastic.o)]
 
         m.d.comb += ClockSignal("gmii_rx").eq(ClockSignal("sfp_rx"))
-        m.submodules.rx_rst = ResetSynchronizer(~(self._locked & gtp.ready), domain="gmii_rx")
+        m.submodules.rx_rst = ResetSynchronizer(~(self.locked & gtp.ready), domain="gmii_rx")
         m.d.gmii_rx += self.rx.eq(pcs.gmii_rx)
-        m.submodules.tx_disable = tx_disable = io.Buffer("o", sfp.tx_disable)
-        m.d.comb += [tx_disable.o.eq(0), self.mdio_i.eq(1)]
+        m.d.comb += [getattr(self, name).eq(getattr(pcs, name))
+                     for name in ("sync_status", "mr_an_complete", "xmit", "losses", "slips", "restarts")]
         return m
 
 

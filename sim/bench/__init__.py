@@ -20,6 +20,7 @@ MODULES = [
     "sim.bench.host_figures",
     "sim.bench.mac_figures",
     "sim.bench.net_figures",
+    "sim.bench.pcs_figures",
     "sim.bench.rates_figures",
     "sim.bench.registers_figures",
     "sim.bench.store_figures",

@@ -5,18 +5,20 @@
 // correction bypassed, one byte (10 bits) a user-clock cycle, 1.25 Gb/s from a 125 MHz CLK00:
 //
 // * PLL: PLLLKDET0 rises SIM_LOCK_CYCLES cycles of CLK00 after GTPRESET0 falls, RESETDONE0
-//   SIM_DONE_CYCLES later; both fall at once on GTPRESET0. The bit clock is free-running, half
-//   a period SIM_HALF_BIT_NS (0.4 ns: 1.25 Gb/s); with CLK00 at 8 ns from time 0 the two are in
-//   step, as the real PLL's are.
+//   SIM_DONE_CYCLES later; both fall at once on GTPRESET0. The transmit bit clock is CLK00
+//   times ten, in step with CLK00's rising edge (from CLK00's last period), so a reference
+//   clock off its nominal rate gives a line off its nominal rate.
 // * Transmit: on each TXUSRCLK20 rising edge the word {TXCHARDISPMODE0[0], TXCHARDISPVAL0[0],
-//   TXDATA0[7:0]} is taken; the serialiser sends the last word taken, bit 0 first, ten bits a
-//   word (the TX buffer's latency is not modelled). TXN0 is ~TXP0. GTPCLKOUT0[0] is CLK00.
-// * Receive: RXP0 is sampled in the middle of each bit (the bit clock's falling edge: an ideal
-//   CDR for a line driven by another of these models); ten bits make a word, the first in bit 0,
-//   starting SIM_RX_OFFSET bits (0..9) after time 0, so words arrive at an arbitrary bit offset
-//   and the PCS must find the comma. The recovered clock GTPCLKOUT0[1] rises as each word is
-//   complete; RXDATA0[7:0], RXCHARISK0[0] and RXDISPERR0[0] are the last complete word, taken on
-//   RXUSRCLK20 (the elastic buffer, here a register).
+//   TXDATA0[7:0]} is taken; at each CLK00 rising edge the serialiser sends the word taken at
+//   the one before, bit 0 first (the "right-most bit first" of UG482 and UG366), ten bits a
+//   word. TXN0 is ~TXP0. GTPCLKOUT0[0] is CLK00.
+// * Receive: a CDR that locks to the line's edges, its nominal bit period 2 * SIM_HALF_BIT_NS
+//   (0.8 ns: 1.25 Gb/s): each bit is sampled half a bit after the last edge (see the receive
+//   block for its tolerance); ten bits make a word, the first in bit 0, starting SIM_RX_OFFSET
+//   bits (0..9) after time 0, so words arrive at an arbitrary bit offset and the PCS must find
+//   the comma. The recovered clock GTPCLKOUT0[1] rises as each word is complete, at the line's
+//   rate; RXDATA0[7:0], RXCHARISK0[0] (bit 8) and RXDISPERR0[0] (bit 9) are the last complete
+//   word, taken on RXUSRCLK20 (the elastic buffer, here a register).
 // * Lane 1 and every other port: accepted and ignored; outputs not listed above read 0.
 //
 // Attributes are accepted (the ones gtp.py sets, lane 0) and not checked.
@@ -140,59 +142,83 @@ module GTPA1_DUAL #(
         end
     end
 
-    // ---- The bit clock ------------------------------------------------------------------------
-    reg bitclk;
-    initial bitclk = 1'b0;
-    always #(SIM_HALF_BIT_NS) bitclk = ~bitclk;
-
     // ---- Transmit: TXUSRCLK2's word, then ten bits on the line, bit 0 first ----------------------
+    // The PLL multiplies CLK00 by ten: each rising edge of CLK00 starts a word, its bits a tenth
+    // of CLK00's last period apart, so the line's bit rate follows the reference clock's.
     reg [9:0] tx_word;
-    reg [9:0] tx_shift;
+    reg [9:0] tx_send;
+    realtime clk_edge, clk_period;
     integer tx_bit;
     initial begin
         tx_word = 10'd0;
-        tx_shift = 10'd0;
-        tx_bit = 0;
+        tx_send = 10'd0;
         TXP0 = 1'b0;
+        clk_edge = 0.0;
+        clk_period = 20.0 * SIM_HALF_BIT_NS;
     end
     always @(posedge TXUSRCLK20)
         tx_word <= {TXCHARDISPMODE0[0], TXCHARDISPVAL0[0], TXDATA0[7:0]};
-    // a word starts on every tenth bit clock, in step with CLK00's rising edge
-    always @(posedge bitclk) begin
-        if (tx_bit == 0) begin
-            TXP0 <= tx_word[0];
-            tx_shift <= {1'b0, tx_word[9:1]};
-        end else begin
-            TXP0 <= tx_shift[0];
-            tx_shift <= {1'b0, tx_shift[9:1]};
+    always @(posedge CLK00) begin
+        if (clk_edge > 0.0)
+            clk_period = $realtime - clk_edge;
+        clk_edge = $realtime;
+        // the word taken at the previous edge: the TX buffer's one word
+        tx_send = tx_word;
+        TXP0 = tx_send[0];
+        for (tx_bit = 1; tx_bit < 10; tx_bit = tx_bit + 1) begin
+            /* verilator lint_off ZERODLY */
+            #(clk_period / 10.0);
+            /* verilator lint_on ZERODLY */
+            TXP0 = tx_send[tx_bit];
         end
-        tx_bit <= (tx_bit == 9) ? 0 : tx_bit + 1;
     end
     assign TXN0 = ~TXP0;
 
-    // ---- Receive: mid-bit samples, ten a word at SIM_RX_OFFSET; the recovered clock ------------
+    // ---- Receive: a CDR locked to the line's edges, ten bits a word; the recovered clock -------
+    // Each bit is sampled half a nominal bit period (SIM_HALF_BIT_NS) after the last edge seen,
+    // or a whole period after the last sample when no edge came within the last bit: the
+    // sampling point follows a line whose bit rate differs from the nominal as long as the drift
+    // over a run of equal bits (at most five in 8b/10b) stays under half a bit, far beyond the
+    // +-100 ppm 1000BASE-X allows. Without edges the CDR free-runs at the nominal rate.
     reg [9:0] rx_shift;
     reg [9:0] rx_word;
     reg rxrecclk;
     integer rx_bit;
+    realtime rx_edge, rx_next;
     initial begin
         rx_shift = 10'd0;
         rx_word = 10'd0;
         rxrecclk = 1'b0;
         rx_bit = (10 - SIM_RX_OFFSET) % 10;
+        rx_edge = -1.0e9;
         RXDATA0 = 32'd0;
         RXCHARISK0 = 4'd0;
         RXDISPERR0 = 4'd0;
     end
-    always @(negedge bitclk) begin
-        rx_shift <= {RXP0, rx_shift[9:1]};
-        if (rx_bit == 9) begin
-            rx_word <= {RXP0, rx_shift[9:1]};
-            rxrecclk <= 1'b1;
-        end else if (rx_bit == 4) begin
-            rxrecclk <= 1'b0;
+    always @(posedge RXP0 or negedge RXP0)
+        rx_edge = $realtime;
+    initial begin
+        rx_next = SIM_HALF_BIT_NS;
+        forever begin
+            /* verilator lint_off ZERODLY */
+            #(rx_next - $realtime);
+            /* verilator lint_on ZERODLY */
+            rx_shift = {RXP0, rx_shift[9:1]};
+            if (rx_bit == 9) begin
+                rx_word = rx_shift;
+                rxrecclk = 1'b1;
+            end else if (rx_bit == 4) begin
+                rxrecclk = 1'b0;
+            end
+            rx_bit = (rx_bit == 9) ? 0 : rx_bit + 1;
+            if ($realtime - rx_edge < 2.0 * SIM_HALF_BIT_NS) begin
+                rx_next = rx_edge + SIM_HALF_BIT_NS;
+                while (rx_next < $realtime + SIM_HALF_BIT_NS)
+                    rx_next = rx_next + 2.0 * SIM_HALF_BIT_NS;
+            end else begin
+                rx_next = $realtime + 2.0 * SIM_HALF_BIT_NS;
+            end
         end
-        rx_bit <= (rx_bit == 9) ? 0 : rx_bit + 1;
     end
     always @(posedge RXUSRCLK20) begin
         RXDATA0 <= {24'd0, rx_word[7:0]};
