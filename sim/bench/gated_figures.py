@@ -9,6 +9,9 @@ of a frame between two others under the camera model (the mirrors' delay and cro
 facts table, the gate pin's waveform with the source's rise and fall), the pulses late, and the
 gate edges not where the registers put them.
 
+``sys.gray8_rate_hz_dlp7000_gated_memory`` (:func:`memory`): gated frames from the store, the
+memory in the loop while GigE writes, on the core of ``make sim``.
+
 ``..._store_row_period``: the same with the rows paced at the store's row period (the row period
 :func:`sim.rigs.fast_system_rig.read_rate` gives, held equal to the store's measured
 ``store.dlp7000_row_period_cycles_with_ingest`` by a test): a stand-in store paced at that row
@@ -36,7 +39,7 @@ from spec import schedule
 from spec.facts import ANCHORS, DMDS, TEST_DMD, TIMING
 from spec.registers import TriggerMode
 
-__all__ = ["run", "played", "misalignment"]
+__all__ = ["run", "played", "misalignment", "memory"]
 
 XGA = DMDS["dlp7000"]
 DCLK = 400e6
@@ -152,6 +155,7 @@ def run():
             figures[f"seq.gray8_gated{sfx}_over_ti_{anchor}"] = (
                 figures[gated][0] / fact.value, "1", f"arithmetic: {gated} / TI's {fact.value:g} Hz "
                                                      f"(spec.facts.ANCHORS {key})")
+    figures.update(memory())
     curves = misalignment()
     write_one_curve("camera_misalignment_gated", curves, "gated, MSB first")
     cam = ("gateware: sequencer Verilog (sim.rigs.seq_rig), test DMD, the gated plan, three frames triggered at "
@@ -159,6 +163,47 @@ def run():
     for when, worst in worst_by_shift(curves).items():
         figures[f"cam.{when}_error_lsb_max_gated"] = (worst, "LSB", cam)
     return figures
+
+
+def memory():
+    """Gated frames from the store with the memory in the loop (:func:`sim.rigs.gated_run.gated_stream`):
+    the core of ``make sim``, the gated plan set over GMII, its plane reader and the MCB model
+    feeding the sequencer while GigE writes the next frame at line rate. The headline is the
+    slowest frame period while GigE wrote; beside it the median, the plan's, and the bound at the
+    memory's pace (:func:`spec.bounds.gated`)."""
+    from sim.rigs import gated_run
+    from spec import bounds
+    name = "bench-gated"
+    r = gated_run.gated_stream(name, log=lambda _text: None)
+    during, status = r["periods_during_ingest"], r["status"]
+    run = (f"gateware: the full-XGA system run's core (sim.rigs.gated_run, the build of make sim: Verilator, GMII in, "
+           f"MCB model, DLPC410 rule model), DLP7000 at DCLK 400 MHz, the gated plan chained, {len(r['frames'])} "
+           f"frames of {gated_run.FRAMES} sent, the later ones over GMII at line rate while the frames play, each "
+           f"frame's light through the camera model with the gate pin; run {name}")
+    rate = schedule.FABRIC_HZ / max(during)
+    paces = bounds.Paces.of(XGA, DCLK, r["plan"].params.row_period)
+    bound = bounds.gated(paces, 8)
+    plan_source = (f"model: the gated plan's period (sim.rigs.gated_run.gated_plan, spec.schedule.plan_gated), "
+                   f"run {name}")
+    return {
+        "sys.gray8_rate_hz_dlp7000_gated_memory": (rate, "Hz", run + ", the slowest frame period while GigE wrote"),
+        "sys.gray8_rate_hz_dlp7000_gated_memory_median": (
+            schedule.FABRIC_HZ / sorted(during)[len(during) // 2], "Hz",
+            run + ", the median frame period while GigE wrote"),
+        "sys.gray8_gated_memory_periods_during_ingest": (len(during), "period", run),
+        "sys.gray8_gated_memory_periods_off_plan": (sum(period != r["period_cycles"] for period in r["periods"]),
+                                                    "period", run + ", periods other than the plan's"),
+        "sys.gray8_gated_memory_gray_error_lsb_max": (r["error_lsb_max"], "LSB", run),
+        "sys.gray8_gated_memory_row_underruns": (status["row_underruns"], "row", run + ", status reply"),
+        "sys.gray8_gated_memory_pulses_late": (status["pulses_late"], "pulse", run + ", status reply"),
+        "sys.gray8_rate_hz_dlp7000_gated_memory_model": (r["plan"].rate_hz, "Hz", plan_source),
+        "sys.gray8_gated_memory_bound_hz_model": (
+            bound.rate_hz, "Hz", f"model: spec.bounds.gated, 8 bits, binds {bound.binds}, a row every "
+                                 f"{paces.row_period} cycles (the run's plan's row period)"),
+        "sys.gray8_gated_memory_fraction_of_bound_model": (
+            rate / bound.rate_hz, "", "arithmetic: sys.gray8_rate_hz_dlp7000_gated_memory / "
+                                      "sys.gray8_gated_memory_bound_hz_model"),
+    }
 
 
 if __name__ == "__main__":

@@ -15,7 +15,7 @@ from gateware.mac import gmii as gmii_pins
 from sim.harness.layout import fields
 from sim.models.dlpc410_model import INPUTS, OUTPUTS
 
-__all__ = ["read", "Mismatch", "replay_dlpc410", "rising_edges", "gmii_frames", "write_vcd"]
+__all__ = ["read", "Mismatch", "replay_dlpc410", "rising_edges", "edges", "gmii_frames", "write_vcd"]
 
 #: Controller outputs the responder drives and the replay compares.
 COMPARED = ("init_active", "rst_active", "ecp2_finished")
@@ -45,6 +45,18 @@ def rising_edges(trace, layout, name):
             edges.append(cycle)
         last = level
     return edges
+
+
+def edges(trace, layout, name):
+    """``(cycle, level)`` of every change of field ``name``, from level 0."""
+    _, offset, mask = next(f for f in fields(layout) if f[0] == name)
+    out, last = [], 0
+    for cycle, value in trace:
+        level = value >> offset & mask
+        if level != last:
+            out.append((cycle, level))
+        last = level
+    return out
 
 
 def replay_dlpc410(model, trace, layout, *, until=None):

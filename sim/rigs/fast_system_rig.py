@@ -60,14 +60,14 @@ INGEST_BYTES_PER_S = 125e6
 
 def pin_layout(buses, beats=1):
     """One record of the DLPC410 pin trace: the pins the model reads (data and DVALID on every
-    DCLK edge of the cycle), the controller's outputs the responder drove, and the trigger, sync
-    and camera pins."""
+    DCLK edge of the cycle), the controller's outputs the responder drove, and the trigger, sync,
+    camera and light gate pins."""
     return data.StructLayout({
         **{f"din_{b}": 32 * beats for b in "abcd"[:buses]},
         "dvalid": 2 * beats, "rowmd": 2, "rowad": 11, "blkmd": 2, "blkad": 4, "rst2blkz": 1, "comp_data": 1,
         "ns_flip": 1, "wdt_enblz": 1, "pwr_float": 1, "arstz": 1,
         "init_active": 1, "rst_active": 1, "ecp2_finished": 1,
-        "trigger_in": 1, "sync_out": 1, "camera_out": 1,
+        "trigger_in": 1, "sync_out": 1, "camera_out": 1, "gate_out": 1,
     })
 
 
@@ -294,7 +294,7 @@ class FastSystem(wiring.Component):
         dlpc410_side(m, dmd, core.dlpc, rst_active_cycles=cycles["rst_active_cycles"], init_cycles=self._init[0],
                      init_grace_cycles=self._init[1], flush=self.flush,
                      extra={"trigger_in": self.trigger_in, "sync_out": core.sync_out,
-                            "camera_out": core.camera_out})
+                            "camera_out": core.camera_out, "gate_out": core.gate_out})
         tx = Signal(gmii.TxPins)
         m.d.comb += tx.eq(core.gmii_tx)
         m.submodules.tx_trace = Instance(

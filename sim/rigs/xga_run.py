@@ -580,21 +580,21 @@ def binary_plan(dclk_hz=DCLK_HZ, reset_mode=ResetMode.QUAD, dmd=DMD):
                          words_per_cycle=read_rate(McbTiming(), DMD_HZ, BINARY_INGEST_BYTES_PER_S))
 
 
-def _binary_files(directory, images, the_plan, dmd):
-    """GMII replay files of the binary run: the setup (a control record for a bit depth of 1, a
-    sequencer record with the plan's registers, checked as the projector checks them), then
-    each frame whole. Returns (sends, query)."""
+def chain_files(directory, images, the_plan, dmd, *, bit_depth=1, name="binary"):
+    """GMII replay files of a run of chained frames: the setup (a control record for a bit depth
+    of ``bit_depth``, a sequencer record with the plan's registers, checked as the projector
+    checks them), then each frame whole, in files named after ``name``. Returns (sends, query)."""
     p = the_plan.params
-    setup = [codec.control_record(0, bit_depth=1),
+    setup = [codec.control_record(0, bit_depth=bit_depth),
              codec.sequencer_record(p.registers(dmd), 1, dmd=dmd, beats=p.beats)]
-    path = directory / "binary_setup.bin"
+    path = directory / f"{name}_setup.bin"
     gmii.replay_file(path, _datagrams(setup))
-    sends, sequence = [{"path": str(path), "what": "bit depth 1 and the binary plan's registers",
+    sends, sequence = [{"path": str(path), "what": f"bit depth {bit_depth} and the {name} plan's registers",
                         "kind": "control"}], len(setup)
     for index, image in enumerate(images):
         payloads = codec.image_records(image, frame=index, sequence=sequence)
         sequence += len(payloads)
-        path = directory / f"binary{index}.bin"
+        path = directory / f"{name}{index}.bin"
         gmii.replay_file(path, _datagrams(payloads))
         sends.append({"path": str(path), "what": f"frame {index + 1}/{len(images)}", "kind": "whole"})
     query = directory / "status_query.bin"
@@ -623,7 +623,7 @@ def binary_stream(key="binary", frames=BINARY_FRAMES, *, reset_mode=ResetMode.QU
     planes = [(image >> 7).astype(bool) for image in images]
     assert all(not np.array_equal(a, b) for k, a in enumerate(planes) for b in planes[:k]), \
         "the frames' patterns must differ, or a repeat or a skip would not be seen"
-    sends, query = _binary_files(directory, images, the_plan, dmd)
+    sends, query = chain_files(directory, images, the_plan, dmd)
     files = {name: directory / f"{name}.txt" for name in ("pins", "tx")}
     report_path = directory / "stimulus.json"
     p = {"sends": sends, "status_query": query, "replay": str(directory / "replay.bin"), "settle_us": 250,
@@ -632,7 +632,7 @@ def binary_stream(key="binary", frames=BINARY_FRAMES, *, reset_mode=ResetMode.QU
     build = cocotb_run.run(top_verilog(build_plan, False, dmd), toplevel=TOPLEVEL, module="sim.tb.fast_system_rig_tb",
                            key=f"{_name(dmd)}-{build_plan.params.beats}beats", params=p, extra_sources=SOURCES,
                            plusargs=_trace_plusargs(p["replay"], files), waves=False,
-                           testcase="stream_binary_patterns", top_signals_only=True)
+                           testcase="stream_chained_frames", top_signals_only=True)
     stimulus = json.loads(report_path.read_text())
     log(f"simulation done: build and run {time.monotonic() - start:.0f} s; checking the pins")
     _layout, _pins, model = _pins_checked(dmd, the_plan.params.beats, files["pins"])

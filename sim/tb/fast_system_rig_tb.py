@@ -229,9 +229,10 @@ async def stream_new_frames(dut):
 
 
 @cocotb.test()
-async def stream_binary_patterns(dut):
-    """Binary patterns from the store while GigE writes (:func:`sim.rigs.xga_run.binary_stream`): the setup
-    records (a bit depth of 1, a register set of chained 1-bit frames), the first frame, one
+async def stream_chained_frames(dut):
+    """Chained frames from the store while GigE writes (binary patterns,
+    :func:`sim.rigs.xga_run.binary_stream`; gated frames, :func:`sim.rigs.gated_run.gated_stream`):
+    the setup records (a bit depth, a register set of chained frames), the first frame, one
     trigger that starts the chain; then the other frames back to back over GMII, each written
     while the one before it repeats on the DMD; ``tail_us`` more after the last, then the
     status query."""
