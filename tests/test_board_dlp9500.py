@@ -127,7 +127,7 @@ def test_tree_places_the_whole_link(svec_tree):
     assert len(re.findall(r"^\s+GTPA1_DUAL #\(", v, re.M)) == 1
     assert re.search(r"\.PLL_DIVSEL_FB_0\(32'd2\)", v), "1.25 Gb/s from 125 MHz"
     assert len(re.findall(r"^\s+BUFIO2 #\(", v, re.M)) >= 2
-    assert re.search(r"^module \\projector_dlp9500\.gmii\.pcs ", v, re.M), "the PCS"
+    assert re.search(r"^module \\projector_dlp9500\.gmii\.phy\.pcs ", v, re.M), "the PCS"
     # the clock loop's DAC: the VCXO behind the 125 MHz reference (the reference design's pins)
     assert {("vcxo_dac_0__sclk__io", "N27"), ("vcxo_dac_0__din__io", "P25"),
             ("vcxo_dac_0__sync_n__io", "P26")} <= set(locs)
