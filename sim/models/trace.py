@@ -36,15 +36,10 @@ def read(path):
 
 
 def rising_edges(trace, layout, name):
-    """Cycles on which field ``name`` rose."""
-    _, offset, mask = next(f for f in fields(layout) if f[0] == name)
-    edges, last = [], 0
-    for cycle, value in trace:
-        level = value >> offset & mask
-        if level and not last:
-            edges.append(cycle)
-        last = level
-    return edges
+    """Cycles on which field ``name`` rose (from 0 to any other level)."""
+    changes = edges(trace, layout, name)
+    before = [0] + [level for _, level in changes[:-1]]
+    return [cycle for (cycle, level), last in zip(changes, before, strict=True) if level and not last]
 
 
 def edges(trace, layout, name):

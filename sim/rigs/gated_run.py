@@ -16,17 +16,14 @@ the frame periods, the ones while GigE wrote apart.
 """
 
 import json
-import time
 
 import numpy as np
 
-from sim.harness import cocotb_run
-from sim.harness.paths import build_dir
 from sim.models import trace
 from sim.models.camera_model import Camera, to_lsb
 from sim.models.mcb_model import McbTiming
 from sim.rigs import xga_run as xga
-from sim.rigs.fast_system_rig import INGEST_BYTES_PER_S, SOURCES, read_rate
+from sim.rigs.fast_system_rig import INGEST_BYTES_PER_S, read_rate
 from sim.rigs.scene import default_scene
 from spec import schedule
 from spec.facts import TIMING
@@ -39,11 +36,6 @@ FRAMES, TAIL_US = 3, 2500
 #: The mirrors in the camera model: pulse to motion, and the crossover (the facts table's).
 DELAY = round(TIMING["t_pulse_to_mirror"].value * schedule.FABRIC_HZ)
 CROSSOVER = round(TIMING["t_crossover"].value * schedule.FABRIC_HZ)
-#: Counters of the status reply that say something was lost or late.
-LOSSES = ("drop_overflow", "mac_rx_dropped", "rows_incomplete", "store_rows_refused", "store_frames_abandoned",
-          "pulses_late", "frames_bad_depth")
-
-
 def gated_plan(dclk_hz=xga.DCLK_HZ, dmd=xga.DMD):
     """The gated plan (:func:`spec.schedule.plan_gated`) of chained 8-bit frames, rows paced to
     the read bandwidth the memory model leaves the plane reader while GigE writes 8-bit frames at
@@ -84,31 +76,16 @@ def gated_stream(key="gated", frames=FRAMES, *, tail_us=TAIL_US, dclk_hz=xga.DCL
     when a frame shows none of the frames sent (more than half an LSB off each), the frames are
     out of order, or a counter says something was lost or late."""
     the_plan = gated_plan(dclk_hz, dmd)
-    build_plan = xga.plan(dclk_hz, None, dmd)
-    directory = build_dir("system", key)
     images = default_scene(frames, dmd.rows, dmd.columns)
-    sends, query = xga.chain_files(directory, images, the_plan, dmd, bit_depth=8, name="gated")
-    files = {name: directory / f"{name}.txt" for name in ("pins", "tx")}
-    report_path = directory / "stimulus.json"
-    p = {"sends": sends, "status_query": query, "replay": str(directory / "replay.bin"), "settle_us": 250,
-         "tail_us": tail_us, "margin_us": 20, "reply_us": 30, "progress_us": 2000, "report": str(report_path)}
-    start = time.monotonic()
-    build = cocotb_run.run(xga.top_verilog(build_plan, False, dmd), toplevel=xga.TOPLEVEL,
-                           module="sim.tb.fast_system_rig_tb", key=f"{xga._name(dmd)}-{build_plan.params.beats}beats",
-                           params=p, extra_sources=SOURCES, plusargs=xga._trace_plusargs(p["replay"], files),
-                           waves=False, testcase="stream_chained_frames", top_signals_only=True)
-    stimulus = json.loads(report_path.read_text())
-    log(f"simulation done: build and run {time.monotonic() - start:.0f} s; checking the pins")
+    stimulus, files, build = xga.run_chain(key, images, the_plan, dmd, tail_us=tail_us, dclk_hz=dclk_hz, bit_depth=8,
+                                           name="gated", log=log)
     layout, pins, model = xga._pins_checked(dmd, the_plan.params.beats, files["pins"])
     shown = _shown(model, pins, layout, the_plan.params, images, dmd)
     order = [f["image"] for f in shown]
     worst = max(f["error_lsb"] for f in shown)
     assert worst <= 0.5, f"a frame shows none of the frames sent: {worst:.3f} LSB off the nearest"
     assert order == sorted(order) and order[-1] == frames - 1, f"frames shown: {order}"
-    status = xga._status(trace.read(files["tx"]))
-    lost = {name: status[name] for name in LOSSES if status.get(name)}
-    assert not lost, lost
-    assert status["store_frames_complete"] == frames and status["registers_applied"] == 1, status
+    status = xga.chain_status(files, frames)
     sent = stimulus["sends"]
     first_ns, last_ns = sent[2]["start_ns"], sent[-1]["end_ns"]
     ns = 1e9 / xga.DMD_HZ

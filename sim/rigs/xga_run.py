@@ -602,6 +602,43 @@ def chain_files(directory, images, the_plan, dmd, *, bit_depth=1, name="binary")
     return sends, str(query)
 
 
+#: Counters of the status reply that say a chained run lost or delayed something.
+CHAIN_LOSSES = ("drop_overflow", "mac_rx_dropped", "rows_incomplete", "store_rows_refused", "store_frames_abandoned",
+                "pulses_late", "frames_bad_depth")
+
+
+def run_chain(key, images, the_plan, dmd, *, tail_us, dclk_hz=DCLK_HZ, bit_depth=1, name="binary", log=print):
+    """Play ``images`` chained from the store while GigE writes, on the core of ``make sim`` (the
+    8-bit plan's build) under Verilator: the setup and the first frame, one trigger, then the other
+    frames over GMII at line rate, ``tail_us`` more, the status query (:func:`chain_files`, the
+    testbench's ``stream_chained_frames``). Returns (the testbench's report, the trace files, the build)."""
+    build_plan = plan(dclk_hz, None, dmd)
+    directory = build_dir("system", key)
+    sends, query = chain_files(directory, images, the_plan, dmd, bit_depth=bit_depth, name=name)
+    files = {kind: directory / f"{kind}.txt" for kind in ("pins", "tx")}
+    report_path = directory / "stimulus.json"
+    p = {"sends": sends, "status_query": query, "replay": str(directory / "replay.bin"), "settle_us": 250,
+         "tail_us": tail_us, "margin_us": 20, "reply_us": 30, "progress_us": 2000, "report": str(report_path)}
+    start = time.monotonic()
+    build = cocotb_run.run(top_verilog(build_plan, False, dmd), toplevel=TOPLEVEL, module="sim.tb.fast_system_rig_tb",
+                           key=f"{_name(dmd)}-{build_plan.params.beats}beats", params=p, extra_sources=SOURCES,
+                           plusargs=_trace_plusargs(p["replay"], files), waves=False,
+                           testcase="stream_chained_frames", top_signals_only=True)
+    stimulus = json.loads(report_path.read_text())
+    log(f"simulation done: build and run {time.monotonic() - start:.0f} s; checking the pins")
+    return stimulus, files, build
+
+
+def chain_status(files, frames):
+    """The status reply of a chained run; raises when a counter says something was lost or late,
+    or the store did not complete ``frames`` frames under one register set."""
+    status = _status(trace.read(files["tx"]))
+    lost = {name: status[name] for name in CHAIN_LOSSES if status.get(name)}
+    assert not lost, lost
+    assert status["store_frames_complete"] == frames and status["registers_applied"] == 1, status
+    return status
+
+
 def binary_stream(key="binary", frames=BINARY_FRAMES, *, reset_mode=ResetMode.QUAD, dclk_hz=DCLK_HZ, log=print,
                   dmd=DMD):
     """Binary patterns played from the store while GigE writes: the run's core (the 8-bit plan's
@@ -617,24 +654,11 @@ def binary_stream(key="binary", frames=BINARY_FRAMES, *, reset_mode=ResetMode.QU
     in the order sent, each at least once; the pattern periods. Returns the report; raises when a
     pattern shows anything else or a counter says something was lost."""
     the_plan = binary_plan(dclk_hz, reset_mode, dmd)
-    build_plan = plan(dclk_hz, None, dmd)
-    directory = build_dir("system", key)
     images = default_scene(frames, dmd.rows, dmd.columns)
     planes = [(image >> 7).astype(bool) for image in images]
     assert all(not np.array_equal(a, b) for k, a in enumerate(planes) for b in planes[:k]), \
         "the frames' patterns must differ, or a repeat or a skip would not be seen"
-    sends, query = chain_files(directory, images, the_plan, dmd)
-    files = {name: directory / f"{name}.txt" for name in ("pins", "tx")}
-    report_path = directory / "stimulus.json"
-    p = {"sends": sends, "status_query": query, "replay": str(directory / "replay.bin"), "settle_us": 250,
-         "tail_us": BINARY_TAIL_US, "margin_us": 20, "reply_us": 30, "progress_us": 2000, "report": str(report_path)}
-    start = time.monotonic()
-    build = cocotb_run.run(top_verilog(build_plan, False, dmd), toplevel=TOPLEVEL, module="sim.tb.fast_system_rig_tb",
-                           key=f"{_name(dmd)}-{build_plan.params.beats}beats", params=p, extra_sources=SOURCES,
-                           plusargs=_trace_plusargs(p["replay"], files), waves=False,
-                           testcase="stream_chained_frames", top_signals_only=True)
-    stimulus = json.loads(report_path.read_text())
-    log(f"simulation done: build and run {time.monotonic() - start:.0f} s; checking the pins")
+    stimulus, files, build = run_chain(key, images, the_plan, dmd, tail_us=BINARY_TAIL_US, dclk_hz=dclk_hz, log=log)
     _layout, _pins, model = _pins_checked(dmd, the_plan.params.beats, files["pins"])
     starts = [c.cycle for c in model.log if c.kind == "pulse" and 0 in c.blocks]
     shown = []
@@ -651,12 +675,7 @@ def binary_stream(key="binary", frames=BINARY_FRAMES, *, reset_mode=ResetMode.QU
         shown.append(matches[0])
     assert shown == sorted(shown) and sorted(set(shown)) == list(range(frames)), \
         f"frames shown in the patterns: {shown}"
-    status = _status(trace.read(files["tx"]))
-    counted = ("drop_overflow", "mac_rx_dropped", "rows_incomplete", "store_rows_refused", "store_frames_abandoned",
-               "pulses_late", "frames_bad_depth")
-    lost = {name: status[name] for name in counted if status.get(name)}
-    assert not lost, lost
-    assert status["store_frames_complete"] == frames and status["registers_applied"] == 1, status
+    status = chain_status(files, frames)
     periods = [b - a for a, b in zip(starts, starts[1:], strict=False)]
     # the patterns played while GigE wrote: from the second frame's first byte to the last's last
     sent = stimulus["sends"]
