@@ -38,8 +38,8 @@ def read(path):
 def rising_edges(trace, layout, name):
     """Cycles on which field ``name`` rose (from 0 to any other level)."""
     changes = edges(trace, layout, name)
-    before = [0] + [level for _, level in changes[:-1]]
-    return [cycle for (cycle, level), last in zip(changes, before, strict=True) if level and not last]
+    before = [0, *(level for _, level in changes)]  # one longer: the level after the last change
+    return [cycle for (cycle, level), last in zip(changes, before, strict=False) if level and not last]
 
 
 def edges(trace, layout, name):
