@@ -36,6 +36,8 @@ FRAMES, TAIL_US = 3, 2500
 #: The mirrors in the camera model: pulse to motion, and the crossover (the facts table's).
 DELAY = round(TIMING["t_pulse_to_mirror"].value * schedule.FABRIC_HZ)
 CROSSOVER = round(TIMING["t_crossover"].value * schedule.FABRIC_HZ)
+
+
 def gated_plan(dclk_hz=xga.DCLK_HZ, dmd=xga.DMD):
     """The gated plan (:func:`spec.schedule.plan_gated`) of chained 8-bit frames, rows paced to
     the read bandwidth the memory model leaves the plane reader while GigE writes 8-bit frames at
